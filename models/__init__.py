@@ -1,0 +1,201 @@
+"""planbench's MJCF models, one Menagerie-style folder per mechanism.
+
+``load(name)`` compiles ``models/<name>/scene.xml`` into a ``mujoco.MjModel``. The specs
+(``loader_spec()``...) read dimensions and limits from the same MJCF with ElementTree, so
+the planners (pure numpy) and MuJoCo share one source of truth for every number; tests compare
+the planners' kinematics with MuJoCo's at random poses.
+"""
+
+from __future__ import annotations
+
+import functools
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+MODELS_DIR = Path(__file__).resolve().parent
+MECHANISMS = ("loader",)
+
+
+def model_dir(name: str) -> Path:
+    if name not in MECHANISMS:
+        raise ValueError(f"unknown model {name!r}; known models: {', '.join(MECHANISMS)}")
+    return MODELS_DIR / name
+
+
+def scene_path(name: str) -> Path:
+    """Path of ``models/<name>/scene.xml``."""
+    return model_dir(name) / "scene.xml"
+
+
+def load(name: str):
+    """Compile the scene of mechanism ``name`` into a ``mujoco.MjModel``."""
+    import mujoco  # models/ is importable without MuJoCo for the planners' specs.
+
+    return mujoco.MjModel.from_xml_path(str(scene_path(name)))
+
+
+def _floats(text: str | None, default: tuple[float, ...]) -> np.ndarray:
+    return np.array([float(v) for v in text.split()] if text else default, dtype=float)
+
+
+@dataclass(frozen=True)
+class JointSpec:
+    """One actuated 1-dof joint of a serial chain.
+
+    Attributes:
+      name: joint (and actuator) name.
+      kind: "slide" or "hinge".
+      body: name of the body the joint moves.
+      axis: (3,) unit joint axis in the body frame.
+      lower, upper: joint range, m or rad.
+      force_limit: actuator force/torque limit, N or N m.
+      rate_limit: set-point rate limit of the drive, m/s or rad/s.
+      kp, kv: servo stiffness (N/m or N m/rad) and damping (N s/m or N m s/rad).
+    """
+
+    name: str
+    kind: str
+    body: str
+    axis: np.ndarray
+    lower: float
+    upper: float
+    force_limit: float
+    rate_limit: float
+    kp: float
+    kv: float
+
+
+@dataclass(frozen=True)
+class BodySpec:
+    """A body of a serial chain: its fixed offset in its parent and its joint, if any.
+
+    Attributes:
+      name: body name.
+      pos: (3,) origin in the parent's frame, m.
+      quat: (4,) orientation in the parent's frame (w, x, y, z).
+      joint: index into the chain's joints, or None for a body welded to its parent.
+    """
+
+    name: str
+    pos: np.ndarray
+    quat: np.ndarray
+    joint: int | None
+
+
+@dataclass(frozen=True)
+class SerialChainSpec:
+    """A serial chain read from an MJCF: joints in order from the base, and named sites.
+
+    ``sites`` maps a site name to (body name, (3,) position in that body's frame, m).
+    ``base_pos``/``base_quat`` place the parent of the chain's first body in the world.
+    """
+
+    joints: tuple[JointSpec, ...]
+    bodies: tuple[BodySpec, ...]
+    sites: dict
+    base_pos: np.ndarray
+    base_quat: np.ndarray
+
+    @property
+    def names(self) -> list[str]:
+        return [j.name for j in self.joints]
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.array([j.lower for j in self.joints])
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.array([j.upper for j in self.joints])
+
+    @property
+    def force_limit(self) -> np.ndarray:
+        return np.array([j.force_limit for j in self.joints])
+
+    @property
+    def rate_limit(self) -> np.ndarray:
+        return np.array([j.rate_limit for j in self.joints])
+
+    @property
+    def kp(self) -> np.ndarray:
+        return np.array([j.kp for j in self.joints])
+
+    @property
+    def kv(self) -> np.ndarray:
+        return np.array([j.kv for j in self.joints])
+
+
+def _serial_chain(xml_path: Path, root_body: str) -> SerialChainSpec:
+    """Read the serial chain below ``root_body`` (inclusive) of an MJCF.
+
+    The model files of planbench give every position, quaternion, axis and range explicitly
+    on the element (no inherited pos/axis), which is what this reader relies on; the spec
+    test compares it with the compiled model.
+    """
+    root = ET.parse(xml_path).getroot()
+    actuators = {a.get("joint"): a for a in root.iter("general")}
+    parents = {child: parent for parent in root.iter() for child in parent}
+    body = next(b for b in root.iter("body") if b.get("name") == root_body)
+    base = parents[body]
+    if base.tag == "body" and parents[base].tag != "worldbody":
+        raise ValueError(f"the parent of {root_body!r} must be a child of the worldbody")
+    base_pos = _floats(base.get("pos"), (0.0, 0.0, 0.0))
+    base_quat = _floats(base.get("quat"), (1.0, 0.0, 0.0, 0.0))
+    joints, bodies, sites = [], [], {}
+    node = body
+    while node is not None:
+        bodies.append(
+            BodySpec(
+                name=node.get("name"),
+                pos=_floats(node.get("pos"), (0.0, 0.0, 0.0)),
+                quat=_floats(node.get("quat"), (1.0, 0.0, 0.0, 0.0)),
+                joint=len(joints) if node.findall("joint") else None,
+            )
+        )
+        for site in node.findall("site"):
+            sites[site.get("name")] = (node.get("name"), _floats(site.get("pos"), (0.0, 0.0, 0.0)))
+        for joint in node.findall("joint"):
+            act = actuators[joint.get("name")]
+            lower, upper = _floats(joint.get("range"), (-np.inf, np.inf))
+            gain = _floats(act.get("gainprm"), (1.0,))
+            bias = _floats(act.get("biasprm"), (0.0, 0.0, 0.0))
+            axis = _floats(joint.get("axis"), (0.0, 0.0, 1.0))
+            joints.append(
+                JointSpec(
+                    name=joint.get("name"),
+                    kind=joint.get("type", "hinge"),
+                    body=node.get("name"),
+                    axis=axis / np.linalg.norm(axis),
+                    lower=float(lower),
+                    upper=float(upper),
+                    force_limit=float(_floats(act.get("forcerange"), (-np.inf, np.inf))[1]),
+                    rate_limit=float(_floats(act.get("ctrlrange"), (-np.inf, np.inf))[1]),
+                    kp=float(gain[0]),
+                    kv=float(-bias[2]),
+                )
+            )
+        children = node.findall("body")
+        if len(children) > 1:
+            raise ValueError(f"body {node.get('name')!r} of {xml_path.name} branches; not a serial chain")
+        if not children:
+            break
+        child = children[0]
+        if len(child.findall("joint")) > 1:
+            raise ValueError(f"body {child.get('name')!r} has more than one joint")
+        node = child
+    return SerialChainSpec(
+        joints=tuple(joints), bodies=tuple(bodies), sites=sites, base_pos=base_pos, base_quat=base_quat
+    )
+
+
+@functools.cache
+def loader_spec() -> SerialChainSpec:
+    """The PRR-3R loader's chain, limits and servo gains, read from models/loader/loader.xml.
+
+    Joint order is Table 1's theta1 ... theta6 (slide, shoulder, elbow, wrist_pitch,
+    wrist_yaw, wrist_roll). The chain starts at the body ``carriage``, child of ``base``.
+    """
+    return _serial_chain(model_dir("loader") / "loader.xml", "carriage")

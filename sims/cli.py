@@ -1,0 +1,201 @@
+"""The ``planbench`` command line (ARCHITECTURE.md, "Contracts").
+
+  planbench list
+  planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--duration S] [--video FILE]
+                [--camera overview|closeup] [--quiet]
+  planbench plan NAME --out DIR
+  planbench bench
+  planbench demo [--out DIR]
+
+Exit codes: 0 every check passed, 1 a check failed, 2 bad input (one line on stderr).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+import sims  # noqa: F401  (chooses the OpenGL back end before mujoco is imported)
+
+EXIT_OK, EXIT_CHECK_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class BadInput(Exception):
+    """Raised for input errors: printed as one line, exit code 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, no usage dump
+        raise BadInput(message)
+
+
+def _finite(kind: str, minimum: float | None = None, strict: bool = False):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind} {text!r} is not a number") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{kind} {text} is not finite")
+        if minimum is not None and (value <= minimum if strict else value < minimum):
+            raise argparse.ArgumentTypeError(
+                f"{kind} {text} must be {'>' if strict else '>='} {minimum:g}"
+            )
+        return value
+
+    return parse
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seed {text!r} is not an integer") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"seed {value} must be in [0, 2^63)")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="planbench", description="MuJoCo testbed for motion planners.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    sub.add_parser("list", help="list the scenarios")
+    run = sub.add_parser("run", help="simulate a scenario and check it")
+    run.add_argument("name")
+    run.add_argument("--out", type=Path, help="output directory (default results/NAME)")
+    run.add_argument("--seed", type=_seed, default=0)
+    run.add_argument("--wind", type=_finite("wind speed", 0.0), help="mean wind, m/s")
+    run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
+    run.add_argument("--video", type=Path, help="write an H.264 video of the run here")
+    run.add_argument("--camera", default=None, help="video camera: overview or closeup")
+    run.add_argument("--quiet", action="store_true", help="no progress bars")
+    plan = sub.add_parser("plan", help="write a scenario's planned motion, no physics")
+    plan.add_argument("name")
+    plan.add_argument("--out", type=Path, required=True)
+    sub.add_parser("bench", help="benchmark table: realtime factors and loop/bare-mj_step ratios")
+    demo = sub.add_parser("demo", help="run every scenario with a video; one table of checks")
+    demo.add_argument("--out", type=Path, default=Path("results"))
+    demo.add_argument("--quiet", action="store_true")
+    return parser
+
+
+def _options(scenario, args):
+    from sims.scenarios import RunOptions
+
+    if args.wind is not None and "wind" not in scenario.options:
+        raise BadInput(f"scenario {scenario.name} has no wind model; --wind is not accepted")
+    return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind)
+
+
+def cmd_list(args) -> int:
+    from sims.scenarios import SCENARIOS
+
+    width = max(len(n) for n in SCENARIOS)
+    for s in SCENARIOS.values():
+        print(f"{s.name:<{width}}  {s.summary}")
+    return EXIT_OK
+
+
+def format_checks(rows) -> str:
+    """One table of (scenario, check) rows."""
+    lines = [f"{'scenario':<16} {'check':<22} {'value':>12} {'limit':>10} {'unit':<6} result"]
+    for scenario, c in rows:
+        lines.append(
+            f"{scenario:<16} {c.name:<22} {c.value:>12.5g} {c.comparison:>2}{c.limit:>8.4g} "
+            f"{c.unit:<6} {'pass' if c.passed else 'FAIL'}"
+        )
+    return "\n".join(lines)
+
+
+def cmd_run(args) -> int:
+    from sims import outputs, runner, scenarios
+
+    try:
+        scenario = scenarios.get(args.name)
+    except ValueError as e:
+        raise BadInput(str(e)) from None
+    out = args.out if args.out is not None else Path("results") / scenario.name
+    outputs.check_writable(out, "output dir")
+    if args.video is not None:
+        outputs.check_writable(args.video, "video")
+    camera = args.camera or scenario.camera
+    if camera not in ("overview", "closeup"):
+        raise BadInput(f"camera {camera!r} is not one of overview, closeup")
+    setup = scenario.build(_options(scenario, args))
+    result = runner.run(scenario.name, setup, quiet=args.quiet)
+    outputs.write_run(result, setup, out, video=args.video, camera=camera, quiet=args.quiet)
+    print(format_checks([(scenario.name, c) for c in result.checks]))
+    print(f"{'PASSED' if result.passed else 'FAILED'}: {scenario.name}, "
+          f"{result.sim_time_s:.2f} s simulated in {result.wall_time_s:.2f} s; outputs in {out}")
+    return EXIT_OK if result.passed else EXIT_CHECK_FAILED
+
+
+def cmd_plan(args) -> int:
+    from sims import outputs, plans, scenarios
+
+    try:
+        scenario = scenarios.get(args.name)
+    except ValueError as e:
+        raise BadInput(str(e)) from None
+    outputs.check_writable(args.out, "output dir")
+    plans.write_plan(scenario, args.out)
+    print(f"plan of {scenario.name} written to {args.out}")
+    return EXIT_OK
+
+
+def cmd_bench(args) -> int:
+    from sims import bench
+
+    print(bench.format_table(bench.run_all()))
+    return EXIT_OK
+
+
+def cmd_demo(args) -> int:
+    from sims import outputs, runner, scenarios
+
+    rows, unexpected = [], []
+    for scenario in scenarios.SCENARIOS.values():
+        out = args.out / scenario.name
+        setup = scenario.build(scenarios.RunOptions())
+        result = runner.run(scenario.name, setup, quiet=args.quiet)
+        outputs.write_run(result, setup, out, video=out / f"{scenario.name}.mp4",
+                          camera=scenario.camera, quiet=args.quiet)
+        rows += [(scenario.name, c) for c in result.checks]
+        verdict = "passed" if result.passed else "failed"
+        expected = "as expected" if result.passed == scenario.expect_pass else "UNEXPECTEDLY"
+        if result.passed != scenario.expect_pass:
+            unexpected.append(scenario.name)
+        print(f"{scenario.name}: {verdict} {expected} ({result.sim_time_s:.1f} s simulated in "
+              f"{result.wall_time_s:.1f} s) -> {out}", flush=True)
+    print()
+    print(format_checks(rows))
+    if unexpected:
+        print(f"\nunexpected outcome: {', '.join(unexpected)}")
+        return EXIT_CHECK_FAILED
+    print(f"\nall {len(scenarios.SCENARIOS)} scenarios behaved as expected "
+          "(loader-direct is meant to fail its obstacle check)")
+    return EXIT_OK
+
+
+COMMANDS = {"list": cmd_list, "run": cmd_run, "plan": cmd_plan, "bench": cmd_bench, "demo": cmd_demo}
+
+
+def main(argv=None) -> int:
+    from planners.errors import PlanningError
+    from sims.outputs import OutputError
+
+    try:
+        args = build_parser().parse_args(argv)
+        return COMMANDS[args.command](args)
+    except (BadInput, PlanningError, OutputError) as e:
+        print(f"planbench: error: {e}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("planbench: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,205 @@
+"""The PRR-3R ammunition loader in MuJoCo: physics accessors, scenarios, checks, report.
+
+Scenarios:
+  loader-supply  Table 1's key points through the cubic B-spline (the paper's supply stage).
+  loader-direct  P2 to P3 as one straight joint-space move in the same time; it strikes the
+                 breechblock and the seat ring, which is why the paper adds M1 ... M4.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+
+import models
+from planners import loader as loader_planner
+from planners.trajectory import Trajectory
+from sims.checks import Check
+from sims.collision import clearance, geoms_by_contype, obstacle_contact_pairs
+from sims.controllers import ServoFeedforwardController, demanded_force
+from sims.runner import RunLog, Setup
+
+#: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
+ROBOT_CONTYPE = 1
+OBSTACLE_CONTYPE = 2
+
+CONTROL_DT = 0.005  # s: 200 Hz motion controller; the drives run at the 0.5 ms physics step
+SETTLE_S = 0.5  # s simulated after the plan ends, so the arrival is seen at rest
+
+#: Check limits. 0.1 deg at the key points is 3.8 mm at the 2.2 m reach of the shell tip, a
+#: small fraction of the 6 cm by which the planned path clears the obstacles; the run-wide
+#: tracking limit allows 0.25 deg (9.6 mm at the tip) while the arm accelerates.
+KEYPOINT_LIMIT_DEG = 0.1
+TRACKING_LIMIT_DEG = 0.25
+
+
+class LoaderPhysics(dm_mujoco.Physics):
+    """dm_control Physics of models/loader/scene.xml with readable accessors."""
+
+    @classmethod
+    def load(cls) -> "LoaderPhysics":
+        physics = cls.from_xml_path(str(models.scene_path("loader")))
+        physics.reset(keyframe_id=0)
+        return physics
+
+    @property
+    def joint_names(self) -> list[str]:
+        return models.loader_spec().names
+
+    def joint_positions(self) -> np.ndarray:
+        """theta1 ... theta6: slide (m) and five angles (rad)."""
+        return self.named.data.qpos[self.joint_names].copy()
+
+    def joint_velocities(self) -> np.ndarray:
+        return self.named.data.qvel[self.joint_names].copy()
+
+    def setpoints(self) -> np.ndarray:
+        """The drives' position set-points (their activations), m and rad."""
+        return self.data.act.copy()
+
+    def actuator_forces(self) -> np.ndarray:
+        """Drive force (N) and torques (N m) after the force-range clamp."""
+        return self.named.data.actuator_force[self.joint_names].copy()
+
+    def shell_tip(self) -> np.ndarray:
+        """World position of the shell's nose, m."""
+        return self.named.data.site_xpos["shell_tip"].copy()
+
+    def robot_geoms(self) -> np.ndarray:
+        return geoms_by_contype(self.model.ptr, ROBOT_CONTYPE)
+
+    def obstacle_geoms(self) -> np.ndarray:
+        return geoms_by_contype(self.model.ptr, OBSTACLE_CONTYPE)
+
+
+def joint_kinds() -> list[str]:
+    return [j.kind for j in models.loader_spec().joints]
+
+
+def _joint_dofs(physics: LoaderPhysics) -> np.ndarray:
+    model = physics.model.ptr
+    return np.array([model.joint(n).dofadr[0] for n in physics.joint_names])
+
+
+class LoaderEvaluation:
+    """Checks and outputs of a loader run (keypoints are Table 1's, in SI units)."""
+
+    def __init__(self, physics: LoaderPhysics, key_times: np.ndarray, key_points: np.ndarray):
+        self.physics = physics
+        self.spec = models.loader_spec()
+        self.key_times = np.asarray(key_times)
+        self.key_points = np.asarray(key_points)
+        self._clearance = None
+
+    def clearance(self, log: RunLog):
+        if self._clearance is None or self._clearance[0] is not log:
+            c, pairs = clearance(
+                self.physics.model.ptr, log.qpos, self.physics.robot_geoms(), self.physics.obstacle_geoms()
+            )
+            self._clearance = (log, c, pairs)
+        return self._clearance[1], self._clearance[2]
+
+    def _joint_log(self, log: RunLog):
+        dofs = _joint_dofs(self.physics)
+        return log.qpos[:, dofs], log.qvel[:, dofs]
+
+    def __call__(self, log: RunLog):
+        model = self.physics.model.ptr
+        q, qd = self._joint_log(log)
+        ref = log.reference.position
+        err = q - ref
+        err_deg = np.rad2deg(np.abs(err[:, 1:]))
+        # Key times that the run reached: nearest logged tick (key times are tick multiples).
+        reached = self.key_times <= log.t[-1] + 1e-9
+        ticks = np.searchsorted(log.t, self.key_times[reached] - 1e-9)
+        key_err_deg = np.rad2deg(np.abs(q[ticks, 1:] - self.key_points[reached, 1:]))
+        key_err_slide_mm = 1e3 * np.abs(q[ticks, 0] - self.key_points[reached, 0])
+        tau = demanded_force(self.spec.kp, self.spec.kv, log.act, q, qd)
+        torque_ratio = np.abs(tau) / self.spec.force_limit
+        robot, obstacles = self.physics.robot_geoms(), self.physics.obstacle_geoms()
+        pairs = obstacle_contact_pairs(log.contacts, robot, obstacles)
+        clear, closest = self.clearance(log)
+        i_min = int(np.argmin(clear))
+        names = lambda pair: f"{model.geom(int(pair[0])).name}/{model.geom(int(pair[1])).name}"
+        contact_note = ", ".join(
+            f"{names(p)} from t = {log.t[v[0]]:.3f} s for {v[1]} ticks, {1e3 * v[2]:.1f} mm deep"
+            for p, v in sorted(pairs.items(), key=lambda kv: kv[1][0])
+        )
+        checks = [
+            Check("keypoint_error", float(key_err_deg.max()) if key_err_deg.size else float("nan"),
+                  KEYPOINT_LIMIT_DEG, "deg",
+                  note=f"{int(reached.sum())} of {self.key_times.size} key points reached"),
+            Check("tracking_error", float(err_deg.max()), TRACKING_LIMIT_DEG, "deg"),
+            Check("obstacle_contacts", len(pairs), 0, "count", "==", note=contact_note),
+            Check("min_clearance", float(clear[i_min]), 0.0, "m", ">",
+                  note=f"{names(closest[i_min])} at t = {log.t[i_min]:.3f} s"
+                  if closest[i_min, 0] >= 0 else "nothing within 0.5 m"),
+            Check("joint_torque", float(torque_ratio.max()), 1.0, "ratio",
+                  note=f"peak on {self.spec.names[int(np.argmax(torque_ratio.max(0)))]}"),
+        ]
+        metrics = {
+            "keypoint_error_slide_mm": float(key_err_slide_mm.max()) if key_err_slide_mm.size else None,
+            "tracking_error_slide_mm": float(1e3 * np.abs(err[:, 0]).max()),
+            "tracking_error_deg_per_joint": dict(zip(self.spec.names[1:], err_deg.max(0).round(6).tolist())),
+            "peak_torque_per_joint": dict(zip(self.spec.names, np.abs(tau).max(0).round(3).tolist())),
+            "torque_limit_per_joint": dict(zip(self.spec.names, self.spec.force_limit.tolist())),
+            "final_shell_tip_m": log.sensordata[-1, -3:].tolist(),
+            "contact_ticks": int(sum(v[1] for v in pairs.values())),
+        }
+        return checks, metrics
+
+    def timeseries(self, log: RunLog) -> dict:
+        q, qd = self._joint_log(log)
+        clear, _ = self.clearance(log)
+        return {
+            "joint_names": np.array(self.spec.names),
+            "q_planned": log.reference.position,
+            "qd_planned": log.reference.velocity,
+            "qdd_planned": log.reference.acceleration,
+            "q_actual": q,
+            "qd_actual": qd,
+            "setpoint": log.act,
+            "drive_force": log.actuator_force,
+            "drive_force_demanded": demanded_force(self.spec.kp, self.spec.kv, log.act, q, qd),
+            "drive_force_limit": self.spec.force_limit,
+            "shell_tip_pos": log.sensordata[:, -3:],
+            "clearance": clear,
+            "key_times": self.key_times,
+            "key_points": self.key_points,
+        }
+
+    def report(self, log: RunLog, checks, path) -> None:
+        from sims.report import loader_report
+
+        loader_report(self.timeseries(log), log.t, checks, path)
+
+
+def _setup(trajectory: Trajectory, key_times, key_points, options) -> Setup:
+    physics = LoaderPhysics.load()
+    spec = models.loader_spec()
+    controller = ServoFeedforwardController(spec.kp, spec.kv, _joint_dofs(physics))
+    evaluation = LoaderEvaluation(physics, key_times, key_points)
+    duration = options.duration if options.duration is not None else trajectory.duration + SETTLE_S
+    return Setup(
+        physics=physics,
+        trajectory=trajectory,
+        controller=controller,
+        control_dt=CONTROL_DT,
+        duration=duration,
+        evaluate=evaluation,
+        timeseries=evaluation.timeseries,
+        report=evaluation.report,
+        video_speed=1.0,
+        seed=options.seed,
+    )
+
+
+def build_supply(options) -> Setup:
+    plan = loader_planner.supply_plan()
+    return _setup(plan, plan.key_times, plan.key_points, options)
+
+
+def build_direct(options) -> Setup:
+    plan = loader_planner.direct_plan()
+    # The key points checked are the endpoints; M1 ... M4 are not on this path.
+    return _setup(plan, plan.key_times, plan.key_points, options)

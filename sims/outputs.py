@@ -1,0 +1,110 @@
+"""Outputs of a run, written atomically: a temporary directory beside the target, renamed.
+
+A failed or interrupted write leaves no half-written directory or video behind.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+
+class OutputError(ValueError):
+    """The output location cannot be written."""
+
+
+def check_writable(path: Path, what: str) -> None:
+    """Fail early, before simulating, if ``path`` (a file or directory) cannot be created.
+
+    Its nearest existing ancestor must be a writable directory and ``path`` itself must not
+    be an existing entry of the wrong kind.
+    """
+    path = Path(path)
+    parent = path.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise OutputError(f"{what} {path}: {parent} is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{what} {path}: directory {parent} is not writable")
+    if what == "output dir" and path.exists() and not path.is_dir():
+        raise OutputError(f"{what} {path} exists and is not a directory")
+    if what == "video" and path.is_dir():
+        raise OutputError(f"{what} {path} is a directory")
+
+
+def summary_dict(result) -> dict:
+    return {
+        "scenario": result.scenario,
+        "passed": result.passed,
+        "seed": result.seed,
+        "sim_time_s": result.sim_time_s,
+        "wall_time_s": round(result.wall_time_s, 4),
+        "realtime_factor": round(result.sim_time_s / result.wall_time_s, 3) if result.wall_time_s > 0 else None,
+        "checks": [c.to_json() for c in result.checks],
+        "metrics": result.metrics,
+    }
+
+
+def replace_dir(tmp: Path, target: Path) -> None:
+    """Rename ``tmp`` to ``target``, replacing an existing ``target`` directory."""
+    if target.exists():
+        old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
+        os.rename(target, old / target.name)
+        os.rename(tmp, target)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.rename(tmp, target)
+
+
+def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: str = "overview",
+              quiet: bool = True) -> dict:
+    """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
+
+    The video goes into the same temporary directory when it lies inside ``out_dir``, else
+    into a temporary file beside it; both are renamed into place only when everything is
+    written. Returns the summary.
+    """
+    from sims.render import render_video
+
+    out_dir = Path(out_dir).absolute()
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
+    video_tmp = None
+    try:
+        summary = summary_dict(result)
+        log = result.log
+        arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl, "act": log.act,
+                  "actuator_force": log.actuator_force, "sensordata": log.sensordata}
+        arrays.update(setup.timeseries(log))
+        np.savez_compressed(tmp / "timeseries.npz", **arrays)
+        setup.report(log, result.checks, tmp / "report.png")
+        if video is not None:
+            video = Path(video).absolute()
+            try:
+                inside = video.relative_to(out_dir)
+                target = tmp / inside
+                target.parent.mkdir(parents=True, exist_ok=True)
+            except ValueError:
+                video.parent.mkdir(parents=True, exist_ok=True)
+                fd, name = tempfile.mkstemp(prefix=f".{video.stem}.tmp-", suffix=video.suffix, dir=video.parent)
+                os.close(fd)
+                video_tmp = target = Path(name)
+            frames = render_video(setup.physics.model.ptr, log, target, camera=camera,
+                                  speed=setup.video_speed, quiet=quiet)
+            summary["video"] = {"path": str(video), "frames": frames, "camera": camera}
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        replace_dir(tmp, out_dir)
+        if video_tmp is not None:
+            os.replace(video_tmp, video)
+        return summary
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        if video_tmp is not None and video_tmp.exists():
+            video_tmp.unlink()
+        raise

@@ -1,0 +1,41 @@
+"""``planbench plan``: the planned motion of a scenario, without physics."""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from planners.trajectory import control_ticks
+from sims.outputs import replace_dir
+from sims.report import plan_plot
+
+PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
+
+
+def write_plan(scenario, out_dir: Path) -> Path:
+    """Write plan.npz (t, position, velocity, acceleration, labels, key points) and plan.png."""
+    trajectory = scenario.plan()
+    sample = trajectory.sample(control_ticks(trajectory.duration, PLAN_DT))
+    kinds = scenario.kinds()
+    out_dir = Path(out_dir).absolute()
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
+    try:
+        arrays = dict(t=sample.t, position=sample.position, velocity=sample.velocity,
+                      acceleration=sample.acceleration, labels=np.array(trajectory.labels),
+                      kinds=np.array(kinds))
+        key_times = getattr(trajectory, "key_times", None)
+        key_points = getattr(trajectory, "key_points", None)
+        if key_times is not None:
+            arrays.update(key_times=key_times, key_points=key_points)
+        np.savez_compressed(tmp / "plan.npz", **arrays)
+        plan_plot(sample, trajectory.labels, kinds, tmp / "plan.png",
+                  title=f"{scenario.name}: planned motion", key_times=key_times, key_points=key_points)
+        replace_dir(tmp, out_dir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out_dir

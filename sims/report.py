@@ -1,0 +1,87 @@
+"""Plots: report.png of a run and plan.png of a planned motion (matplotlib, Agg)."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def _to_display(values: np.ndarray, kinds: list[str]):
+    """SI to display units per column: m -> mm for slides, rad -> deg for hinges."""
+    scale = np.array([1e3 if k == "slide" else np.rad2deg(1.0) for k in kinds])
+    return values * scale
+
+
+def plan_plot(sample, labels, kinds, path, title: str, key_times=None, key_points=None) -> None:
+    """Positions, velocities and accelerations of a planned motion, one column per joint."""
+    units = ["mm" if k == "slide" else "deg" for k in kinds]
+    fig, axes = plt.subplots(3, 1, figsize=(10, 9), sharex=True)
+    for ax, data, what in zip(
+        axes,
+        (sample.position, sample.velocity, sample.acceleration),
+        ("position", "velocity", "acceleration"),
+    ):
+        shown = _to_display(data, kinds)
+        for j, label in enumerate(labels):
+            ax.plot(sample.t, shown[:, j], label=f"{label} [{units[j]}]")
+        ax.set_ylabel({"position": "unit", "velocity": "unit/s", "acceleration": "unit/s²"}[what])
+        ax.set_title(what, fontsize=10, loc="left")
+        ax.grid(alpha=0.3)
+    if key_times is not None:
+        shown = _to_display(np.asarray(key_points), kinds)
+        for j in range(shown.shape[1]):
+            axes[0].plot(key_times, shown[:, j], "ko", ms=3)
+    axes[0].legend(fontsize=8, ncol=3)
+    axes[-1].set_xlabel("t [s]")
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def checks_text(checks) -> str:
+    return "\n".join(
+        f"{'PASS' if c.passed else 'FAIL'} {c.name}: {c.value:.4g} {c.unit} ({c.comparison} {c.limit:g})"
+        for c in checks
+    )
+
+
+def loader_report(ts: dict, t: np.ndarray, checks, path) -> None:
+    """report.png of a loader run: joints, tracking error, drive load, clearance."""
+    names = [str(n) for n in ts["joint_names"]]
+    fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
+    ax = axes[0, 0]
+    for j in range(1, len(names)):
+        line, = ax.plot(t, np.rad2deg(ts["q_actual"][:, j]), label=names[j])
+        ax.plot(t, np.rad2deg(ts["q_planned"][:, j]), "--", color=line.get_color(), lw=0.8)
+    ax.plot(ts["key_times"], np.rad2deg(ts["key_points"][:, 1:]), "ko", ms=3)
+    ax.set(title="joint angles (solid: simulated, dashed: planned)", xlabel="t [s]", ylabel="deg")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    err = np.rad2deg(ts["q_actual"][:, 1:] - ts["q_planned"][:, 1:])
+    for j in range(1, len(names)):
+        ax.plot(t, err[:, j - 1], label=names[j])
+    ax.set(title="tracking error", xlabel="t [s]", ylabel="deg")
+    ax.legend(fontsize=8)
+    ax = axes[1, 0]
+    ratio = ts["drive_force_demanded"] / ts["drive_force_limit"]
+    for j, name in enumerate(names):
+        ax.plot(t, ratio[:, j], label=name)
+    ax.axhline(1.0, color="r", lw=0.8)
+    ax.axhline(-1.0, color="r", lw=0.8)
+    ax.set(title="demanded drive force / limit", xlabel="t [s]", ylabel="ratio")
+    ax.legend(fontsize=8)
+    ax = axes[1, 1]
+    ax.plot(t, 1e3 * ts["clearance"])
+    ax.axhline(0.0, color="r", lw=0.8)
+    ax.set(title="clearance to breechblock, seat ring, floor", xlabel="t [s]", ylabel="mm")
+    ax.text(0.02, 0.97, checks_text(checks), transform=ax.transAxes, va="top", fontsize=7,
+            family="monospace", bbox=dict(facecolor="white", alpha=0.8))
+    for a in axes.flat:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -1,0 +1,257 @@
+"""The runner: the control loop around MuJoCo, shared by every mechanism.
+
+Per control tick it calls the controller once (it writes ``data.ctrl``), applies the
+disturbance, lets MuJoCo take ``k`` physics steps with ``mj_step(model, data, nstep=k)`` and
+copies the state into preallocated logs. Everything else (the planned motion, checks,
+rendering) works on whole arrays before or after the loop.
+
+Divergence (a NaN in the state, or any MuJoCo warning such as the bad-qacc reset) ends the
+run early; the ``simulation_warnings`` check then fails with a message that says when and why.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Protocol
+
+import mujoco
+import numpy as np
+from tqdm import tqdm
+
+from planners.trajectory import Trajectory, TrajectorySample, control_ticks
+from sims.checks import Check, divergence_check
+
+#: How often (in control ticks) the loop scans MuJoCo's warning counters. NaN is checked
+#: every tick; MuJoCo's own bad-qacc detection resets the state and raises a warning, which
+#: is caught within this many ticks.
+WARNING_SCAN_TICKS = 10
+
+
+class Controller(Protocol):
+    """A controller plugged into the runner.
+
+    ``reset`` is called once with the physics at its initial state and the reference
+    sampled at every control tick; ``__call__`` once per tick, before the physics steps of
+    that tick, and writes ``physics.data.ctrl`` (and may read sensors).
+    """
+
+    def reset(self, physics, reference: TrajectorySample, control_dt: float) -> None: ...
+
+    def __call__(self, tick: int, physics) -> None: ...
+
+
+class Disturbance(Protocol):
+    """Wind, ship motion, payload forces...: applied once per control tick."""
+
+    def reset(self, physics, times: np.ndarray, rng: np.random.Generator) -> None: ...
+
+    def __call__(self, tick: int, physics) -> None: ...
+
+
+@dataclass
+class Setup:
+    """Everything one run needs; built by a scenario.
+
+    Attributes:
+      physics: a ``dm_control.mujoco.Physics`` of the scene, at its initial state.
+      trajectory: the planned motion.
+      controller: see ``Controller``.
+      control_dt: control period, s; a multiple of the model timestep.
+      duration: simulated time, s.
+      evaluate: (RunLog) -> (checks, metrics) for this mechanism.
+      timeseries: (RunLog) -> {name: array} written to timeseries.npz besides the log.
+      report: (RunLog, checks, path) -> None, draws report.png.
+      disturbance: optional, see ``Disturbance``.
+      video_speed: video clock / simulated clock (1 real time, 0.5 slow motion, 20 time-lapse).
+    """
+
+    physics: object
+    trajectory: Trajectory
+    controller: Controller
+    control_dt: float
+    duration: float
+    evaluate: Callable
+    timeseries: Callable
+    report: Callable
+    disturbance: Disturbance | None = None
+    video_speed: float = 1.0
+    seed: int = 0
+
+
+@dataclass
+class RunLog:
+    """State at every control tick (row i is the state at time ``t[i]``; row 0 is the start).
+
+    Arrays: t (n,), qpos, qvel, act, ctrl, actuator_force, sensordata (n, size), mocap_pos
+    and mocap_quat (n, nmocap, 3|4) when the model has mocap bodies. ``reference`` is the
+    planned motion sampled at ``t``. ``contacts`` lists (tick, geom1, geom2, distance) of
+    every contact seen at a tick's end. ``n`` may be shorter than planned when the run
+    diverged.
+    """
+
+    t: np.ndarray
+    qpos: np.ndarray
+    qvel: np.ndarray
+    act: np.ndarray
+    ctrl: np.ndarray
+    actuator_force: np.ndarray
+    sensordata: np.ndarray
+    mocap_pos: np.ndarray
+    mocap_quat: np.ndarray
+    reference: TrajectorySample
+    contacts: list = field(default_factory=list)
+    warnings: dict = field(default_factory=dict)
+    diverged_at: float | None = None
+    divergence_message: str = ""
+    physics_steps: int = 0
+    loop_wall_s: float = 0.0
+
+
+@dataclass
+class RunResult:
+    scenario: str
+    seed: int
+    log: RunLog
+    checks: list[Check]
+    metrics: dict
+    sim_time_s: float
+    wall_time_s: float
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+
+def steps_per_tick(model: mujoco.MjModel, control_dt: float) -> int:
+    """Physics steps per control tick; the control period must be a multiple of the timestep."""
+    k = control_dt / model.opt.timestep
+    if k < 1 or abs(k - round(k)) > 1e-6:
+        raise ValueError(
+            f"control period {control_dt} s is not a whole multiple of the model timestep "
+            f"{model.opt.timestep} s"
+        )
+    return int(round(k))
+
+
+def warning_counts(data: mujoco.MjData) -> dict[str, int]:
+    """MuJoCo's warning counters that are non-zero, by warning name."""
+    out = {}
+    for name, index in _WARNINGS:
+        n = int(data.warning[index].number)
+        if n:
+            out[name] = n
+    return out
+
+
+_WARNINGS = [
+    (name, int(getattr(mujoco.mjtWarning, name)))
+    for name in dir(mujoco.mjtWarning)
+    if name.startswith("mjWARN_")
+]
+
+
+def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) -> RunLog:
+    """Run the control loop of ``setup`` and return its log."""
+    physics = setup.physics
+    model, data = physics.model.ptr, physics.data.ptr
+    k = steps_per_tick(model, setup.control_dt)
+    times = control_ticks(setup.duration, setup.control_dt)
+    n = times.size
+    reference = setup.trajectory.sample(times)
+    setup.controller.reset(physics, reference, setup.control_dt)
+    rng = np.random.default_rng(setup.seed)
+    if setup.disturbance is not None:
+        setup.disturbance.reset(physics, times, rng)
+
+    log = RunLog(
+        t=times,
+        qpos=np.empty((n, model.nq)),
+        qvel=np.empty((n, model.nv)),
+        act=np.empty((n, model.na)),
+        ctrl=np.zeros((n, model.nu)),
+        actuator_force=np.empty((n, model.nu)),
+        sensordata=np.empty((n, model.nsensordata)),
+        mocap_pos=np.empty((n, model.nmocap, 3)),
+        mocap_quat=np.empty((n, model.nmocap, 4)),
+        reference=reference,
+    )
+    qpos, qvel, act, ctrl = log.qpos, log.qvel, log.act, log.ctrl
+    frc, sens, mpos, mquat = log.actuator_force, log.sensordata, log.mocap_pos, log.mocap_quat
+    has_mocap = model.nmocap > 0
+    mujoco.mj_forward(model, data)
+
+    def record(i: int) -> None:
+        qpos[i] = data.qpos
+        qvel[i] = data.qvel
+        act[i] = data.act
+        frc[i] = data.actuator_force
+        sens[i] = data.sensordata
+        if has_mocap:
+            mpos[i] = data.mocap_pos
+            mquat[i] = data.mocap_quat
+
+    record(0)
+    controller, disturbance = setup.controller, setup.disturbance
+    contacts = log.contacts
+    bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
+               desc="simulating")
+    update_every = max(1, (n - 1) // 200)
+    last = n - 1
+    start = time.perf_counter()
+    for i in range(n - 1):
+        controller(i, physics)
+        if disturbance is not None:
+            disturbance(i, physics)
+        ctrl[i] = data.ctrl
+        mujoco.mj_step(model, data, nstep=k)
+        record(i + 1)
+        if data.ncon:
+            for c in data.contact:
+                contacts.append((i + 1, int(c.geom1), int(c.geom2), float(c.dist)))
+        if not np.isfinite(data.qacc).all() or not np.isfinite(data.qpos).all():
+            log.diverged_at = float(times[i + 1])
+            log.divergence_message = f"non-finite state at t = {times[i + 1]:.4f} s"
+            last = i + 1
+            break
+        if i % WARNING_SCAN_TICKS == 0 or i == n - 2:
+            warnings = warning_counts(data)
+            if warnings:
+                log.warnings = warnings
+                log.diverged_at = float(times[i + 1])
+                log.divergence_message = (
+                    f"MuJoCo warning {', '.join(warnings)} by t = {times[i + 1]:.4f} s"
+                )
+                last = i + 1
+                break
+        if i % update_every == 0:
+            bar.update(update_every)
+    log.loop_wall_s = time.perf_counter() - start
+    bar.close()
+    log.physics_steps = last * k
+    if last < n - 1:
+        for name in ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata",
+                     "mocap_pos", "mocap_quat"):
+            setattr(log, name, getattr(log, name)[: last + 1])
+        r = log.reference
+        log.reference = TrajectorySample(r.t[: last + 1], r.position[: last + 1],
+                                         r.velocity[: last + 1], r.acceleration[: last + 1])
+    if not log.warnings:
+        log.warnings = warning_counts(data)
+    return log
+
+
+def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
+    """Simulate ``setup`` and evaluate its checks."""
+    start = time.perf_counter()
+    log = simulate(setup, quiet=quiet)
+    checks, metrics = setup.evaluate(log)
+    checks = list(checks) + [
+        divergence_check(log.warnings, log.diverged_at, log.divergence_message)
+    ]
+    wall = time.perf_counter() - start
+    sim_time = float(log.t[-1])
+    metrics = dict(metrics)
+    metrics["physics_steps"] = log.physics_steps
+    metrics["loop_wall_s"] = log.loop_wall_s
+    return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall)

@@ -1,0 +1,80 @@
+"""The scenario registry: every runnable scenario of every mechanism, by name."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+from sims import loader
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Options of one run, from the CLI or a caller.
+
+    Attributes:
+      seed: seed of every random process of the run (disturbances, noise).
+      duration: simulated time in s, None for the scenario's default.
+      wind: mean wind speed in m/s, None for the scenario's default (wind scenarios only).
+    """
+
+    seed: int = 0
+    duration: float | None = None
+    wind: float | None = None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A named run: a mechanism, a planner and its checks.
+
+    Attributes:
+      name: CLI name.
+      summary: one line for ``planbench list``.
+      build: (RunOptions) -> runner.Setup.
+      plan: () -> the planned trajectory (``planbench plan``), no physics.
+      options: the RunOptions fields beyond seed and duration that it uses (e.g. {"wind"}).
+      expect_pass: False for a scenario that demonstrates a failure (loader-direct).
+      camera: the default camera of its video.
+      kinds: () -> "slide" or "hinge" per planned channel (units of plots).
+    """
+
+    name: str
+    summary: str
+    build: Callable
+    plan: Callable
+    options: frozenset = field(default_factory=frozenset)
+    expect_pass: bool = True
+    camera: str = "overview"
+    kinds: Callable = lambda: ()
+
+
+SCENARIOS: dict[str, Scenario] = {
+    s.name: s
+    for s in (
+        Scenario(
+            "loader-supply",
+            "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the breechblock and seat ring",
+            loader.build_supply,
+            lambda: loader.loader_planner.supply_plan(),
+            kinds=loader.joint_kinds,
+        ),
+        Scenario(
+            "loader-direct",
+            "PRR-3R loader: P2 to P3 as a straight joint-space move in the same 2.5 s; strikes the obstacles (expected to fail)",
+            loader.build_direct,
+            lambda: loader.loader_planner.direct_plan(),
+            expect_pass=False,
+            kinds=loader.joint_kinds,
+        ),
+    )
+}
+
+
+def get(name: str) -> Scenario:
+    """The scenario called ``name``; a ValueError lists the known names otherwise."""
+    try:
+        return SCENARIOS[name]
+    except KeyError:
+        raise ValueError(
+            f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}"
+        ) from None
