@@ -22,10 +22,10 @@ from tqdm import tqdm
 from planners.trajectory import Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, divergence_check
 
-#: How often (in control ticks) the loop scans MuJoCo's warning counters. NaN is checked
-#: every tick; MuJoCo's own bad-qacc detection resets the state and raises a warning, which
-#: is caught within this many ticks.
-WARNING_SCAN_TICKS = 10
+#: How often (in control ticks) the loop scans for divergence: NaN or inf in the logged
+#: state since the last scan, and MuJoCo's warning counters (its bad-qacc detection resets the
+#: state and raises a warning). A divergence ends the run within this many ticks.
+SCAN_TICKS = 10
 
 
 class Controller(Protocol):
@@ -151,6 +151,20 @@ _WARNINGS = [
 ]
 
 
+def _divergence(data, qpos, qvel, times, i: int, window: int):
+    """(time, message) if the state diverged in the ticks up to ``i``, else None."""
+    lo = max(0, i - window)
+    finite = np.isfinite(qpos[lo : i + 1]).all(axis=1) & np.isfinite(qvel[lo : i + 1]).all(axis=1)
+    if not finite.all():
+        first = lo + int(np.argmin(finite))
+        return float(times[first]), f"non-finite state at t = {times[first]:.4f} s"
+    warnings = warning_counts(data)
+    if warnings:
+        detail = ", ".join(f"{name} x{count}" for name, count in warnings.items())
+        return float(times[i]), f"MuJoCo warning {detail} by t = {times[i]:.4f} s"
+    return None
+
+
 def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) -> RunLog:
     """Run the control loop of ``setup`` and return its log."""
     physics = setup.physics
@@ -209,19 +223,11 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
         if data.ncon:
             for c in data.contact:
                 contacts.append((i + 1, int(c.geom1), int(c.geom2), float(c.dist)))
-        if not np.isfinite(data.qacc).all() or not np.isfinite(data.qpos).all():
-            log.diverged_at = float(times[i + 1])
-            log.divergence_message = f"non-finite state at t = {times[i + 1]:.4f} s"
-            last = i + 1
-            break
-        if i % WARNING_SCAN_TICKS == 0 or i == n - 2:
-            warnings = warning_counts(data)
-            if warnings:
-                log.warnings = warnings
-                log.diverged_at = float(times[i + 1])
-                log.divergence_message = (
-                    f"MuJoCo warning {', '.join(warnings)} by t = {times[i + 1]:.4f} s"
-                )
+        if i % SCAN_TICKS == 0 or i == n - 2:
+            message = _divergence(data, qpos, qvel, times, i + 1, SCAN_TICKS)
+            if message:
+                log.warnings = warning_counts(data)
+                log.diverged_at, log.divergence_message = message
                 last = i + 1
                 break
         if i % update_every == 0:

@@ -1,0 +1,84 @@
+"""``planbench bench``: realtime factors and loop-to-bare-``mj_step`` ratios, side by side.
+
+For each benchmarked scenario (no video) it reports:
+  realtime factor  simulated seconds per wall second of the whole run (planning, feed-forward,
+                   loop, checks);
+  loop ratio       physics steps per second inside the control loop divided by physics steps
+                   per second of one bare ``mj_step(model, data, nstep=N)`` call on the same
+                   model from the same initial state, with the same N, in the same process.
+The best of REPEATS runs is taken for both, so a busy machine affects both sides alike.
+"""
+
+from __future__ import annotations
+
+import time
+
+import mujoco
+
+from sims import runner, scenarios
+
+BENCHMARKS = ("loader-supply",)
+REPEATS = 5
+
+
+def bare_steps_per_second(setup, n_steps: int) -> float:
+    """Steps per second of one bare ``mj_step(..., nstep=n_steps)`` from the setup's state."""
+    physics = setup.physics
+    model, data = physics.model.ptr, physics.data.ptr
+    state_size = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    import numpy as np
+
+    state = np.empty(state_size)
+    mujoco.mj_getState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    best = float("inf")
+    for _ in range(REPEATS):
+        mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        start = time.perf_counter()
+        mujoco.mj_step(model, data, nstep=n_steps)
+        best = min(best, time.perf_counter() - start)
+    mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    return n_steps / best
+
+
+def bench_scenario(name: str) -> dict:
+    scenario = scenarios.get(name)
+    best_run, best_loop = None, None
+    for _ in range(REPEATS):
+        setup = scenario.build(scenarios.RunOptions())
+        result = runner.run(name, setup)
+        if best_run is None or result.wall_time_s < best_run.wall_time_s:
+            best_run = result
+        loop_rate = result.log.physics_steps / result.log.loop_wall_s
+        best_loop = loop_rate if best_loop is None else max(best_loop, loop_rate)
+    setup = scenario.build(scenarios.RunOptions())
+    bare = bare_steps_per_second(setup, best_run.log.physics_steps)
+    return {
+        "scenario": name,
+        "sim_time_s": best_run.sim_time_s,
+        "wall_time_s": best_run.wall_time_s,
+        "realtime_factor": best_run.sim_time_s / best_run.wall_time_s,
+        "physics_steps": best_run.log.physics_steps,
+        "loop_steps_per_s": best_loop,
+        "bare_steps_per_s": bare,
+        "loop_ratio": best_loop / bare,
+        "passed": best_run.passed,
+    }
+
+
+def run_all() -> list[dict]:
+    return [bench_scenario(name) for name in BENCHMARKS]
+
+
+def format_table(rows: list[dict]) -> str:
+    lines = [
+        f"{'scenario':<16} {'sim s':>7} {'wall s':>7} {'realtime x':>10} {'steps':>8} "
+        f"{'loop steps/s':>13} {'bare steps/s':>13} {'loop/bare':>9}"
+    ]
+    for r in rows:
+        lines.append(
+            f"{r['scenario']:<16} {r['sim_time_s']:>7.2f} {r['wall_time_s']:>7.3f} "
+            f"{r['realtime_factor']:>10.1f} {r['physics_steps']:>8d} {r['loop_steps_per_s']:>13.0f} "
+            f"{r['bare_steps_per_s']:>13.0f} {r['loop_ratio']:>9.2f}"
+        )
+    lines.append("loop/bare target >= 0.8 (issue 2); realtime x = simulated / wall time of the whole run")
+    return "\n".join(lines)
