@@ -1,0 +1,109 @@
+"""The planbench command line: outputs, exit codes, one-line errors, atomic writes."""
+
+import json
+import subprocess
+import sys
+
+import imageio_ffmpeg
+import numpy as np
+import pytest
+
+
+def planbench(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "sims.cli", *map(str, args)],
+                          capture_output=True, text=True, cwd=cwd, timeout=300)
+
+
+def assert_one_line_error(proc, *words):
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert "Traceback" not in proc.stderr
+    for w in words:
+        assert w in lines[0], lines[0]
+
+
+def test_list_names_every_scenario():
+    proc = planbench("list")
+    assert proc.returncode == 0
+    names = [line.split()[0] for line in proc.stdout.splitlines()]
+    assert names == ["loader-supply", "loader-direct"]
+
+
+def test_run_writes_summary_timeseries_report_and_video(tmp_path):
+    out = tmp_path / "run"
+    proc = planbench("run", "loader-supply", "--out", out, "--video", out / "loader.mp4", "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    assert {p.name for p in out.iterdir()} == {"summary.json", "timeseries.npz", "report.png", "loader.mp4"}
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["scenario"] == "loader-supply" and summary["passed"] is True
+    assert summary["sim_time_s"] == pytest.approx(3.0) and summary["realtime_factor"] > 0
+    assert {c["name"] for c in summary["checks"]} >= {"keypoint_error", "obstacle_contacts"}
+    ts = np.load(out / "timeseries.npz")
+    assert ts["t"].shape[0] == ts["q_actual"].shape[0] == 601
+    # mediapy's reader does not parse this ffmpeg's header; imageio-ffmpeg reads it.
+    reader = imageio_ffmpeg.read_frames(str(out / "loader.mp4"))
+    meta = next(reader)
+    assert tuple(meta["size"]) == (640, 480) and meta["fps"] == 30 and meta["codec"] == "h264"
+    frames = [np.frombuffer(f, np.uint8).reshape(480, 640, 3) for f in reader]
+    assert len(frames) >= 85  # 3 s at 30 fps
+    assert frames[len(frames) // 2].std() > 10  # frames show something, not a blank buffer
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp dirs left
+
+
+def test_failing_check_exits_1(tmp_path):
+    proc = planbench("run", "loader-direct", "--out", tmp_path / "d", "--quiet", "--camera", "closeup")
+    assert proc.returncode == 1, proc.stderr
+    assert "obstacle_contacts" in proc.stdout and "FAIL" in proc.stdout
+    assert json.loads((tmp_path / "d" / "summary.json").read_text())["passed"] is False
+
+
+def test_unknown_scenario_exits_2(tmp_path):
+    assert_one_line_error(planbench("run", "loader-teleport", "--out", tmp_path / "x"),
+                          "loader-teleport", "loader-supply")
+    assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("duration", ["-1", "0", "nan", "abc"])
+def test_bad_duration_exits_2(tmp_path, duration):
+    assert_one_line_error(planbench("run", "loader-supply", "--out", tmp_path / "x",
+                                    f"--duration={duration}"), "duration")
+    assert not (tmp_path / "x").exists()
+
+
+def test_unwritable_output_dir_exits_2(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    assert_one_line_error(planbench("run", "loader-supply", "--out", blocker / "out"),
+                          str(blocker), "not a directory")
+    assert_one_line_error(planbench("run", "loader-supply", "--out", blocker), "not a directory")
+    assert blocker.read_text() == "not a directory"
+
+
+def test_other_bad_options_exit_2(tmp_path):
+    assert_one_line_error(planbench("run", "loader-supply", "--wind", "4"), "no wind model")
+    assert_one_line_error(planbench("run", "loader-supply", "--seed", "-3"), "seed")
+    assert_one_line_error(planbench("run", "loader-supply", "--camera", "top",
+                                    "--out", tmp_path / "c"), "camera")
+    assert_one_line_error(planbench("frobnicate"), "invalid choice")
+
+
+def test_existing_output_is_replaced_whole(tmp_path):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "stale.txt").write_text("old")
+    proc = planbench("run", "loader-supply", "--out", out, "--quiet", "--duration", "0.5")
+    assert proc.returncode == 0, proc.stderr
+    assert not (out / "stale.txt").exists() and (out / "summary.json").exists()
+
+
+def test_plan_writes_npz_and_plot(tmp_path):
+    proc = planbench("plan", "loader-supply", "--out", tmp_path / "p")
+    assert proc.returncode == 0, proc.stderr
+    plan = np.load(tmp_path / "p" / "plan.npz")
+    assert list(plan["labels"]) == ["slide", "shoulder", "elbow", "wrist_pitch", "wrist_yaw", "wrist_roll"]
+    assert plan["t"][-1] == pytest.approx(2.5)
+    assert plan["position"].shape == plan["velocity"].shape == plan["acceleration"].shape
+    np.testing.assert_allclose(plan["position"][::500], plan["key_points"], atol=1e-12)
+    assert (tmp_path / "p" / "plan.png").stat().st_size > 10_000
+    assert_one_line_error(planbench("plan", "nope", "--out", tmp_path / "q"), "nope")

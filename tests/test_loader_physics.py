@@ -1,0 +1,144 @@
+"""Short MuJoCo runs of the loader scenarios: checks, collisions, determinism, divergence."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from planners.loader import direct_plan, supply_plan
+from sims import runner, scenarios
+from sims.collision import clearance
+from sims.loader import LoaderPhysics, build_supply
+from sims.controllers import ServoFeedforwardController
+
+
+def run(name, **options):
+    scenario = scenarios.get(name)
+    setup = scenario.build(scenarios.RunOptions(**options))
+    return runner.run(name, setup), setup
+
+
+@pytest.fixture(scope="module")
+def supply():
+    return run("loader-supply")
+
+
+@pytest.fixture(scope="module")
+def direct():
+    return run("loader-direct")
+
+
+def checks(result):
+    return {c.name: c for c in result.checks}
+
+
+def test_supply_checks_hold(supply):
+    result, _ = supply
+    c = checks(result)
+    assert result.passed, [x.to_json() for x in result.checks if not x.passed]
+    assert set(c) == {"keypoint_error", "tracking_error", "obstacle_contacts", "min_clearance",
+                      "joint_torque", "simulation_warnings"}
+    assert c["obstacle_contacts"].value == 0
+    assert c["min_clearance"].value > 0.05  # the planned path clears by ~6 cm
+    assert c["keypoint_error"].value < 0.1 and c["joint_torque"].value < 1.0
+    assert result.sim_time_s == pytest.approx(3.0)
+
+
+def test_supply_reaches_p3_at_rest(supply):
+    result, _ = supply
+    q_end = result.log.qpos[-1]
+    np.testing.assert_allclose(q_end, supply_plan().key_points[-1], atol=np.deg2rad(0.01))
+    assert np.abs(result.log.qvel[-1]).max() < 1e-3
+
+
+def test_direct_move_strikes_the_obstacles(direct):
+    result, setup = direct
+    c = checks(result)
+    assert not result.passed
+    assert not c["obstacle_contacts"].passed and c["obstacle_contacts"].value >= 2
+    assert "breechblock" in c["obstacle_contacts"].note and "seat_ring" in c["obstacle_contacts"].note
+    assert c["min_clearance"].value < 0
+    assert c["simulation_warnings"].passed  # it collides, it does not diverge
+
+
+def test_obstacles_sit_between_the_two_planned_paths():
+    """Kinematically (no controller): the straight move cuts into the obstacles by > 5 cm;
+    the spline path clears them by > 5 cm."""
+    physics = LoaderPhysics.load()
+    t = np.linspace(0, 2.5, 126)
+    model = physics.model.ptr
+    robot, obstacles = physics.robot_geoms(), physics.obstacle_geoms()
+    c_supply, _ = clearance(model, supply_plan().sample(t).position, robot, obstacles)
+    c_direct, _ = clearance(model, direct_plan().sample(t).position, robot, obstacles)
+    assert c_supply.min() > 0.05
+    assert c_direct.min() < -0.05
+
+
+def test_same_seed_same_log():
+    a, _ = run("loader-supply", seed=3)
+    b, _ = run("loader-supply", seed=3)
+    for field in ("qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata"):
+        np.testing.assert_array_equal(getattr(a.log, field), getattr(b.log, field))
+    assert [c.to_json() for c in a.checks] == [c.to_json() for c in b.checks]
+
+
+def test_without_feedforward_tracking_fails():
+    """The tracking checks can fail: PD drives alone lag the spline by more than 0.25 deg."""
+    setup = build_supply(scenarios.RunOptions())
+    c = setup.controller
+    setup.controller = ServoFeedforwardController(c.kp, c.kv, c.dofs, feedforward=False)
+    result = runner.run("loader-supply", setup)
+    assert not checks(result)["tracking_error"].passed
+
+
+def test_duration_option_truncates_and_checks_reached_key_points():
+    result, _ = run("loader-supply", duration=1.2)
+    assert result.log.t[-1] == pytest.approx(1.2)
+    assert "3 of 6 key points reached" in checks(result)["keypoint_error"].note
+
+
+class NaNForce:
+    """A disturbance that injects a NaN force at a given tick."""
+
+    def __init__(self, tick):
+        self.tick = tick
+
+    def reset(self, physics, times, rng):
+        pass
+
+    def __call__(self, tick, physics):
+        if tick == self.tick:
+            physics.data.qfrc_applied[1] = np.nan
+
+
+def test_divergence_ends_the_run_as_a_failed_check():
+    setup = build_supply(scenarios.RunOptions())
+    setup.disturbance = NaNForce(tick=100)
+    result = runner.run("loader-supply", setup)
+    c = checks(result)["simulation_warnings"]
+    assert not c.passed and not result.passed
+    assert "t = 0.5" in c.note or "by t = 0.5" in c.note
+    assert result.log.t[-1] <= 0.5 + runner.SCAN_TICKS * setup.control_dt + 1e-9
+    assert np.isfinite(result.log.qpos).all() or "non-finite" in c.note
+
+
+def test_steps_per_tick_rejects_non_multiples():
+    model = LoaderPhysics.load().model.ptr
+    assert runner.steps_per_tick(model, 0.005) == 10
+    with pytest.raises(ValueError, match="not a whole multiple"):
+        runner.steps_per_tick(model, 0.0012)
+
+
+def test_dm_control_environment_steps():
+    from sims.envs import loader_environment
+
+    env = loader_environment()
+    ts = env.reset()
+    assert set(ts.observation) == {"joint_positions", "joint_velocities", "reference_positions",
+                                   "reference_velocities"}
+    np.testing.assert_allclose(ts.observation["joint_positions"], ts.observation["reference_positions"])
+    spec = env.action_spec()
+    for _ in range(20):
+        ts = env.step(np.zeros(spec.shape))
+    # Holding still while the plan moves on: the reward drops below its maximum.
+    assert 0.0 < ts.reward < 1.0
+    assert env.physics.data.time == pytest.approx(0.1)
