@@ -52,7 +52,13 @@ def summary_dict(result) -> dict:
 
 
 def replace_dir(tmp: Path, target: Path) -> None:
-    """Rename ``tmp`` to ``target``, replacing an existing ``target`` directory."""
+    """Rename ``tmp`` to ``target``, replacing an existing ``target`` directory.
+
+    mkdtemp makes its directory private (0700); the result gets the usual mode (umask).
+    """
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)
     if target.exists():
         old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
         os.rename(target, old / target.name)
