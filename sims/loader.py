@@ -13,6 +13,7 @@ from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import loader as loader_planner
+from planners.loader import forward_kinematics
 from planners.trajectory import Trajectory
 from sims.checks import Check
 from sims.collision import clearance, geoms_by_contype, obstacle_contact_pairs
@@ -65,6 +66,15 @@ class LoaderPhysics(dm_mujoco.Physics):
         """World position of the shell's nose, m."""
         return self.named.data.site_xpos["shell_tip"].copy()
 
+    def shell_tip_log(self, sensordata: np.ndarray) -> np.ndarray:
+        """The ``shell_tip_pos`` sensor's columns of a logged sensordata array, m.
+
+        MuJoCo evaluates sensors before integrating, so after ``mj_step`` they describe the
+        state one physics step (0.5 ms) before the logged qpos.
+        """
+        sensor = self.model.ptr.sensor("shell_tip_pos")
+        return sensordata[:, sensor.adr[0] : sensor.adr[0] + sensor.dim[0]]
+
     def robot_geoms(self) -> np.ndarray:
         return geoms_by_contype(self.model.ptr, ROBOT_CONTYPE)
 
@@ -98,6 +108,11 @@ class LoaderEvaluation:
             )
             self._clearance = (log, c, pairs)
         return self._clearance[1], self._clearance[2]
+
+    def _shell_tip(self, log: RunLog) -> np.ndarray:
+        """Shell nose position (m) at every logged tick, from the logged joint positions."""
+        q, _ = self._joint_log(log)
+        return forward_kinematics(q, ["shell_tip"])["shell_tip"]
 
     def _joint_log(self, log: RunLog):
         dofs = _joint_dofs(self.physics)
@@ -143,7 +158,7 @@ class LoaderEvaluation:
             "tracking_error_deg_per_joint": dict(zip(self.spec.names[1:], err_deg.max(0).round(6).tolist())),
             "peak_torque_per_joint": dict(zip(self.spec.names, np.abs(tau).max(0).round(3).tolist())),
             "torque_limit_per_joint": dict(zip(self.spec.names, self.spec.force_limit.tolist())),
-            "final_shell_tip_m": log.sensordata[-1, -3:].tolist(),
+            "final_shell_tip_m": self._shell_tip(log)[-1].tolist(),
             "contact_ticks": int(sum(v[1] for v in pairs.values())),
         }
         return checks, metrics
@@ -162,7 +177,7 @@ class LoaderEvaluation:
             "drive_force": log.actuator_force,
             "drive_force_demanded": demanded_force(self.spec.kp, self.spec.kv, log.act, q, qd),
             "drive_force_limit": self.spec.force_limit,
-            "shell_tip_pos": log.sensordata[:, -3:],
+            "shell_tip_pos": self._shell_tip(log),
             "clearance": clear,
             "key_times": self.key_times,
             "key_points": self.key_points,

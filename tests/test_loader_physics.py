@@ -142,3 +142,27 @@ def test_dm_control_environment_steps():
     # Holding still while the plan moves on: the reward drops below its maximum.
     assert 0.0 < ts.reward < 1.0
     assert env.physics.data.time == pytest.approx(0.1)
+
+
+def test_benchmark_reports_ratios_against_bare_stepping():
+    from sims import bench
+
+    row = bench.bench_scenario("loader-supply")
+    assert row["physics_steps"] == 6000 and row["passed"]
+    assert 0 < row["loop_ratio"] and np.isfinite(row["loop_ratio"])
+    assert row["realtime_factor"] > 0
+    assert "loader-supply" in bench.format_table([row])
+
+
+def test_shell_tip_sensor_matches_planner_kinematics(supply):
+    from planners.loader import forward_kinematics
+
+    """The sensor lags the logged qpos by one physics step; at rest at the end they agree."""
+    result, setup = supply
+    tip = setup.physics.shell_tip_log(result.log.sensordata)
+    expected = forward_kinematics(result.log.qpos, ["shell_tip"])["shell_tip"]
+    np.testing.assert_allclose(tip[-1], expected[-1], atol=1e-7)
+    step = setup.physics.model.opt.timestep
+    tip_speed = np.linalg.norm(np.diff(expected, axis=0), axis=1) / setup.control_dt
+    lag = np.linalg.norm(tip - expected, axis=1)
+    assert np.all(lag[1:] <= 1.5 * tip_speed.max() * step + 1e-9)
