@@ -51,14 +51,16 @@ def summary_dict(result) -> dict:
     }
 
 
-def replace_dir(tmp: Path, target: Path) -> None:
-    """Rename ``tmp`` to ``target``, replacing an existing ``target`` directory.
-
-    mkdtemp makes its directory private (0700); the result gets the usual mode (umask).
-    """
+def _usual_mode(path: Path, mode: int) -> None:
+    """mkdtemp/mkstemp make private entries (0700/0600); give ``path`` ``mode`` less the umask."""
     umask = os.umask(0)
     os.umask(umask)
-    os.chmod(tmp, 0o777 & ~umask)
+    os.chmod(path, mode & ~umask)
+
+
+def replace_dir(tmp: Path, target: Path) -> None:
+    """Rename ``tmp`` to ``target``, replacing an existing ``target`` directory."""
+    _usual_mode(tmp, 0o777)
     if target.exists():
         old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
         os.rename(target, old / target.name)
@@ -107,6 +109,7 @@ def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: s
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         replace_dir(tmp, out_dir)
         if video_tmp is not None:
+            _usual_mode(video_tmp, 0o666)
             os.replace(video_tmp, video)
         return summary
     except BaseException:

@@ -51,6 +51,16 @@ def test_run_writes_summary_timeseries_report_and_video(tmp_path):
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp dirs left
 
 
+def test_video_outside_the_output_dir(tmp_path):
+    video = tmp_path / "videos" / "short.mp4"
+    proc = planbench("run", "loader-supply", "--out", tmp_path / "r", "--video", video,
+                     "--duration", "0.5", "--camera", "closeup", "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    assert imageio_ffmpeg.count_frames_and_secs(str(video))[0] == 16  # 0.5 s at 30 fps
+    assert json.loads((tmp_path / "r" / "summary.json").read_text())["video"]["camera"] == "closeup"
+    assert [p.name for p in video.parent.iterdir()] == ["short.mp4"]  # no temp file left
+
+
 def test_failing_check_exits_1(tmp_path):
     proc = planbench("run", "loader-direct", "--out", tmp_path / "d", "--quiet", "--camera", "closeup")
     assert proc.returncode == 1, proc.stderr

@@ -1,6 +1,5 @@
 """Short MuJoCo runs of the loader scenarios: checks, collisions, determinism, divergence."""
 
-import mujoco
 import numpy as np
 import pytest
 
