@@ -85,6 +85,16 @@ class BodySpec:
     joint: int | None
 
 
+class _JointColumn:
+    """Read-only attribute: the array of one JointSpec field over a chain's joints."""
+
+    def __set_name__(self, owner, name):
+        self.field = name
+
+    def __get__(self, chain, owner=None) -> np.ndarray:
+        return np.array([getattr(j, self.field) for j in chain.joints])
+
+
 @dataclass(frozen=True)
 class SerialChainSpec:
     """A serial chain read from an MJCF: joints in order from the base, and named sites.
@@ -103,29 +113,14 @@ class SerialChainSpec:
     def names(self) -> list[str]:
         return [j.name for j in self.joints]
 
-    @property
-    def lower(self) -> np.ndarray:
-        return np.array([j.lower for j in self.joints])
-
-    @property
-    def upper(self) -> np.ndarray:
-        return np.array([j.upper for j in self.joints])
-
-    @property
-    def force_limit(self) -> np.ndarray:
-        return np.array([j.force_limit for j in self.joints])
-
-    @property
-    def rate_limit(self) -> np.ndarray:
-        return np.array([j.rate_limit for j in self.joints])
-
-    @property
-    def kp(self) -> np.ndarray:
-        return np.array([j.kp for j in self.joints])
-
-    @property
-    def kv(self) -> np.ndarray:
-        return np.array([j.kv for j in self.joints])
+    # Per-joint arrays, in chain order: limits (m, rad), force limits (N, N m), rate limits
+    # (m/s, rad/s) and drive gains.
+    lower = _JointColumn()
+    upper = _JointColumn()
+    force_limit = _JointColumn()
+    rate_limit = _JointColumn()
+    kp = _JointColumn()
+    kv = _JointColumn()
 
 
 def _serial_chain(xml_path: Path, root_body: str) -> SerialChainSpec:

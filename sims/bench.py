@@ -14,6 +14,7 @@ from __future__ import annotations
 import time
 
 import mujoco
+import numpy as np
 
 from sims import runner, scenarios
 
@@ -26,8 +27,6 @@ def bare_steps_per_second(setup, n_steps: int) -> float:
     physics = setup.physics
     model, data = physics.model.ptr, physics.data.ptr
     state_size = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    import numpy as np
-
     state = np.empty(state_size)
     mujoco.mj_getState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
     best = float("inf")

@@ -5,6 +5,7 @@ A failed or interrupted write leaves no half-written directory or video behind.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -70,6 +71,24 @@ def replace_dir(tmp: Path, target: Path) -> None:
         os.rename(tmp, target)
 
 
+@contextlib.contextmanager
+def atomic_dir(out_dir: Path):
+    """Yield a temporary directory beside ``out_dir`` that replaces it on success.
+
+    On any exception (or interrupt) the temporary directory is removed and ``out_dir`` is
+    left as it was.
+    """
+    out_dir = Path(out_dir).absolute()
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
+    try:
+        yield tmp
+        replace_dir(tmp, out_dir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
 def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: str = "overview",
               quiet: bool = True) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
@@ -81,39 +100,37 @@ def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: s
     from sims.render import render_video
 
     out_dir = Path(out_dir).absolute()
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
     video_tmp = None
     try:
-        summary = summary_dict(result)
-        log = result.log
-        arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl, "act": log.act,
-                  "actuator_force": log.actuator_force, "sensordata": log.sensordata}
-        arrays.update(setup.timeseries(log))
-        np.savez_compressed(tmp / "timeseries.npz", **arrays)
-        setup.report(log, result.checks, tmp / "report.png")
-        if video is not None:
-            video = Path(video).absolute()
-            try:
-                inside = video.relative_to(out_dir)
-                target = tmp / inside
-                target.parent.mkdir(parents=True, exist_ok=True)
-            except ValueError:
-                video.parent.mkdir(parents=True, exist_ok=True)
-                fd, name = tempfile.mkstemp(prefix=f".{video.stem}.tmp-", suffix=video.suffix, dir=video.parent)
-                os.close(fd)
-                video_tmp = target = Path(name)
-            frames = render_video(setup.physics.model.ptr, log, target, camera=camera,
-                                  speed=setup.video_speed, quiet=quiet)
-            summary["video"] = {"path": str(video), "frames": frames, "camera": camera}
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-        replace_dir(tmp, out_dir)
+        with atomic_dir(out_dir) as tmp:
+            summary = summary_dict(result)
+            log = result.log
+            arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl,
+                      "act": log.act, "actuator_force": log.actuator_force,
+                      "sensordata": log.sensordata}
+            arrays.update(setup.timeseries(log))
+            np.savez_compressed(tmp / "timeseries.npz", **arrays)
+            setup.report(log, result.checks, tmp / "report.png")
+            if video is not None:
+                video = Path(video).absolute()
+                if video.is_relative_to(out_dir):
+                    target = tmp / video.relative_to(out_dir)
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                else:
+                    video.parent.mkdir(parents=True, exist_ok=True)
+                    fd, name = tempfile.mkstemp(prefix=f".{video.stem}.tmp-", suffix=video.suffix,
+                                                dir=video.parent)
+                    os.close(fd)
+                    video_tmp = target = Path(name)
+                frames = render_video(setup.physics.model.ptr, log, target, camera=camera,
+                                      speed=setup.video_speed, quiet=quiet)
+                summary["video"] = {"path": str(video), "frames": frames, "camera": camera}
+            (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         if video_tmp is not None:
             _usual_mode(video_tmp, 0o666)
             os.replace(video_tmp, video)
         return summary
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
         if video_tmp is not None and video_tmp.exists():
             video_tmp.unlink()
         raise

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from planners.trajectory import control_ticks
-from sims.outputs import replace_dir
+from sims.outputs import atomic_dir
 from sims.report import plan_plot
 
 PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
@@ -20,10 +18,7 @@ def write_plan(scenario, out_dir: Path) -> Path:
     trajectory = scenario.plan()
     sample = trajectory.sample(control_ticks(trajectory.duration, PLAN_DT))
     kinds = scenario.kinds()
-    out_dir = Path(out_dir).absolute()
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
-    try:
+    with atomic_dir(out_dir) as tmp:
         arrays = dict(t=sample.t, position=sample.position, velocity=sample.velocity,
                       acceleration=sample.acceleration, labels=np.array(trajectory.labels),
                       kinds=np.array(kinds))
@@ -34,8 +29,4 @@ def write_plan(scenario, out_dir: Path) -> Path:
         np.savez_compressed(tmp / "plan.npz", **arrays)
         plan_plot(sample, trajectory.labels, kinds, tmp / "plan.png",
                   title=f"{scenario.name}: planned motion", key_times=key_times, key_points=key_points)
-        replace_dir(tmp, out_dir)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return out_dir
+    return Path(out_dir)

@@ -117,3 +117,17 @@ def test_plan_writes_npz_and_plot(tmp_path):
     np.testing.assert_allclose(plan["position"][::500], plan["key_points"], atol=1e-12)
     assert (tmp_path / "p" / "plan.png").stat().st_size > 10_000
     assert_one_line_error(planbench("plan", "nope", "--out", tmp_path / "q"), "nope")
+
+
+def test_failed_write_leaves_old_output_and_no_temp_dir(tmp_path):
+    from sims.outputs import atomic_dir
+
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "summary.json").write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_dir(out) as tmp:
+            (tmp / "summary.json").write_text("half")
+            raise RuntimeError("renderer died")
+    assert (out / "summary.json").read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["run"]
