@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 MODELS_DIR = Path(__file__).resolve().parent
-MECHANISMS = ("loader",)
+MECHANISMS = ("loader", "hexapod")
 
 
 def model_dir(name: str) -> Path:

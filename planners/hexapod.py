@@ -206,6 +206,12 @@ def platform_frame(pose, geometry: HexapodGeometry = RUBIN_CAMERA):
     return geometry.rotation_pivot + pose[..., :3], rotation_matrix(pose[..., 3:])
 
 
+def pivot_positions(pose, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
+    """(..., 6, 3) mirror-side pivot positions at the poses, m: c + (x, y, z) + R (m_i - c)."""
+    position, rotation = platform_frame(pose, geometry)
+    return position[..., None, :] + np.einsum("...jk,nk->...nj", rotation, geometry.platform_local)
+
+
 def strut_lengths(pose, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
     """Inverse kinematics: (..., 6) pose -> (..., 6) strut lengths, m."""
     position, rotation = platform_frame(pose, geometry)
@@ -326,6 +332,18 @@ def check_stroke(positions, limits: HexapodLimits = RUBIN_LIMITS, what: str = "t
             f"{what} {STRUT_LABELS[strut]} length change {flat[row, strut] * 1e3:.4f} mm is "
             f"beyond the stroke limit +/-{limits.stroke * 1e3:.4g} mm{where}"
         )
+
+
+def random_poses(n: int, rng: np.random.Generator, geometry: HexapodGeometry = RUBIN_CAMERA,
+                 limits: HexapodLimits = RUBIN_LIMITS) -> np.ndarray:
+    """(n, 6) poses drawn uniformly inside the pose limits and the strut stroke (rejection)."""
+    found, total = [], 0
+    while total < n:
+        poses = rng.uniform(limits.pose_lower, limits.pose_upper, size=(max(4 * (n - total), 16), 6))
+        inside = np.all(np.abs(strut_positions(poses, geometry)) <= limits.stroke, axis=1)
+        found.append(poses[inside])
+        total += int(inside.sum())
+    return np.vstack(found)[:n]
 
 
 def static_strut_forces(pose, wrench, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:

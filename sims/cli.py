@@ -1,8 +1,8 @@
 """The ``planbench`` command line (ARCHITECTURE.md, "Contracts").
 
   planbench list
-  planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--duration S] [--video FILE]
-                [--camera overview|closeup] [--quiet]
+  planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--elevation DEG] [--duration S]
+                [--video FILE] [--camera overview|closeup] [--quiet]
   planbench plan NAME --out DIR
   planbench bench
   planbench demo [--out DIR]
@@ -67,6 +67,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, help="output directory (default results/NAME)")
     run.add_argument("--seed", type=_seed, default=0)
     run.add_argument("--wind", type=_finite("wind speed", 0.0), help="mean wind, m/s")
+    run.add_argument("--elevation", type=_finite("elevation"),
+                     help="telescope elevation, deg (hexapod scenarios: 15 ... 90)")
     run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
     run.add_argument("--video", type=Path, help="write an H.264 video of the run here")
     run.add_argument("--camera", default=None, help="video camera: overview or closeup")
@@ -86,7 +88,17 @@ def _options(scenario, args):
 
     if args.wind is not None and "wind" not in scenario.options:
         raise BadInput(f"scenario {scenario.name} has no wind model; --wind is not accepted")
-    return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind)
+    if args.elevation is not None:
+        if "elevation" not in scenario.options:
+            raise BadInput(f"scenario {scenario.name} has no elevation; --elevation is not accepted")
+        from sims.hexapod import check_elevation
+
+        try:
+            check_elevation(args.elevation)
+        except ValueError as e:
+            raise BadInput(str(e)) from None
+    return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
+                      elevation=args.elevation)
 
 
 def cmd_list(args) -> int:
@@ -149,6 +161,8 @@ def cmd_bench(args) -> int:
     from sims import bench
 
     print(bench.format_table(bench.run_all()))
+    print()
+    print(bench.format_planning(bench.planning_throughput()))
     return EXIT_OK
 
 

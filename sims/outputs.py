@@ -123,8 +123,11 @@ def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: s
                     os.close(fd)
                     video_tmp = target = Path(name)
                 frames = render_video(setup.physics.model.ptr, log, target, camera=camera,
-                                      speed=setup.video_speed, quiet=quiet)
+                                      speed=setup.video_speed, quiet=quiet,
+                                      frame_qpos=setup.video_qpos)
                 summary["video"] = {"path": str(video), "frames": frames, "camera": camera}
+                if setup.video_note:
+                    summary["video"]["shows"] = setup.video_note
             (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         if video_tmp is not None:
             _usual_mode(video_tmp, 0o666)

@@ -33,8 +33,13 @@ def frame_ticks(t: np.ndarray, speed: float, fps: int = FPS) -> np.ndarray:
 
 
 def render_video(model: mujoco.MjModel, log, path, camera: str = "overview", speed: float = 1.0,
-                 width: int = WIDTH, height: int = HEIGHT, fps: int = FPS, quiet: bool = True) -> int:
-    """Write the run ``log`` as an H.264 video at ``path``; returns the number of frames."""
+                 width: int = WIDTH, height: int = HEIGHT, fps: int = FPS, quiet: bool = True,
+                 frame_qpos=None) -> int:
+    """Write the run ``log`` as an H.264 video at ``path``; returns the number of frames.
+
+    ``frame_qpos``: optional (log, ticks) -> (len(ticks), nq) states to show instead of the
+    logged ones (``Setup.video_qpos``).
+    """
     if camera not in [model.camera(i).name for i in range(model.ncam)]:
         known = ", ".join(model.camera(i).name for i in range(model.ncam))
         raise ValueError(f"unknown camera {camera!r}; this model has: {known}")
@@ -45,11 +50,13 @@ def render_video(model: mujoco.MjModel, log, path, camera: str = "overview", spe
         )
     data = mujoco.MjData(model)
     ticks = frame_ticks(log.t, speed, fps)
+    qpos = log.qpos[ticks] if frame_qpos is None else frame_qpos(log, ticks)
     renderer = mujoco.Renderer(model, height=height, width=width)
     try:
         with mediapy.VideoWriter(path, shape=(height, width), fps=fps, codec="h264") as writer:
-            for i in tqdm(ticks, unit="frame", disable=quiet, delay=2.0, leave=False, desc="rendering"):
-                data.qpos[:] = log.qpos[i]
+            for frame, i in enumerate(tqdm(ticks, unit="frame", disable=quiet, delay=2.0,
+                                           leave=False, desc="rendering")):
+                data.qpos[:] = qpos[frame]
                 data.qvel[:] = log.qvel[i]
                 if model.nmocap:
                     data.mocap_pos[:] = log.mocap_pos[i]

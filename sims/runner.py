@@ -64,6 +64,9 @@ class Setup:
       report: (RunLog, checks, path) -> None, draws report.png.
       disturbance: optional, see ``Disturbance``.
       video_speed: video clock / simulated clock (1 real time, 0.5 slow motion, 20 time-lapse).
+      video_qpos: optional (log, ticks) -> qpos rows to render at those ticks, for a video
+        that shows something other than the logged state (the hexapod's magnified motion).
+      video_note: what the video shows, written to summary.json (e.g. the magnification).
     """
 
     physics: object
@@ -77,6 +80,8 @@ class Setup:
     disturbance: Disturbance | None = None
     video_speed: float = 1.0
     seed: int = 0
+    video_qpos: Callable | None = None
+    video_note: str = ""
 
 
 @dataclass

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
-from sims import loader
+from sims import hexapod, loader
 
 
 @dataclass(frozen=True)
@@ -16,11 +16,13 @@ class RunOptions:
       seed: seed of every random process of the run (disturbances, noise).
       duration: simulated time in s, None for the scenario's default.
       wind: mean wind speed in m/s, None for the scenario's default (wind scenarios only).
+      elevation: telescope elevation in deg, None for the default (hexapod scenarios).
     """
 
     seed: int = 0
     duration: float | None = None
     wind: float | None = None
+    elevation: float | None = None
 
 
 @dataclass(frozen=True)
@@ -65,6 +67,22 @@ SCENARIOS: dict[str, Scenario] = {
             lambda: loader.loader_planner.direct_plan(),
             expect_pass=False,
             kinds=loader.joint_kinds,
+        ),
+        Scenario(
+            "hexapod-sync-move",
+            "Rubin camera hexapod, 3 t camera: synchronous move of ~2 mm and 0.1 deg, all six struts arrive on one tick (--elevation, --wind)",
+            hexapod.build_sync,
+            lambda: hexapod.plan(True),
+            options=frozenset({"wind", "elevation"}),
+            kinds=hexapod.strut_kinds,
+        ),
+        Scenario(
+            "hexapod-async-move",
+            "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at its own minimum time (--elevation, --wind)",
+            hexapod.build_async,
+            lambda: hexapod.plan(False),
+            options=frozenset({"wind", "elevation"}),
+            kinds=hexapod.strut_kinds,
         ),
     )
 }

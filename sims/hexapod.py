@@ -1,0 +1,549 @@
+"""The Rubin camera hexapod in MuJoCo: physics accessors, the strut controller, scenarios.
+
+Scenarios:
+  hexapod-sync-move   a move of a few mm and ~0.1 deg, every strut arriving on the same tick
+  hexapod-async-move  another such move, each strut at its own minimum time
+both with ``--elevation`` (telescope elevation, 15 ... 90 deg: gravity's direction in the
+hexapod frame) and ``--wind`` (turbulent drag on the camera).
+
+The hexapod frame is the model's body ``top_end`` (models/hexapod/hexapod.xml); the model is
+recompiled per elevation with the top end tilted (MjSpec), so gravity stays the world's -z.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import mujoco
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+from scipy.spatial.transform import Rotation
+
+import models
+from planners import hexapod as hexapod_planner
+from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
+from planners.trajectory import TrajectorySample
+from sims.checks import Check
+from sims.runner import RunLog, Setup
+from sims.wind import BodyWindDrag, cylinder_projected_area
+
+CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
+SETTLE_S = 1.0  # s simulated after the move: the integral action settles in ~0.5 s
+SETTLE_WINDOW_S = 0.25  # s: pose_error_final is the worst over the run's last 0.25 s
+ELEVATION_RANGE_DEG = (15.0, 90.0)
+DEFAULT_ELEVATION_DEG = 45.0
+
+#: Check limits (REFERENCE.md, "Rubin hexapod"): following error up to 40 um during a move,
+#: ~1 um at its end.
+FOLLOWING_LIMIT_UM = 40.0
+POSE_FINAL_LIMIT_UM = 1.0
+#: Synchronous moves end within one tick.
+ARRIVAL_SPREAD_LIMIT_S = CONTROL_DT
+
+#: The moves: a few mm and ~0.1 deg, inside the pose limits and the stroke (m, rad).
+SYNC_TARGET = np.array([1.5e-3, -1.0e-3, 0.8e-3, np.radians(0.10), np.radians(-0.05), np.radians(0.03)])
+ASYNC_TARGET = np.array([-2.0e-3, 1.5e-3, -1.0e-3, np.radians(-0.05), np.radians(0.10), np.radians(-0.05)])
+
+#: Drag of the camera (a cylinder, 1.65 m x 3 m): Cd = 1.0 for a circular cylinder in cross
+#: flow (subcritical, ~1.0-1.2), applied to its silhouette across the wind (README.md).
+CAMERA_DRAG_COEFFICIENT = 1.0
+#: The wind blows toward world +x, across the elevation axis's normal plane, so the camera
+#: shows its full side (D x L) at every elevation: the worst case.
+WIND_AZIMUTH_DEG = 0.0
+INTEGRAL_TIME_S = 0.1  # integral action's time constant; the lowest mode is ~12 Hz
+#: The moves are millimetres on a 6 m assembly: the video shows the platform's motion (pose
+#: change from the start) magnified this many times, like a deformation plot.
+VIDEO_MAGNIFICATION = 100.0
+DEFAULT_WIND_M_S = 5.0
+
+
+def top_end_rotation(elevation_deg: float) -> np.ndarray:
+    """Orientation of the hexapod frame in the world at a telescope elevation (deg).
+
+    +z (base to mirror side, toward the primary) points along (0, cos El, -sin El): down at the
+    zenith, horizontal at El = 0; +y = (0, sin El, cos El); +x = y x z = (-1, 0, 0).
+    """
+    el = np.radians(elevation_deg)
+    x = np.array([-1.0, 0.0, 0.0])
+    y = np.array([0.0, np.sin(el), np.cos(el)])
+    z = np.array([0.0, np.cos(el), -np.sin(el)])
+    return np.column_stack([x, y, z])
+
+
+def check_elevation(elevation_deg: float) -> float:
+    lo, hi = ELEVATION_RANGE_DEG
+    if not np.isfinite(elevation_deg) or not lo <= elevation_deg <= hi:
+        raise ValueError(f"elevation {elevation_deg!r} deg is outside the telescope's range "
+                         f"[{lo:g}, {hi:g}] deg")
+    return float(elevation_deg)
+
+
+def _wxyz(rotation: np.ndarray) -> np.ndarray:
+    x, y, z, w = Rotation.from_matrix(rotation).as_quat()
+    return np.array([w, x, y, z])
+
+
+@functools.lru_cache(maxsize=16)
+def _compiled(elevation_deg: float) -> mujoco.MjModel:
+    spec = mujoco.MjSpec.from_file(str(models.scene_path("hexapod")))
+    top_end = spec.body("top_end")
+    rotation = top_end_rotation(elevation_deg)
+    origin = np.array(top_end.pos)
+    quat = _wxyz(rotation)
+    top_end.quat = quat
+    platform_pos = origin + rotation @ RUBIN_CAMERA.rotation_pivot
+    platform = spec.body("platform")
+    platform.pos = platform_pos
+    platform.quat = quat
+    key = spec.key("home")
+    qpos = np.array(key.qpos)
+    qpos[-7:-4] = platform_pos
+    qpos[-4:] = quat
+    key.qpos = qpos
+    return spec.compile()
+
+
+class HexapodPhysics(dm_mujoco.Physics):
+    """dm_control Physics of models/hexapod/scene.xml at one telescope elevation."""
+
+    @classmethod
+    def load(cls, elevation_deg: float = 90.0) -> "HexapodPhysics":
+        elevation_deg = check_elevation(elevation_deg)
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy_model(_compiled(elevation_deg))))
+        physics.elevation_deg = elevation_deg
+        physics.reset(keyframe_id=0)
+        return physics
+
+    # ---- indices
+    @functools.cached_property
+    def _slide_qpos(self) -> np.ndarray:
+        model = self.model.ptr
+        return np.array([model.joint(n).qposadr[0] for n in STRUT_LABELS])
+
+    @functools.cached_property
+    def _slide_dof(self) -> np.ndarray:
+        model = self.model.ptr
+        return np.array([model.joint(n).dofadr[0] for n in STRUT_LABELS])
+
+    @functools.cached_property
+    def _free_qpos(self) -> int:
+        return int(self.model.ptr.joint("platform").qposadr[0])
+
+    @property
+    def top_end_frame(self):
+        """(origin (3,), rotation (3, 3)) of the hexapod frame in the world (a fixed body)."""
+        model = self.model.ptr
+        body = model.body("top_end")
+        return np.array(body.pos), Rotation.from_quat(np.roll(body.quat, -1)).as_matrix()
+
+    # ---- drive constants (from the compiled model: one source of truth)
+    @property
+    def kp(self) -> np.ndarray:
+        return self.model.ptr.actuator_gainprm[:6, 0].copy()
+
+    @property
+    def kv(self) -> np.ndarray:
+        return -self.model.ptr.actuator_biasprm[:6, 2].copy()
+
+    @property
+    def force_limit(self) -> np.ndarray:
+        return self.model.ptr.actuator_forcerange[:6, 1].copy()
+
+    @property
+    def strut_dofs(self) -> np.ndarray:
+        return self._slide_dof
+
+    # ---- state
+    def strut_positions(self) -> np.ndarray:
+        """Encoder readings: strut length changes from the zero pose, m."""
+        return self.data.qpos[self._slide_qpos].copy()
+
+    def strut_velocities(self) -> np.ndarray:
+        return self.data.qvel[self._slide_dof].copy()
+
+    def strut_drive_forces(self) -> np.ndarray:
+        """Drive forces along each strut, N; positive pushes (compression)."""
+        return self.data.actuator_force[:6].copy()
+
+    def strut_lengths(self) -> np.ndarray:
+        """Pivot-to-pivot lengths (MuJoCo's spatial tendons), m."""
+        return self.data.ten_length[:6].copy()
+
+    def gravity_in_hexapod_frame(self) -> np.ndarray:
+        _, rotation = self.top_end_frame
+        return rotation.T @ self.model.opt.gravity
+
+    def poses_from_qpos(self, qpos: np.ndarray) -> np.ndarray:
+        """(n, 6) hexapod poses (x, y, z, rx, ry, rz) of logged qpos rows (n, nq)."""
+        qpos = np.atleast_2d(qpos)
+        origin, rotation = self.top_end_frame
+        pos_world = qpos[:, self._free_qpos:self._free_qpos + 3]
+        quat_world = qpos[:, self._free_qpos + 3:self._free_qpos + 7]
+        position = (pos_world - origin) @ rotation - RUBIN_CAMERA.rotation_pivot
+        r_world = Rotation.from_quat(np.roll(quat_world, -1, axis=1))
+        angles = (Rotation.from_matrix(rotation.T) * r_world).as_euler("XYZ")
+        return np.hstack([position, angles])
+
+    def platform_pose(self) -> np.ndarray:
+        return self.poses_from_qpos(self.data.qpos)[0]
+
+    def payload_mass_properties(self):
+        """(mass kg, centre of mass (3,) in the platform frame) of the platform and camera."""
+        model, data = self.model.ptr, self.data.ptr
+        platform = model.body("platform").id
+        mass = float(model.body_subtreemass[platform])
+        com_world = data.subtree_com[platform]
+        local = data.xmat[platform].reshape(3, 3).T @ (com_world - data.xpos[platform])
+        return mass, local
+
+    def strut_rod_masses(self) -> np.ndarray:
+        model = self.model.ptr
+        return np.array([model.body_mass[model.body(f"{n}_rod").id] for n in STRUT_LABELS])
+
+    def set_pose(self, pose) -> None:
+        """Put the hexapod at rest at ``pose``: platform, universal joints and slides.
+
+        Each strut's universal joint turns its housing's z axis onto the new pivot-to-pivot
+        direction (hinge about x by a, then about the new y by b: z' = Rx(a) Ry(b) e_z) and
+        the slide takes up the length change; the loops close to round-off.
+        """
+        pose = np.asarray(pose, dtype=float)
+        model, data = self.model.ptr, self.data.ptr
+        origin, rotation = self.top_end_frame
+        position, r_pose = hexapod_planner.platform_frame(pose)
+        data.qpos[self._free_qpos:self._free_qpos + 3] = origin + rotation @ position
+        data.qpos[self._free_qpos + 3:self._free_qpos + 7] = _wxyz(rotation @ r_pose)
+        pivots = hexapod_planner.pivot_positions(pose)
+        for i, name in enumerate(STRUT_LABELS):
+            housing = model.body(f"{name}_housing")
+            r0 = Rotation.from_quat(np.roll(housing.quat, -1)).as_matrix()
+            leg = pivots[i] - RUBIN_CAMERA.base_pivots[i]
+            length = np.linalg.norm(leg)
+            u = r0.T @ leg / length
+            b = np.arcsin(np.clip(u[0], -1.0, 1.0))
+            a = np.arctan2(-u[1], u[2])
+            data.qpos[model.joint(f"{name}_u1").qposadr[0]] = a
+            data.qpos[model.joint(f"{name}_u2").qposadr[0]] = b
+            data.qpos[self._slide_qpos[i]] = length - model.body(f"{name}_rod").pos[2]
+        data.qvel[:] = 0.0
+        data.act[:] = data.qpos[self._slide_qpos]
+        mujoco.mj_forward(model, data)
+
+    def loop_closure_error(self) -> float:
+        """Largest violation of the six ball constraints, m."""
+        data = self.data.ptr
+        rows = data.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        return float(np.abs(data.efc_pos[rows]).max()) if rows.any() else 0.0
+
+
+def magnified_qpos(physics: HexapodPhysics, magnification: float):
+    """Setup.video_qpos: states whose pose change from the first logged pose is magnified."""
+
+    def frames(log: RunLog, ticks: np.ndarray) -> np.ndarray:
+        scratch = HexapodPhysics.from_model(dm_mujoco.wrapper.MjModel(copy_model(physics.model.ptr)))
+        scratch.elevation_deg = physics.elevation_deg
+        poses = physics.poses_from_qpos(log.qpos[ticks])
+        start = physics.poses_from_qpos(log.qpos[0])[0]
+        out = np.empty((ticks.size, physics.model.nq))
+        for k, pose in enumerate(start + magnification * (poses - start)):
+            scratch.set_pose(pose)
+            out[k] = scratch.data.qpos
+        return out
+
+    return frames
+
+
+def copy_model(model: mujoco.MjModel) -> mujoco.MjModel:
+    import copy
+
+    return copy.copy(model)
+
+
+# ----------------------------------------------------------------------------- control
+
+
+class HexapodController:
+    """Strut servo: reference tracking with static-load feed-forward and integral action.
+
+    The drives (MJCF integrator actuators) apply kp (s - q) - kv qdot with s the set-point in
+    their activation; per tick this controller ramps s linearly (ctrl = set-point rate) to
+
+        s = q_ref + (f_ff + kv qdot_ref) / kp + z,   z <- z + dt / T_i (q_ref - q)
+
+    f_ff: the drive forces that hold the payload in static equilibrium at the reference pose
+    (``planners.hexapod.static_strut_forces`` of the payload's weight, plus each rod's weight
+    along its strut), what a real hexapod's gravity table supplies; z: integral action on the
+    encoder error for what the model leaves out (housings, wind, the constraint compliance),
+    limited so that kp z stays inside the force limit.
+
+    Args:
+      feedforward: include f_ff (False: PD + integral only).
+      integral_time: T_i in s; None for no integral action.
+    """
+
+    def __init__(self, feedforward: bool = True, integral_time: float | None = INTEGRAL_TIME_S):
+        self.feedforward = feedforward
+        self.integral_time = integral_time
+        self.setpoints = None
+        self.reference = None
+        self.f_ff = None
+        self.z = None
+
+    def static_drive_forces(self, physics: HexapodPhysics, strut_positions: np.ndarray) -> np.ndarray:
+        """(n, 6) drive forces (N, push positive) that hold the reference poses statically.
+
+        Exact statics of the model: the payload's weight, and each strut's own weight. A
+        strut's housing and rod hang on its base universal joint; the moment of their weights
+        about it, M = sum_k r_k x m_k g (r_k along the strut), is held by a transverse force
+        at the top pivot, F_t = (l x M) / |l|^2, whose reaction loads the platform. The rod's
+        weight along the strut is the drive's own. Tensions from
+        ``planners.hexapod.static_strut_forces`` of the total wrench on the platform.
+        """
+        model = physics.model.ptr
+        lengths = strut_positions + RUBIN_CAMERA.nominal_lengths
+        poses, _ = hexapod_planner.forward_kinematics(lengths)
+        mass, com_local = physics.payload_mass_properties()
+        gravity = physics.gravity_in_hexapod_frame()
+        origin, rotation = hexapod_planner.platform_frame(poses)
+        force = np.broadcast_to(mass * gravity, poses[:, :3].shape).copy()
+        moment = np.cross(rotation @ com_local, force)
+        pivots = hexapod_planner.pivot_positions(poses)
+        legs = pivots - RUBIN_CAMERA.base_pivots
+        leg_length = np.linalg.norm(legs, axis=-1, keepdims=True)
+        units = legs / leg_length
+        housing = np.array([model.body(f"{n}_housing").id for n in STRUT_LABELS])
+        rod = np.array([model.body(f"{n}_rod").id for n in STRUT_LABELS])
+        # Centres of mass along the strut from its base pivot, m (rod frame origin = tip).
+        housing_arm = model.body_ipos[housing, 2]
+        rod_arm = leg_length[..., 0] + model.body_ipos[rod, 2]
+        weight_moment = (model.body_mass[housing] * housing_arm + model.body_mass[rod] * rod_arm)
+        strut_moment = np.cross(units * weight_moment[..., None], gravity)
+        tip_force = np.cross(legs, strut_moment) / leg_length**2
+        force -= tip_force.sum(axis=1)
+        moment -= np.cross(pivots - origin[:, None, :], tip_force).sum(axis=1)
+        tension = hexapod_planner.static_strut_forces(poses, np.hstack([force, moment]))
+        rod_weight = model.body_mass[rod] * (units @ gravity)
+        return -tension - rod_weight
+
+    def reset(self, physics, reference: TrajectorySample, control_dt: float) -> None:
+        kp, kv = physics.kp, physics.kv
+        self._kp, self._limit = kp, physics.force_limit
+        self._qadr = physics._slide_qpos
+        n = reference.t.size
+        self.f_ff = (self.static_drive_forces(physics, reference.position) if self.feedforward
+                     else np.zeros((n, 6)))
+        self.reference = reference.position
+        self.setpoints = reference.position + (self.f_ff + kv * reference.velocity) / kp
+        self.z = np.zeros(6)
+        self._gain = 0.0 if self.integral_time is None else control_dt / self.integral_time
+        self._inv_dt = 1.0 / control_dt
+        physics.data.act[:6] = self.setpoints[0]
+
+    def __call__(self, tick: int, physics) -> None:
+        data = physics.data.ptr
+        error = self.reference[tick] - data.qpos[self._qadr]
+        z = self.z + self._gain * error
+        self.z = np.clip(z, -self._limit / self._kp, self._limit / self._kp)
+        target = self.setpoints[min(tick + 1, self.setpoints.shape[0] - 1)] + self.z
+        data.ctrl[:6] = (target - data.act[:6]) * self._inv_dt
+
+
+def demanded_drive_force(kp, kv, act, q, qd) -> np.ndarray:
+    """kp (s - q) - kv qdot before the force-range clamp, N."""
+    return kp * (act - q) - kv * qd
+
+
+# ----------------------------------------------------------------------------- evaluation
+
+
+def arrival_times(reference: TrajectorySample, tolerance: float = 0.0) -> np.ndarray:
+    """(6,) first time after which each channel's reference rests on its final value, s."""
+    final = reference.position[-1]
+    moving = (np.abs(reference.position - final) > tolerance) | (reference.velocity != 0.0)
+    last_moving = np.where(moving.any(axis=0), moving.shape[0] - 1 - np.argmax(moving[::-1], axis=0), -1)
+    index = np.minimum(last_moving + 1, reference.t.size - 1)
+    return np.where(last_moving >= 0, reference.t[index], 0.0)
+
+
+class HexapodEvaluation:
+    """Checks and outputs of a hexapod run."""
+
+    def __init__(self, physics: HexapodPhysics, move, synchronous: bool, wind: BodyWindDrag | None):
+        self.physics = physics
+        self.move = move
+        self.synchronous = synchronous
+        self.wind = wind
+
+    def _strut_log(self, log: RunLog):
+        p = self.physics
+        return log.qpos[:, p._slide_qpos], log.qvel[:, p._slide_dof]
+
+    def closure_mismatch(self, log: RunLog) -> np.ndarray:
+        """(n,) largest |pivot-to-pivot length - (nominal + encoder)|, m: the compliance of
+        MuJoCo's soft loop constraints (sensors of one physics step, so they agree)."""
+        model = self.physics.model.ptr
+        length = np.column_stack([log.sensordata[:, model.sensor(f"{n}_length").adr[0]] for n in STRUT_LABELS])
+        encoder = np.column_stack([log.sensordata[:, model.sensor(f"{n}_encoder").adr[0]] for n in STRUT_LABELS])
+        return np.abs(length - RUBIN_CAMERA.nominal_lengths - encoder).max(axis=1)
+
+    def pivot_errors_um(self, log: RunLog, target_pose) -> np.ndarray:
+        """(n,) largest displacement of the six mirror-side pivots from the target pose, um."""
+        poses = self.physics.poses_from_qpos(log.qpos)
+        actual = hexapod_planner.pivot_positions(poses)
+        wanted = hexapod_planner.pivot_positions(np.asarray(target_pose))
+        return 1e6 * np.linalg.norm(actual - wanted, axis=-1).max(axis=-1)
+
+    def __call__(self, log: RunLog):
+        p = self.physics
+        ref = log.reference
+        q, qd = self._strut_log(log)
+        limits = RUBIN_LIMITS
+        moving = np.abs(ref.position[-1] - ref.position[0]) > 0
+        arrivals = arrival_times(ref)
+        spread = float(arrivals[moving].max() - arrivals[moving].min()) if moving.any() else 0.0
+        move_end = float(arrivals.max())
+        during = log.t <= move_end + 1e-9
+        following = 1e6 * np.abs(q - ref.position)[during].max()
+        window = log.t >= log.t[-1] - SETTLE_WINDOW_S - 1e-9
+        target_pose = self.move.target_pose
+        pose_err = self.pivot_errors_um(log, target_pose)
+        demanded = demanded_drive_force(p.kp, p.kv, log.act[:, :6], q, qd)
+        force = np.abs(demanded).max()
+        stroke = np.abs(q).max()
+        v_cmd = np.abs(ref.velocity).max()
+        a_cmd = np.abs(ref.acceleration).max()
+        checks = []
+        if self.synchronous:
+            checks.append(Check("arrival_spread", spread, ARRIVAL_SPREAD_LIMIT_S, "s",
+                                note="last minus first strut arrival of the commanded motion"))
+        else:
+            own = 2.0 * np.asarray(self.move.profiles.half_time)
+            late = float(np.abs(arrivals - own)[moving].max()) if moving.any() else 0.0
+            checks.append(Check("arrival_vs_own_time", late, 2 * CONTROL_DT, "s",
+                                note=f"each strut ends within two ticks of its own time 2 T_i; "
+                                     f"arrival spread {spread:.3f} s"))
+        ended = log.t[-1] >= move_end + SETTLE_S - 1e-9
+        checks += [
+            Check("strut_velocity", 1e6 * v_cmd, 1e6 * limits.strut_speed, "um/s",
+                  note="commanded; measured peak "
+                       f"{1e6 * np.abs(qd).max():.1f} um/s"),
+            Check("strut_accel", 1e6 * a_cmd, 1e6 * limits.strut_accel, "um/s2",
+                  note="commanded by the generator, per tick"),
+            Check("following_error", float(following), FOLLOWING_LIMIT_UM, "um",
+                  note=f"encoder minus reference, t <= {move_end:.3f} s"),
+            Check("pose_error_final", float(pose_err[window].max()) if ended else float("nan"),
+                  POSE_FINAL_LIMIT_UM, "um",
+                  note=f"largest mirror-side pivot displacement over the last {SETTLE_WINDOW_S} s"
+                  if ended else f"the run ended before the move plus {SETTLE_S} s of settling"),
+            Check("strut_force", float(force), float(p.force_limit.min()), "N",
+                  note=f"demanded, peak on {STRUT_LABELS[int(np.argmax(np.abs(demanded).max(0)))]}"),
+            Check("stroke", 1e3 * float(stroke), 1e3 * limits.stroke, "mm"),
+        ]
+        final_pose = p.poses_from_qpos(log.qpos[-1])[0]
+        pose_diff = final_pose - np.asarray(target_pose)
+        metrics = {
+            "elevation_deg": p.elevation_deg,
+            "move_duration_s": move_end,
+            "arrival_times_s": dict(zip(STRUT_LABELS, arrivals.round(4).tolist())),
+            "arrival_spread_s": spread,
+            "final_translation_error_um": (1e6 * pose_diff[:3]).round(4).tolist(),
+            "final_rotation_error_urad": (1e6 * pose_diff[3:]).round(4).tolist(),
+            "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist())),
+            "peak_drive_force_N": dict(zip(STRUT_LABELS, np.abs(demanded).max(0).round(1).tolist())),
+            "static_drive_force_start_N": dict(zip(STRUT_LABELS, demanded[0].round(1).tolist())),
+            "measured_peak_strut_speed_um_s": float(1e6 * np.abs(qd).max()),
+            "loop_closure_um": float(1e6 * self.closure_mismatch(log)[window].max()),
+        }
+        if self.wind is not None and self.wind.speed is not None:
+            n = log.t.size
+            metrics["wind_mean_m_s"] = self.wind.mean_speed
+            metrics["wind_speed_std_m_s"] = float(np.std(self.wind.speed[:n]))
+            metrics["wind_force_peak_N"] = float(np.linalg.norm(self.wind.force[:n], axis=1).max())
+        return checks, metrics
+
+    def timeseries(self, log: RunLog) -> dict:
+        p = self.physics
+        q, qd = self._strut_log(log)
+        out = {
+            "strut_names": np.array(STRUT_LABELS),
+            "strut_position_planned": log.reference.position,
+            "strut_velocity_planned": log.reference.velocity,
+            "strut_accel_planned": log.reference.acceleration,
+            "strut_position_actual": q,
+            "strut_velocity_actual": qd,
+            "setpoint": log.act[:, :6],
+            "drive_force": log.actuator_force[:, :6],
+            "drive_force_demanded": demanded_drive_force(p.kp, p.kv, log.act[:, :6], q, qd),
+            "drive_force_limit": p.force_limit,
+            "pose_actual": p.poses_from_qpos(log.qpos),
+            "target_pose": np.asarray(self.move.target_pose),
+            "pivot_error_um": self.pivot_errors_um(log, self.move.target_pose),
+        }
+        if self.wind is not None and self.wind.speed is not None:
+            out["wind_speed"] = self.wind.speed[: log.t.size]
+            out["wind_force"] = self.wind.force[: log.t.size]
+        return out
+
+    def report(self, log: RunLog, checks, path) -> None:
+        from sims.report import hexapod_report
+
+        hexapod_report(self.timeseries(log), log.t, checks, path)
+
+
+# ----------------------------------------------------------------------------- scenarios
+
+
+def camera_area(physics: HexapodPhysics) -> float:
+    """Silhouette of the camera across the wind, m^2."""
+    model, data = physics.model.ptr, physics.data.ptr
+    geom = model.geom("camera_body")
+    radius, half = geom.size[0], geom.size[1]
+    axis = data.geom_xmat[geom.id].reshape(3, 3)[:, 2]
+    direction = np.array([np.cos(np.radians(WIND_AZIMUTH_DEG)), np.sin(np.radians(WIND_AZIMUTH_DEG)), 0.0])
+    return float(cylinder_projected_area(axis, direction, 2 * radius, 2 * half))
+
+
+def plan(synchronous: bool):
+    target = SYNC_TARGET if synchronous else ASYNC_TARGET
+    return hexapod_planner.plan_move(np.zeros(6), target, synchronous=synchronous)
+
+
+def _setup(synchronous: bool, options, controller=None) -> Setup:
+    elevation = DEFAULT_ELEVATION_DEG if options.elevation is None else options.elevation
+    physics = HexapodPhysics.load(elevation)
+    move = plan(synchronous)
+    physics.set_pose(move.start_pose)
+    wind_speed = DEFAULT_WIND_M_S if options.wind is None else options.wind
+    wind = None
+    if wind_speed > 0:
+        wind = BodyWindDrag("camera", wind_speed, camera_area, CAMERA_DRAG_COEFFICIENT,
+                            WIND_AZIMUTH_DEG)
+    evaluation = HexapodEvaluation(physics, move, synchronous, wind)
+    duration = options.duration if options.duration is not None else move.duration + SETTLE_S
+    return Setup(
+        physics=physics,
+        trajectory=move,
+        controller=controller if controller is not None else HexapodController(),
+        control_dt=CONTROL_DT,
+        duration=duration,
+        evaluate=evaluation,
+        timeseries=evaluation.timeseries,
+        report=evaluation.report,
+        disturbance=wind,
+        video_speed=1.0,
+        seed=options.seed,
+        video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
+        video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)",
+    )
+
+
+def build_sync(options) -> Setup:
+    return _setup(True, options)
+
+
+def build_async(options) -> Setup:
+    return _setup(False, options)
+
+
+def strut_kinds() -> list[str]:
+    return ["slide"] * 6
