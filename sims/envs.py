@@ -76,3 +76,21 @@ def loader_environment(plan: str = "supply", control_dt: float = 0.005) -> contr
     return control.Environment(
         physics, task, time_limit=trajectory.duration + SETTLE_S, n_sub_steps=n_sub
     )
+
+
+def hexapod_environment(synchronous: bool = True, elevation_deg: float = 45.0,
+                        control_dt: float = 0.005) -> control.Environment:
+    """The hexapod as a dm_control Environment following the sync (or async) move.
+
+    The action is the six drives' set-point rates (m/s); the episode starts at rest at the
+    zero pose with the set-points at zero, so a controller must take up the gravity load.
+    """
+    from sims.hexapod import SETTLE_S, HexapodPhysics, plan
+
+    trajectory = plan(synchronous)
+    physics = HexapodPhysics.load(elevation_deg)
+    task = TrajectoryTrackingTask(trajectory, list(trajectory.labels), error_scale=10e-6)
+    n_sub = int(round(control_dt / physics.model.opt.timestep))
+    return control.Environment(
+        physics, task, time_limit=trajectory.duration + SETTLE_S, n_sub_steps=n_sub
+    )

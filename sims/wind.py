@@ -57,7 +57,9 @@ def wind_speed_series(times: np.ndarray, mean_speed: float, rng: np.random.Gener
       spectrum: "kaimal" or "davenport".
       f_max: highest frequency of the sum, Hz (gusts shorter than ~0.1 s carry little energy
         and act on a fraction of a body a metre across).
-      df: frequency step, Hz; default 1 / (run length), at least 1/600 Hz.
+      df: frequency step, Hz; default the smaller of 1 / (run length) and 1/600 Hz, so a short
+        run still sees the slow part of the turbulence (most of a Kaimal spectrum's energy
+        lies below 0.01 Hz) as a slowly drifting speed.
     """
     if not np.isfinite(mean_speed) or mean_speed < 0:
         raise ValueError(f"mean wind speed {mean_speed!r} m/s must be finite and >= 0")
@@ -68,7 +70,7 @@ def wind_speed_series(times: np.ndarray, mean_speed: float, rng: np.random.Gener
         return np.zeros_like(times)
     span = float(times[-1] - times[0]) if times.size > 1 else 1.0
     if df is None:
-        df = max(1.0 / max(span, 1e-9), 1.0 / 600.0)
+        df = min(1.0 / max(span, 1e-9), 1.0 / 600.0)
     freqs = np.arange(1, int(np.floor(f_max / df)) + 1) * df
     amplitude = np.sqrt(2.0 * SPECTRA[spectrum](freqs, mean_speed) * df)
     phases = rng.uniform(0.0, 2.0 * np.pi, freqs.size)

@@ -27,7 +27,7 @@ def test_list_names_every_scenario():
     proc = planbench("list")
     assert proc.returncode == 0
     names = [line.split()[0] for line in proc.stdout.splitlines()]
-    assert names == ["loader-supply", "loader-direct"]
+    assert names == ["loader-supply", "loader-direct", "hexapod-sync-move", "hexapod-async-move"]
 
 
 def test_run_writes_summary_timeseries_report_and_video(tmp_path):
@@ -131,3 +131,34 @@ def test_failed_write_leaves_old_output_and_no_temp_dir(tmp_path):
             raise RuntimeError("renderer died")
     assert (out / "summary.json").read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["run"]
+
+
+def test_hexapod_run_with_elevation_and_wind(tmp_path):
+    out = tmp_path / "hx"
+    proc = planbench("run", "hexapod-async-move", "--elevation", "20", "--wind", "8", "--out", out,
+                     "--video", out / "hexapod.mp4", "--camera", "closeup", "--quiet")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["metrics"]["elevation_deg"] == 20.0 and summary["metrics"]["wind_mean_m_s"] == 8.0
+    assert {c["name"] for c in summary["checks"]} >= {"following_error", "pose_error_final", "stroke"}
+    assert "magnified" in summary["video"]["shows"]
+    ts = np.load(out / "timeseries.npz")
+    assert ts["strut_position_actual"].shape == ts["strut_position_planned"].shape == (ts["t"].size, 6)
+    assert ts["wind_force"].shape == (ts["t"].size, 3)
+    frames = imageio_ffmpeg.count_frames_and_secs(str(out / "hexapod.mp4"))[0]
+    assert frames == int(np.floor(summary["sim_time_s"] * 30)) + 1
+
+
+def test_hexapod_bad_elevation_exits_2(tmp_path):
+    assert_one_line_error(planbench("run", "hexapod-sync-move", "--elevation", "10", "--out",
+                                    tmp_path / "x"), "elevation 10", "[15, 90]")
+    assert_one_line_error(planbench("run", "loader-supply", "--elevation", "45"), "no elevation")
+    assert not (tmp_path / "x").exists()
+
+
+def test_hexapod_plan(tmp_path):
+    proc = planbench("plan", "hexapod-sync-move", "--out", tmp_path / "p")
+    assert proc.returncode == 0, proc.stderr
+    plan = np.load(tmp_path / "p" / "plan.npz")
+    assert list(plan["labels"]) == [f"strut{i}" for i in range(1, 7)]
+    assert np.abs(plan["velocity"]).max() <= 500e-6 and np.abs(plan["acceleration"]).max() <= 500e-6

@@ -1,0 +1,153 @@
+"""Short MuJoCo runs of the hexapod scenarios: checks at three elevations, wind, determinism."""
+
+import numpy as np
+import pytest
+
+from planners import hexapod
+from planners.trajectory import TrajectorySample
+from sims import runner, scenarios
+from sims import hexapod as sim_hexapod
+from sims.wind import AIR_DENSITY, kaimal_spectrum, wind_speed_series
+
+EXPECTED = {"strut_velocity", "strut_accel", "following_error", "pose_error_final",
+            "strut_force", "stroke", "simulation_warnings"}
+WIND_M_S = 10.0
+
+
+def run(name, controller=None, trajectory=None, **options):
+    scenario = scenarios.get(name)
+    setup = scenario.build(scenarios.RunOptions(**options))
+    if controller is not None:
+        setup.controller = controller
+    if trajectory is not None:
+        setup.trajectory = trajectory
+    return runner.run(name, setup), setup
+
+
+def checks(result):
+    return {c.name: c for c in result.checks}
+
+
+@pytest.mark.parametrize("name", ["hexapod-sync-move", "hexapod-async-move"])
+@pytest.mark.parametrize("elevation", [15.0, 45.0, 90.0])
+@pytest.mark.parametrize("wind", [0.0, WIND_M_S])
+def test_checks_hold(name, elevation, wind):
+    result, setup = run(name, elevation=elevation, wind=wind)
+    c = checks(result)
+    assert result.passed, [x.to_json() for x in result.checks if not x.passed]
+    first = "arrival_spread" if name == "hexapod-sync-move" else "arrival_vs_own_time"
+    assert set(c) == EXPECTED | {first}
+    if name == "hexapod-sync-move":
+        assert c["arrival_spread"].value == 0.0
+    else:
+        assert result.metrics["arrival_spread_s"] > 0.5  # async struts really end apart
+    # The run covered the move and the settling time.
+    assert result.sim_time_s >= setup.trajectory.duration + sim_hexapod.SETTLE_S - 1e-9
+    assert result.metrics["loop_closure_um"] < 0.3
+
+
+def test_wind_loads_the_camera_with_its_drag():
+    result, setup = run("hexapod-sync-move", elevation=45.0, wind=WIND_M_S)
+    wind = setup.disturbance
+    # Wind along world x, camera axis in the y-z plane: the camera shows D x L = 4.95 m^2
+    # (to 0.5 %: the move tilts it by ~0.1 deg, showing a sliver of its end).
+    area = 1.65 * 3.0
+    n = result.log.t.size - 1
+    u = wind.speed[:n]
+    np.testing.assert_allclose(wind.force[:n, 0], 0.5 * AIR_DENSITY * 1.0 * area * np.abs(u) * u, rtol=5e-3)
+    assert np.all(wind.force[:n, 1:] == 0)
+    # Over a 9 s run the slow turbulence shifts the mean by up to ~sigma (IEC: 1.8 m/s here).
+    assert abs(u.mean() - WIND_M_S) < 3 * 0.14 * (0.75 * WIND_M_S + 5.6)
+    assert u.std() > 0.05
+    calm, _ = run("hexapod-sync-move", elevation=45.0, wind=0.0)
+    assert checks(result)["following_error"].value > 3 * checks(calm)["following_error"].value
+
+
+def test_wind_series_variance_equals_the_spectrum_integral():
+    """Over one period 1/df the sum of cosines has exactly the variance sum S(f_k) df."""
+    df, f_max, mean = 1 / 600, 2.0, 8.0
+    t = np.arange(0, 1 / df, 1 / (4 * f_max))
+    u = wind_speed_series(t, mean, np.random.default_rng(3), f_max=f_max, df=df)
+    freqs = np.arange(1, int(f_max / df) + 1) * df
+    expected = np.sum(kaimal_spectrum(freqs, mean) * df)
+    assert u.mean() == pytest.approx(mean, abs=1e-9)
+    assert u.var() == pytest.approx(expected, rel=1e-9)
+    # IEC: sigma = I_ref (0.75 U + 5.6). Above f = 1/600 Hz a Kaimal spectrum holds the share
+    # (1 + 6 f L / U)^(-2/3) of it (the integral from f to infinity); the sum over k df, k >= 1,
+    # is a midpoint rule from df / 2 (steep there, so to a few per cent).
+    sigma = 0.14 * (0.75 * mean + 5.6)
+    share = (1 + 6 * (df / 2) * 340.2 / mean) ** (-2 / 3)
+    assert expected == pytest.approx(sigma**2 * share, rel=0.05)
+
+
+def test_same_seed_same_run_other_seed_other_wind():
+    a, _ = run("hexapod-sync-move", seed=4, wind=WIND_M_S)
+    b, _ = run("hexapod-sync-move", seed=4, wind=WIND_M_S)
+    c, _ = run("hexapod-sync-move", seed=5, wind=WIND_M_S)
+    np.testing.assert_array_equal(a.log.qpos, b.log.qpos)
+    np.testing.assert_array_equal(a.log.actuator_force, b.log.actuator_force)
+    assert not np.array_equal(a.log.qpos, c.log.qpos)
+
+
+def test_without_feedforward_or_integral_the_load_pulls_the_pose_off():
+    """The checks can fail: a plain PD drive sags under the 3 t camera (F / kp ~ 0.4 mm)."""
+    controller = sim_hexapod.HexapodController(feedforward=False, integral_time=None)
+    result, _ = run("hexapod-sync-move", controller=controller, elevation=15.0, wind=0.0)
+    c = checks(result)
+    assert not c["pose_error_final"].passed and c["pose_error_final"].value > 50
+    assert not c["following_error"].passed
+    # Integral action alone removes the sag by the end, the feed-forward avoids it throughout.
+    integral_only = sim_hexapod.HexapodController(feedforward=False)
+    result, _ = run("hexapod-sync-move", controller=integral_only, elevation=15.0, wind=0.0)
+    c2 = checks(result)
+    assert c2["pose_error_final"].passed and not c2["following_error"].passed
+
+
+class TimeScaled:
+    """A trajectory run ``factor`` times faster (a planner that ignores the strut limits)."""
+
+    def __init__(self, move, factor):
+        self.move, self.factor = move, factor
+        self.labels = move.labels
+        self.duration = move.duration / factor
+        self.target_pose = move.target_pose
+        self.profiles = move.profiles
+
+    def sample(self, t):
+        s = self.move.sample(np.asarray(t) * self.factor)
+        f = self.factor
+        return TrajectorySample(np.asarray(t, dtype=float).ravel(), s.position, f * s.velocity, f * f * s.acceleration)
+
+
+def test_limit_checks_fail_for_a_planner_that_breaks_them():
+    move = sim_hexapod.plan(True)
+    result, _ = run("hexapod-sync-move", trajectory=TimeScaled(move, 2.0), wind=0.0)
+    c = checks(result)
+    assert not c["strut_velocity"].passed and c["strut_velocity"].value == pytest.approx(2 * 499.84, rel=1e-3)
+    assert not c["strut_accel"].passed
+    # An asynchronous plan judged as a synchronous move fails the arrival check.
+    result, _ = run("hexapod-sync-move", trajectory=sim_hexapod.plan(False), wind=0.0)
+    assert not checks(result)["arrival_spread"].passed
+
+
+def test_pose_error_needs_the_settling_time():
+    result, setup = run("hexapod-sync-move", duration=3.0, wind=0.0)
+    c = checks(result)
+    assert np.isnan(c["pose_error_final"].value) and not c["pose_error_final"].passed
+
+
+@pytest.mark.parametrize("elevation", [14.9, 90.5, float("nan")])
+def test_elevation_outside_the_range_is_refused(elevation):
+    with pytest.raises(ValueError, match="elevation .* outside .*15, 90"):
+        scenarios.get("hexapod-sync-move").build(scenarios.RunOptions(elevation=elevation))
+
+
+def test_dm_control_environment_steps():
+    from sims.envs import hexapod_environment
+
+    env = hexapod_environment(elevation_deg=45.0)
+    step = env.reset()
+    assert set(step.observation) >= {"joint_positions", "reference_positions"}
+    for _ in range(5):
+        step = env.step(np.zeros(6))
+    assert 0.0 < step.reward <= 1.0
