@@ -103,12 +103,12 @@ def format_planning(rows: list[dict]) -> str:
 
 def format_table(rows: list[dict]) -> str:
     lines = [
-        f"{'scenario':<16} {'sim s':>7} {'wall s':>7} {'realtime x':>10} {'steps':>8} "
+        f"{'scenario':<18} {'sim s':>7} {'wall s':>7} {'realtime x':>10} {'steps':>8} "
         f"{'loop steps/s':>13} {'bare steps/s':>13} {'loop/bare':>9}"
     ]
     for r in rows:
         lines.append(
-            f"{r['scenario']:<16} {r['sim_time_s']:>7.2f} {r['wall_time_s']:>7.3f} "
+            f"{r['scenario']:<18} {r['sim_time_s']:>7.2f} {r['wall_time_s']:>7.3f} "
             f"{r['realtime_factor']:>10.1f} {r['physics_steps']:>8d} {r['loop_steps_per_s']:>13.0f} "
             f"{r['bare_steps_per_s']:>13.0f} {r['loop_ratio']:>9.2f}"
         )

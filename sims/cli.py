@@ -112,10 +112,11 @@ def cmd_list(args) -> int:
 
 def format_checks(rows) -> str:
     """One table of (scenario, check) rows."""
-    lines = [f"{'scenario':<16} {'check':<22} {'value':>12} {'limit':>10} {'unit':<6} result"]
+    width = max([len("scenario")] + [len(scenario) for scenario, _ in rows])
+    lines = [f"{'scenario':<{width}} {'check':<22} {'value':>12} {'limit':>10} {'unit':<6} result"]
     for scenario, c in rows:
         lines.append(
-            f"{scenario:<16} {c.name:<22} {c.value:>12.5g} {c.comparison:>2}{c.limit:>8.4g} "
+            f"{scenario:<{width}} {c.name:<22} {c.value:>12.5g} {c.comparison:>2}{c.limit:>8.4g} "
             f"{c.unit:<6} {'pass' if c.passed else 'FAIL'}"
         )
     return "\n".join(lines)
