@@ -354,7 +354,7 @@ def static_strut_forces(pose, wrench, geometry: HexapodGeometry = RUBIN_CAMERA) 
       wrench: (..., 6) force (N) and moment (N m) on the platform about the rotation pivot's
         current position (the moving frame's origin), in the hexapod frame.
 
-    Virtual work: J^T f = -W' in pose coordinates; written with the structure matrix of
+    Virtual work: J^T f = (F, E^T M) in pose coordinates (J = dL/dpose); written with the structure matrix of
     ``planners.legs`` (the same code FAST's cables use).
     """
     from planners.legs import leg_forces, structure_matrix
@@ -594,7 +594,7 @@ class StrutMove:
 
     def sample(self, t) -> TrajectorySample:
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        tau = t[:, None]
+        tau = np.maximum(t, 0.0)[:, None]  # at rest on the start before t = 0
         a = self.accel
         t1 = self.n_accel * self.dt
         t_end = self.n_ticks * self.dt
@@ -609,7 +609,7 @@ class StrutMove:
                                  0.5 * a * t1**2 + a * t1 * (tau - t1)))
         vel = np.where(accelerating, a * tau,
                        np.where(braking, a * (t_end - tau), np.where(done, 0.0, a * t1)))
-        acc = np.where(accelerating, a, np.where(braking, -a, 0.0))
+        acc = np.where(accelerating & (t[:, None] >= 0), a, np.where(braking, -a, 0.0))
         position = np.where(done, self.target, self.start + s * dist)
         return TrajectorySample(t, position, s * vel, s * acc)
 
@@ -667,8 +667,13 @@ def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = 
     """
     start = np.atleast_2d(np.asarray(start, dtype=float))
     target = np.atleast_2d(np.asarray(target, dtype=float))
-    if start.shape != target.shape or start.shape[-1] != 6:
+    if start.shape != target.shape or start.shape[-1] != 6 or start.ndim != 2:
         raise PlanningError(f"start {start.shape} and target {target.shape} must both be (N, 6)")
+    if pose_displacement is not None:
+        pose_displacement = np.atleast_2d(np.asarray(pose_displacement, dtype=float))
+        if pose_displacement.shape != start.shape:
+            raise PlanningError(f"pose displacement {pose_displacement.shape} must be "
+                                f"{start.shape}, one per move")
     for name, value in (("start", start), ("target", target)):
         if not np.all(np.isfinite(value)):
             raise PlanningError(f"{name} strut positions contain a non-finite value")
@@ -679,7 +684,7 @@ def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = 
     half = distance / 2.0
     t_hex = np.zeros(start.shape[0])
     if pose_displacement is not None:
-        t_hex = hexapod_space_min_time(np.atleast_2d(pose_displacement), limits)
+        t_hex = hexapod_space_min_time(pose_displacement, limits)
     t_strut = strut_min_time(half, limits)
     half_time = np.maximum(t_strut, t_hex[:, None])  # T_i,max
     if synchronous:
@@ -703,6 +708,13 @@ def plan_moves(start_pose, target_pose, synchronous: bool = True,
     """
     start_pose = np.atleast_2d(_as_poses(start_pose, "start pose"))
     target_pose = np.atleast_2d(_as_poses(target_pose, "target pose"))
+    if start_pose.ndim != 2 or target_pose.ndim != 2:
+        raise PlanningError(f"poses must be (6,) or (N, 6), got {start_pose.shape} and "
+                            f"{target_pose.shape}")
+    if start_pose.shape[0] != target_pose.shape[0] and 1 not in (start_pose.shape[0],
+                                                                 target_pose.shape[0]):
+        raise PlanningError(f"{start_pose.shape[0]} start poses and {target_pose.shape[0]} "
+                            "target poses: give one of each per move (or one start for all)")
     start_pose, target_pose = np.broadcast_arrays(start_pose, target_pose)
     check_pose_limits(start_pose, limits, "start")
     check_pose_limits(target_pose, limits, "target")

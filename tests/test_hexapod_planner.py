@@ -8,7 +8,8 @@ are half-move times, so a whole move of a strut takes 2 T.
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, strategies as st
+from hypothesis import assume, given
+from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from planners.errors import LimitError, PlanningError
@@ -335,6 +336,15 @@ def test_static_forces_general_wrench_balances():
         force, moment = _equilibrium_residual(pose, wrench, f)
         assert np.abs(force).max() < 1e-8 * np.abs(wrench).max()
         assert np.abs(moment).max() < 1e-8 * np.abs(wrench).max()
+        # In pose coordinates: J^T f = W' = (F, E^T M), E the Euler-rate matrix, written out
+        # here (columns e_x, Rx e_y, Rx Ry e_z). (The docstring of static_strut_forces says
+        # -W'; the sign there is wrong, see the report.)
+        rx, ry = pose[3], pose[4]
+        e = np.column_stack([[1, 0, 0], [0, np.cos(rx), np.sin(rx)],
+                             [np.sin(ry), -np.sin(rx) * np.cos(ry), np.cos(rx) * np.cos(ry)]])
+        expected = np.concatenate([wrench[:3], e.T @ wrench[3:]])
+        np.testing.assert_allclose(jacobian(pose).T @ f, expected, rtol=0,
+                                   atol=1e-9 * np.abs(wrench).max())
 
 
 def test_static_forces_virtual_work():
@@ -378,7 +388,7 @@ def test_structure_matrix_is_minus_jacobian_transpose():
         position = rng.normal(size=3) + np.array([0, 0, 2.0])
         rot0 = Rotation.random(random_state=rng.integers(1 << 31)).as_matrix()
 
-        def lengths(x):
+        def lengths(x, anchors=anchors, points=points, position=position, rot0=rot0):
             rot = Rotation.from_rotvec(x[3:]).as_matrix() @ rot0
             return np.linalg.norm(position + x[:3] + points @ rot.T - anchors, axis=1)
 
@@ -526,6 +536,26 @@ def planned(random_moves):
     return {sync: plan_moves(start, target, synchronous=sync) for sync in (True, False)}
 
 
+@pytest.fixture(scope="module")
+def small_moves():
+    """10 000 short moves (triangle profiles, a few hundred ticks): the regime where the tick
+    rounding matters (odd tick counts need an extra tick)."""
+    rng = np.random.default_rng(18)
+    start = my_random_poses(rng, 12_000)
+    target = np.clip(start + rng.uniform(LOW, HIGH, size=start.shape) * 10 ** rng.uniform(
+        -5, -2.5, size=(len(start), 1)), LOW, HIGH)
+    keep = in_stroke(target)
+    return start[keep][:10_000], target[keep][:10_000]
+
+
+@pytest.fixture(scope="module")
+def batches(planned, small_moves):
+    out = {("full", sync): moves for sync, moves in planned.items()}
+    for sync in (True, False):
+        out[("small", sync)] = plan_moves(*small_moves, synchronous=sync)
+    return out
+
+
 def test_durations_equal_independent_time_optimum(random_moves, planned):
     moves = planned[True]
     D = np.abs(moves.target - moves.start)
@@ -577,9 +607,10 @@ def test_hexapod_limit_sets_half_time(random_moves, planned):
 
 
 @pytest.mark.parametrize("sync", [True, False])
-def test_tick_counts(random_moves, planned, sync):
-    moves = planned[sync]
-    start, target = random_moves
+@pytest.mark.parametrize("kind", ["full", "small"])
+def test_tick_counts(random_moves, small_moves, batches, kind, sync):
+    moves = batches[kind, sync]
+    start, target = random_moves if kind == "full" else small_moves
     assert len(moves) == 10_000
     np.testing.assert_array_equal(moves.start_pose, start)
     np.testing.assert_array_equal(moves.target_pose, target)
@@ -600,8 +631,9 @@ def test_tick_counts(random_moves, planned, sync):
 
 
 @pytest.mark.parametrize("sync", [True, False])
-def test_tick_limits_over_batch(planned, sync):
-    moves = planned[sync]
+@pytest.mark.parametrize("kind", ["full", "small"])
+def test_tick_limits_over_batch(batches, kind, sync):
+    moves = batches[kind, sync]
     D = np.abs(moves.target - moves.start)
     assert np.all(moves.accel <= A_MAX) and np.all(moves.accel >= 0)
     assert np.all(moves.accel * moves.n_accel * DT <= V_MAX)
@@ -632,29 +664,36 @@ def _feasible(D, m):
 
 
 @pytest.mark.parametrize("sync", [True, False])
-def test_tick_counts_are_minimal_and_acceleration_least(planned, sync):
+@pytest.mark.parametrize("kind", ["full", "small"])
+def test_tick_counts_are_minimal_and_acceleration_least(batches, kind, sync):
     """n_ticks is ceil(2 T / dt) or, where rounding broke a limit, the fewest ticks that keep
     the limits; on its ticks each strut uses the longest acceleration phase (the least
     acceleration) that keeps its cruise speed <= v_max."""
-    moves = planned[sync]
+    moves = batches[kind, sync]
     D = np.abs(moves.target - moves.start)
     n = moves.n_ticks
     base = np.ceil(2 * moves.profiles.half_time / DT - 1e-9).astype(int)
     if sync:
         base = np.broadcast_to(base.max(axis=1, keepdims=True), base.shape)
     assert np.all(n >= np.where(D > 0, base, 0))
-    extra = np.argwhere(np.any(n > np.where(D > 0, base, 0), axis=1))[:, 0]
+    over = n > np.where(D > 0, base, 0)
+    extra = np.argwhere(over.any(axis=1))[:, 0]
+    if kind == "small":
+        assert len(extra) > 50  # the rounding case is exercised
     for k in extra[:300]:
-        moving = D[k] > 0
-        feasible_one_less = _feasible(D[k][moving], n[k][moving] - 1)
-        assert not feasible_one_less.all() if sync else not feasible_one_less.any()
+        if sync:  # one tick less breaks a limit for some strut
+            moving = D[k] > 0
+            assert not _feasible(D[k][moving], n[k][moving] - 1).all()
+        else:  # each strut with an extra tick could not do with one less
+            assert not _feasible(D[k][over[k]], n[k][over[k]] - 1).any()
     moving = D > 0
     k = moves.n_accel[moving]
     m = n[moving]
     d = D[moving]
     longer = k + 1
     # One more acceleration tick is impossible (beyond half) or would overshoot v_max.
-    assert np.all((longer > m // 2) | (d / ((m - longer) * DT) > V_MAX))
+    possible = longer <= m // 2
+    assert np.all(d[possible] / ((m[possible] - longer[possible]) * DT) > V_MAX)
 
 
 @pytest.mark.parametrize("sync", [True, False])
@@ -676,8 +715,9 @@ def test_odd_tick_count_short_move_takes_one_more_tick(sync, odd):
 
 
 @pytest.mark.parametrize("sync", [True, False])
-def test_tick_moves_integrate_and_sample(planned, sync):
-    moves = planned[sync]
+@pytest.mark.parametrize("kind", ["full", "small"])
+def test_tick_moves_integrate_and_sample(batches, kind, sync):
+    moves = batches[kind, sync]
     rng = np.random.default_rng(13 + sync)
     for k in rng.choice(len(moves), size=200, replace=False):
         move = moves.move(int(k))
@@ -743,6 +783,28 @@ def test_one_strut_moves(sync, strut, delta):
     s = move.sample(np.linspace(0, move.duration + 1, 777))
     assert np.all(s.position[:, others] == start[others])
     assert np.all(s.velocity[:, others] == 0)
+    check_single_move(move, start, target)
+
+
+@pytest.mark.parametrize("sync", [True, False])
+def test_idle_struts_with_hexapod_limit(sync):
+    """Struts that do not move stay still; asynchronous idle struts take no ticks even when a
+    pose displacement makes the hexapod-space half time longer than the moving struts' own."""
+    start = np.array([1e-3, -2e-3, 0, 3e-3, 0, 0])
+    target = start + np.array([0, 0, 2e-3, 0, 0, -1e-3])
+    displacement = np.array([0.01, 0, 0, 0, 0, 0])  # t'_min = 5 s, longer than the struts
+    moves = plan_strut_moves(start, target, pose_displacement=displacement, synchronous=sync)
+    move = moves.move(0)
+    assert float(moves.hexapod_half_time[0]) == pytest.approx(5.0, rel=1e-14)
+    moving = target != start
+    end = move.end_times
+    assert np.all(end[moving] >= 10.0 - 1e-9) and np.all(end[moving] < 10.0 + 2 * DT)
+    if sync:
+        assert np.all(move.n_ticks == move.n_ticks[0])
+    else:
+        assert np.all(move.n_ticks[~moving] == 0)
+    pos, vel = move.integrate()
+    assert np.all(pos[:, ~moving] == start[~moving]) and np.all(vel[:, ~moving] == 0)
     check_single_move(move, start, target)
 
 
@@ -896,18 +958,28 @@ def test_wrong_strut_shapes_raise(start, target):
         plan_strut_moves(start, target)
 
 
-@pytest.mark.xfail(strict=True, raises=ValueError,
-                   reason="bug: mismatched batch sizes leak numpy's broadcast ValueError")
 def test_mismatched_pose_batches_raise_planning_error():
     with pytest.raises(PlanningError):
         plan_moves(np.zeros((2, 6)), np.zeros((3, 6)))
 
 
-@pytest.mark.xfail(strict=True, raises=ValueError,
-                   reason="bug: (N, M, 6) poses pass the shape check and fail in numpy")
 def test_three_dimensional_pose_batch_raises_planning_error():
     with pytest.raises(PlanningError):
         plan_moves(np.zeros((2, 3, 6)), np.zeros((2, 3, 6)))
+
+
+def test_mismatched_pose_displacement_raises_planning_error():
+    with pytest.raises(PlanningError):
+        plan_strut_moves(np.zeros((2, 6)), np.full((2, 6), 1e-3),
+                         pose_displacement=np.zeros((3, 6)))
+
+
+def test_sample_before_start_holds_start():
+    """Like the B-spline planner, a move should hold its start at rest before t = 0."""
+    move = plan_move(np.zeros(6), np.array([1e-3, 0, 0, 0, 0, 0]))
+    s = move.sample(np.array([-1.0, -0.01]))
+    assert np.all(s.position == move.start) and np.all(s.velocity == 0)
+    assert np.all(s.acceleration == 0)
 
 
 def test_bad_geometry_raises():
