@@ -151,3 +151,20 @@ def test_dm_control_environment_steps():
     for _ in range(5):
         step = env.step(np.zeros(6))
     assert 0.0 < step.reward <= 1.0
+
+
+@pytest.mark.parametrize("start, n", [(0.0, 1715), (3.0, 500), (0.0, 12_001)])
+def test_wind_series_by_fft_equals_the_direct_sum(start, n):
+    """The inverse-FFT synthesis is the sum of cosines of REFERENCE.md, to rounding."""
+    dt, df, mean = 0.005, 1 / 50, 6.0
+    t = start + np.arange(n) * dt
+    fast = wind_speed_series(t, mean, np.random.default_rng(7), df=df)
+    rng = np.random.default_rng(7)
+    freqs = np.arange(1, int(np.floor(10.0 / df)) + 1) * df
+    amplitude = np.sqrt(2 * kaimal_spectrum(freqs, mean) * df)
+    phases = rng.uniform(0, 2 * np.pi, freqs.size)
+    direct = mean + np.cos(2 * np.pi * np.outer(t, freqs) + phases) @ amplitude
+    np.testing.assert_allclose(fast, direct, atol=1e-11)
+    jittered = t + np.r_[0.0, np.full(n - 1, 1e-4)]  # not a uniform grid: the direct sum
+    slow = wind_speed_series(jittered, mean, np.random.default_rng(7), df=df)
+    np.testing.assert_allclose(slow[0], direct[0], atol=1e-11)
