@@ -78,8 +78,14 @@ def loader_report(ts: dict, t: np.ndarray, checks, path) -> None:
     ax.plot(t, 1e3 * ts["clearance"])
     ax.axhline(0.0, color="r", lw=0.8)
     ax.set(title="clearance to breechblock, seat ring, floor", xlabel="t [s]", ylabel="mm")
-    ax.text(0.02, 0.97, checks_text(checks), transform=ax.transAxes, va="top", fontsize=7,
-            family="monospace", bbox=dict(facecolor="white", alpha=0.8))
+    _finish(fig, axes, ax, checks, path, top=True)
+
+
+def _finish(fig, axes, text_ax, checks, path, top: bool) -> None:
+    """Checks in a box on ``text_ax``, grids, layout, save at 90 dpi, close."""
+    text_ax.text(0.02, 0.97 if top else 0.03, checks_text(checks), transform=text_ax.transAxes,
+                 va="top" if top else "bottom", fontsize=7, family="monospace",
+                 bbox=dict(facecolor="white", alpha=0.8))
     for a in axes.flat:
         a.grid(alpha=0.3)
     fig.tight_layout()
@@ -119,10 +125,4 @@ def hexapod_report(ts: dict, t: np.ndarray, checks, path) -> None:
         twin.plot(t, np.linalg.norm(ts["wind_force"], axis=1), color="0.6", lw=0.6)
         twin.set_ylabel("wind drag [N]", color="0.4")
     ax.set(title="distance to the target pose", xlabel="t [s]", ylabel="um")
-    ax.text(0.02, 0.03, checks_text(checks), transform=ax.transAxes, va="bottom", fontsize=7,
-            family="monospace", bbox=dict(facecolor="white", alpha=0.8))
-    for a in axes.flat:
-        a.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _finish(fig, axes, ax, checks, path, top=False)
