@@ -46,7 +46,7 @@ from typing import Sequence
 import numpy as np
 
 from planners.errors import LimitError, PlanningError
-from planners.legs import leg_lengths, leg_vectors
+from planners.legs import leg_forces, leg_lengths, leg_vectors, structure_matrix
 from planners.trajectory import TrajectorySample
 
 POSE_LABELS = ("x", "y", "z", "rx", "ry", "rz")
@@ -357,8 +357,6 @@ def static_strut_forces(pose, wrench, geometry: HexapodGeometry = RUBIN_CAMERA) 
     Virtual work: J^T f = (F, E^T M) in pose coordinates (J = dL/dpose); written with the structure matrix of
     ``planners.legs`` (the same code FAST's cables use).
     """
-    from planners.legs import leg_forces, structure_matrix
-
     position, rotation = platform_frame(pose, geometry)
     structure = structure_matrix(geometry.base_pivots, geometry.platform_local, position, rotation)
     return leg_forces(structure, wrench)
@@ -507,9 +505,10 @@ def realize_on_ticks(distance, total_time, synchronous: bool, limits: HexapodLim
     D = np.asarray(distance, dtype=float)
     v, a_max = limits.strut_speed, limits.strut_accel
     n = np.ceil(np.asarray(total_time, dtype=float) / dt - 1e-9).astype(np.int64)
-    n = np.where(D > 0, n, 0 if not synchronous else n)
     if synchronous:
         n = np.broadcast_to(n.max(axis=-1, keepdims=True), D.shape).copy()
+    else:
+        n = np.where(D > 0, n, 0)
     moving = D > 0
     for _ in range(max_extra_ticks + 1):
         n_accel = np.minimum(n // 2, np.floor(n - D / (v * dt) + 1e-12).astype(np.int64))

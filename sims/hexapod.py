@@ -12,7 +12,9 @@ recompiled per elevation with the top end tilted (MjSpec), so gravity stays the 
 
 from __future__ import annotations
 
+import copy
 import functools
+import math
 
 import mujoco
 import numpy as np
@@ -21,11 +23,13 @@ from scipy.spatial.transform import Rotation
 
 import models
 from planners import hexapod as hexapod_planner
+from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
 from planners.trajectory import TrajectorySample
 from sims.checks import Check
+from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
-from sims.wind import BodyWindDrag, cylinder_projected_area
+from sims.wind import BodyWindDrag
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
 SETTLE_S = 1.0  # s simulated after the move: the integral action settles in ~0.5 s
@@ -54,6 +58,9 @@ INTEGRAL_TIME_S = 0.1  # integral action's time constant; the lowest mode is ~12
 #: The moves are millimetres on a 6 m assembly: the video shows the platform's motion (pose
 #: change from the start) magnified this many times, like a deformation plot.
 VIDEO_MAGNIFICATION = 100.0
+#: Default mean wind on the camera, m/s: an assumption for the air inside a dome with its
+#: wind screen up (a fraction of the 10-15 m/s outside at which telescopes still observe);
+#: the tests also run 10 m/s.
 DEFAULT_WIND_M_S = 5.0
 
 
@@ -71,9 +78,10 @@ def top_end_rotation(elevation_deg: float) -> np.ndarray:
 
 
 def check_elevation(elevation_deg: float) -> float:
+    """The elevation (deg) if the telescope can point there, else a LimitError (bad input)."""
     lo, hi = ELEVATION_RANGE_DEG
     if not np.isfinite(elevation_deg) or not lo <= elevation_deg <= hi:
-        raise ValueError(f"elevation {elevation_deg!r} deg is outside the telescope's range "
+        raise LimitError(f"elevation {elevation_deg!r} deg is outside the telescope's range "
                          f"[{lo:g}, {hi:g}] deg")
     return float(elevation_deg)
 
@@ -109,19 +117,21 @@ class HexapodPhysics(dm_mujoco.Physics):
     @classmethod
     def load(cls, elevation_deg: float = 90.0) -> "HexapodPhysics":
         elevation_deg = check_elevation(elevation_deg)
-        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy_model(_compiled(elevation_deg))))
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(_compiled(elevation_deg))))
         physics.elevation_deg = elevation_deg
         physics.reset(keyframe_id=0)
         return physics
 
     # ---- indices
     @functools.cached_property
-    def _slide_qpos(self) -> np.ndarray:
+    def strut_qpos(self) -> np.ndarray:
+        """qpos index of each strut's slide (the encoders)."""
         model = self.model.ptr
         return np.array([model.joint(n).qposadr[0] for n in STRUT_LABELS])
 
     @functools.cached_property
-    def _slide_dof(self) -> np.ndarray:
+    def strut_dofs(self) -> np.ndarray:
+        """dof index of each strut's slide."""
         model = self.model.ptr
         return np.array([model.joint(n).dofadr[0] for n in STRUT_LABELS])
 
@@ -149,17 +159,13 @@ class HexapodPhysics(dm_mujoco.Physics):
     def force_limit(self) -> np.ndarray:
         return self.model.ptr.actuator_forcerange[:6, 1].copy()
 
-    @property
-    def strut_dofs(self) -> np.ndarray:
-        return self._slide_dof
-
     # ---- state
     def strut_positions(self) -> np.ndarray:
         """Encoder readings: strut length changes from the zero pose, m."""
-        return self.data.qpos[self._slide_qpos].copy()
+        return self.data.qpos[self.strut_qpos].copy()
 
     def strut_velocities(self) -> np.ndarray:
-        return self.data.qvel[self._slide_dof].copy()
+        return self.data.qvel[self.strut_dofs].copy()
 
     def strut_drive_forces(self) -> np.ndarray:
         """Drive forces along each strut, N; positive pushes (compression)."""
@@ -224,9 +230,9 @@ class HexapodPhysics(dm_mujoco.Physics):
             a = np.arctan2(-u[1], u[2])
             data.qpos[model.joint(f"{name}_u1").qposadr[0]] = a
             data.qpos[model.joint(f"{name}_u2").qposadr[0]] = b
-            data.qpos[self._slide_qpos[i]] = length - model.body(f"{name}_rod").pos[2]
+            data.qpos[self.strut_qpos[i]] = length - model.body(f"{name}_rod").pos[2]
         data.qvel[:] = 0.0
-        data.act[:] = data.qpos[self._slide_qpos]
+        data.act[:] = data.qpos[self.strut_qpos]
         mujoco.mj_forward(model, data)
 
     def loop_closure_error(self) -> float:
@@ -240,7 +246,7 @@ def magnified_qpos(physics: HexapodPhysics, magnification: float):
     """Setup.video_qpos: states whose pose change from the first logged pose is magnified."""
 
     def frames(log: RunLog, ticks: np.ndarray) -> np.ndarray:
-        scratch = HexapodPhysics.from_model(dm_mujoco.wrapper.MjModel(copy_model(physics.model.ptr)))
+        scratch = HexapodPhysics.from_model(dm_mujoco.wrapper.MjModel(copy.copy(physics.model.ptr)))
         scratch.elevation_deg = physics.elevation_deg
         poses = physics.poses_from_qpos(log.qpos[ticks])
         start = physics.poses_from_qpos(log.qpos[0])[0]
@@ -253,28 +259,19 @@ def magnified_qpos(physics: HexapodPhysics, magnification: float):
     return frames
 
 
-def copy_model(model: mujoco.MjModel) -> mujoco.MjModel:
-    import copy
-
-    return copy.copy(model)
-
-
 # ----------------------------------------------------------------------------- control
 
 
-class HexapodController:
+class HexapodController(ServoFeedforwardController):
     """Strut servo: reference tracking with static-load feed-forward and integral action.
 
-    The drives (MJCF integrator actuators) apply kp (s - q) - kv qdot with s the set-point in
-    their activation; per tick this controller ramps s linearly (ctrl = set-point rate) to
-
-        s = q_ref + (f_ff + kv qdot_ref) / kp + z,   z <- z + dt / T_i (q_ref - q)
-
-    f_ff: the drive forces that hold the payload in static equilibrium at the reference pose
-    (``planners.hexapod.static_strut_forces`` of the payload's weight, plus each rod's weight
-    along its strut), what a real hexapod's gravity table supplies; z: integral action on the
-    encoder error for what the model leaves out (housings, wind, the constraint compliance),
-    limited so that kp z stays inside the force limit.
+    ``sims.controllers.ServoFeedforwardController`` (set-point interpolation, feed-forward in
+    the set-point, integral action on the encoder error) with its feed-forward replaced:
+    inverse dynamics does not apply to the closed loops, so f_ff is the set of drive forces
+    that hold the payload in static equilibrium at the reference pose, what a real hexapod's
+    gravity table supplies (``static_drive_forces``). The integral action takes what the
+    model leaves out (wind, the constraint compliance, the payload's tiny inertial forces).
+    Gains and force limits are read from the compiled model in ``reset``.
 
     Args:
       feedforward: include f_ff (False: PD + integral only).
@@ -282,12 +279,12 @@ class HexapodController:
     """
 
     def __init__(self, feedforward: bool = True, integral_time: float | None = INTEGRAL_TIME_S):
-        self.feedforward = feedforward
-        self.integral_time = integral_time
-        self.setpoints = None
-        self.reference = None
-        self.f_ff = None
-        self.z = None
+        super().__init__(None, None, None, feedforward, integral_time)
+
+    @property
+    def f_ff(self) -> np.ndarray:
+        """(n, 6) the static drive forces along the reference, N (push positive)."""
+        return self.tau_ff
 
     def static_drive_forces(self, physics: HexapodPhysics, strut_positions: np.ndarray) -> np.ndarray:
         """(n, 6) drive forces (N, push positive) that hold the reference poses statically.
@@ -325,32 +322,13 @@ class HexapodController:
         rod_weight = model.body_mass[rod] * (units @ gravity)
         return -tension - rod_weight
 
+    def feedforward_forces(self, physics, reference: TrajectorySample) -> np.ndarray:
+        return self.static_drive_forces(physics, reference.position)
+
     def reset(self, physics, reference: TrajectorySample, control_dt: float) -> None:
-        kp, kv = physics.kp, physics.kv
-        self._kp, self._limit = kp, physics.force_limit
-        self._qadr = physics._slide_qpos
-        n = reference.t.size
-        self.f_ff = (self.static_drive_forces(physics, reference.position) if self.feedforward
-                     else np.zeros((n, 6)))
-        self.reference = reference.position
-        self.setpoints = reference.position + (self.f_ff + kv * reference.velocity) / kp
-        self.z = np.zeros(6)
-        self._gain = 0.0 if self.integral_time is None else control_dt / self.integral_time
-        self._inv_dt = 1.0 / control_dt
-        physics.data.act[:6] = self.setpoints[0]
-
-    def __call__(self, tick: int, physics) -> None:
-        data = physics.data.ptr
-        error = self.reference[tick] - data.qpos[self._qadr]
-        z = self.z + self._gain * error
-        self.z = np.clip(z, -self._limit / self._kp, self._limit / self._kp)
-        target = self.setpoints[min(tick + 1, self.setpoints.shape[0] - 1)] + self.z
-        data.ctrl[:6] = (target - data.act[:6]) * self._inv_dt
-
-
-def demanded_drive_force(kp, kv, act, q, qd) -> np.ndarray:
-    """kp (s - q) - kv qdot before the force-range clamp, N."""
-    return kp * (act - q) - kv * qd
+        self.kp, self.kv, self.force_limit = physics.kp, physics.kv, physics.force_limit
+        self.dofs, self.qpos_adr = physics.strut_dofs, physics.strut_qpos
+        super().reset(physics, reference, control_dt)
 
 
 # ----------------------------------------------------------------------------- evaluation
@@ -376,7 +354,7 @@ class HexapodEvaluation:
 
     def _strut_log(self, log: RunLog):
         p = self.physics
-        return log.qpos[:, p._slide_qpos], log.qvel[:, p._slide_dof]
+        return log.qpos[:, p.strut_qpos], log.qvel[:, p.strut_dofs]
 
     def closure_mismatch(self, log: RunLog) -> np.ndarray:
         """(n,) largest |pivot-to-pivot length - (nominal + encoder)|, m: the compliance of
@@ -407,7 +385,7 @@ class HexapodEvaluation:
         window = log.t >= log.t[-1] - SETTLE_WINDOW_S - 1e-9
         target_pose = self.move.target_pose
         pose_err = self.pivot_errors_um(log, target_pose)
-        demanded = demanded_drive_force(p.kp, p.kv, log.act[:, :6], q, qd)
+        demanded = demanded_force(p.kp, p.kv, log.act[:, :6], q, qd)
         force = np.abs(demanded).max()
         stroke = np.abs(q).max()
         v_cmd = np.abs(ref.velocity).max()
@@ -473,7 +451,7 @@ class HexapodEvaluation:
             "strut_velocity_actual": qd,
             "setpoint": log.act[:, :6],
             "drive_force": log.actuator_force[:, :6],
-            "drive_force_demanded": demanded_drive_force(p.kp, p.kv, log.act[:, :6], q, qd),
+            "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, :6], q, qd),
             "drive_force_limit": p.force_limit,
             "pose_actual": p.poses_from_qpos(log.qpos),
             "target_pose": np.asarray(self.move.target_pose),
@@ -493,14 +471,21 @@ class HexapodEvaluation:
 # ----------------------------------------------------------------------------- scenarios
 
 
-def camera_area(physics: HexapodPhysics) -> float:
-    """Silhouette of the camera across the wind, m^2."""
-    model, data = physics.model.ptr, physics.data.ptr
-    geom = model.geom("camera_body")
-    radius, half = geom.size[0], geom.size[1]
-    axis = data.geom_xmat[geom.id].reshape(3, 3)[:, 2]
-    direction = np.array([np.cos(np.radians(WIND_AZIMUTH_DEG)), np.sin(np.radians(WIND_AZIMUTH_DEG)), 0.0])
-    return float(cylinder_projected_area(axis, direction, 2 * radius, 2 * half))
+def camera_area(physics: HexapodPhysics):
+    """(physics) -> silhouette of the camera across the wind, m^2; the geom is looked up once."""
+    geom = physics.model.ptr.geom("camera_body")
+    diameter, length, gid = 2 * geom.size[0], 2 * geom.size[1], geom.id
+    az = np.radians(WIND_AZIMUTH_DEG)
+    dx, dy = float(np.cos(az)), float(np.sin(az))
+    side, end = diameter * length, np.pi * diameter**2 / 4.0
+
+    def area(physics) -> float:
+        # cylinder_projected_area in scalars: the cylinder's z axis is column 2 of its xmat.
+        xmat = physics.data.ptr.geom_xmat[gid]
+        cos_t = min(abs(xmat[2] * dx + xmat[5] * dy), 1.0)
+        return side * math.sqrt(1.0 - cos_t * cos_t) + end * cos_t
+
+    return area
 
 
 def plan(synchronous: bool):
@@ -516,7 +501,7 @@ def _setup(synchronous: bool, options, controller=None) -> Setup:
     wind_speed = DEFAULT_WIND_M_S if options.wind is None else options.wind
     wind = None
     if wind_speed > 0:
-        wind = BodyWindDrag("camera", wind_speed, camera_area, CAMERA_DRAG_COEFFICIENT,
+        wind = BodyWindDrag("camera", wind_speed, camera_area(physics), CAMERA_DRAG_COEFFICIENT,
                             WIND_AZIMUTH_DEG)
     evaluation = HexapodEvaluation(physics, move, synchronous, wind)
     duration = options.duration if options.duration is not None else move.duration + SETTLE_S

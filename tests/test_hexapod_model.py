@@ -68,9 +68,7 @@ def test_planner_strut_lengths_equal_mujoco_lengths(seed, elevation):
     assert physics.loop_closure_error() < 1e-12
     np.testing.assert_allclose(physics.platform_pose(), pose, atol=1e-12)
     # The pose sensors (pivot in the hexapod frame) agree.
-    data = physics.data
-    np.testing.assert_allclose(physics.named.data.sensordata["platform_pos"] if False else
-                               data.sensordata[physics.model.ptr.sensor("platform_pos").adr[0]:][:3],
+    np.testing.assert_allclose(physics.named.data.sensordata["platform_pos"],
                                RUBIN_CAMERA.rotation_pivot + pose[:3], atol=1e-12)
 
 

@@ -59,6 +59,14 @@ def test_wind_loads_the_camera_with_its_drag():
     # Over a 9 s run the slow turbulence shifts the mean by up to ~sigma (IEC: 1.8 m/s here).
     assert abs(u.mean() - WIND_M_S) < 3 * 0.14 * (0.75 * WIND_M_S + 5.6)
     assert u.std() > 0.05
+    # The per-tick scalar drag equals drag_force with the camera's silhouette at that tick.
+    from sims.wind import cylinder_projected_area, drag_force
+
+    physics = setup.physics
+    axis = physics.data.geom_xmat[physics.model.ptr.geom("camera_body").id].reshape(3, 3)[:, 2]
+    last = n - 1
+    expected = drag_force(u[last], wind.direction, cylinder_projected_area(axis, wind.direction, 1.65, 3.0), 1.0)
+    np.testing.assert_allclose(wind.force[last], expected, rtol=2e-3)
     calm, _ = run("hexapod-sync-move", elevation=45.0, wind=0.0)
     assert checks(result)["following_error"].value > 3 * checks(calm)["following_error"].value
 
@@ -125,9 +133,12 @@ def test_limit_checks_fail_for_a_planner_that_breaks_them():
     c = checks(result)
     assert not c["strut_velocity"].passed and c["strut_velocity"].value == pytest.approx(2 * 499.84, rel=1e-3)
     assert not c["strut_accel"].passed
-    # An asynchronous plan judged as a synchronous move fails the arrival check.
+    # An asynchronous plan judged as a synchronous move fails the arrival check, and a
+    # synchronous one judged as asynchronous (struts wait for the slowest) fails its own.
     result, _ = run("hexapod-sync-move", trajectory=sim_hexapod.plan(False), wind=0.0)
     assert not checks(result)["arrival_spread"].passed
+    result, _ = run("hexapod-async-move", trajectory=sim_hexapod.plan(True), wind=0.0)
+    assert not checks(result)["arrival_vs_own_time"].passed
 
 
 def test_pose_error_needs_the_settling_time():
