@@ -1,0 +1,545 @@
+"""Ship-borne 4-axis satellite antenna: attitude chain, weighted pseudo-inverse and the
+constant-rotation-ratio (CRR) joint-position algorithm.
+
+Paper: Wu, Chen and Ding, "Joints position approach for satellite antenna attitude
+stabilization system based on constant rotation ratio" (``shared/papers/ship-antenna-crr-
+joint-position.txt``, "the paper" below). Errata and conventions: ``shared/REFERENCE.md``,
+"Ship antenna".
+
+Frames and conventions
+----------------------
+* Earth frame e: East-North-Up. Ship (carrier) frame b: X to starboard, Y to the bow, Z up.
+  Antenna frame a: Z_a the boresight (main lobe), Y_a the polarization direction.
+* ``satellite_attitude`` is eTs of eq. (1) *corrected*: its printed first row begins two
+  entries with cos E where cos A belongs (REFERENCE.md); corrected, eTs is orthonormal and
+  its third column is the boresight (cos El sin Az, cos El cos Az, sin El). It factors as
+  eTs = Rz(-Az) Rx(El) C0 Rz(sigma) with C0 = [[0,1,0],[0,0,1],[1,0,0]] (tested).
+* ``ship_attitude`` is bTe of eq. (1): passive rotations, roll gamma about Y, pitch phi
+  about X, heading psi about Z: bTe = Ry(gamma)^T Rx(phi)^T Rz(psi)^T. As printed, psi turns
+  the bow counter-clockwise (from north toward west).
+* N(t) = bTe eTs: the attitude the antenna frame must have in the ship frame (eq. 1).
+* The 4-axis pedestal (four orthogonal axes meeting at one point, the paper's Figure 1):
+  azimuth about the deck's Z, elevation about -X of the azimuth frame, cross-elevation about
+  Z of the elevation frame, polarization about the boresight:
+
+      f(Theta) = Rz(t1) Rx(-t2) Rz(t3) C0 Rz(t4)
+
+  This is the chain the paper's Theta0 = [136.51, -60, 0, -28.8] deg implies (t1 = -Az,
+  t2 = -El, t3 = 0, t4 = sigma; REFERENCE.md): f(Theta0) = N(0) at zero ship motion (tested).
+  models/antenna/antenna.xml builds the same chain.
+* Angular velocities are in the ship frame (N(t + dt) = Rot N(t), eq. 5 and 8, multiplies on
+  the left); the Jacobian's columns are the four joint axes in the ship frame.
+
+Equation (6) as printed divides the whole matrix, identity included, by dt; from its
+definition (a differential rotation Rot = I + [w]x dt, second order dropped) it reads
+[w]x dt = N(t + dt) N(t)^T - I. ``angular_velocity_eq6`` takes its antisymmetric part (the
+symmetric part is the dropped second-order term); ``angular_velocity_log`` is the exact
+constant-rate rotation, the matrix logarithm of N(t + dt) N(t)^T over dt.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from planners.errors import LimitError, PlanningError
+from planners.trajectory import TrajectorySample
+
+JOINT_LABELS = ("azimuth", "elevation", "cross_elevation", "polarization")
+#: The paper's weights, eq. (7): motion of axis 1 costs most, axis 4 least.
+PAPER_WEIGHTS = np.array([10.0, 5.0, 2.0, 1.0])
+#: The paper's section 5.1: satellite azimuth, elevation, polarization (deg) and Theta0 (deg).
+PAPER_SATELLITE_DEG = (223.49, 60.0, -28.8)
+PAPER_THETA0_DEG = np.array([136.51, -60.0, 0.0, -28.8])
+PAPER_DT = 0.01  # s, the simulation interval of section 5.1
+
+#: Antenna axes at zero joint angles, as columns in the elevation frame: x_a up, y_a to
+#: starboard, z_a (boresight) to the bow.
+C0 = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+
+_E3 = np.array([0.0, 0.0, 1.0])
+
+
+class SingularityError(PlanningError):
+    """The weighted Jacobian is singular and no damping was allowed."""
+
+
+# --------------------------------------------------------------------------------------
+# Rotations
+
+
+def _rotation(axis: int, angle) -> np.ndarray:
+    angle = np.asarray(angle, dtype=float)
+    c, s = np.cos(angle), np.sin(angle)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    m = np.zeros(angle.shape + (3, 3))
+    m[..., axis, axis] = 1.0
+    m[..., i, i] = c
+    m[..., j, j] = c
+    m[..., i, j] = -s
+    m[..., j, i] = s
+    return m
+
+
+def rot_x(angle) -> np.ndarray:
+    """Active rotation matrices about X, (..., 3, 3), for angles (...) in rad."""
+    return _rotation(0, angle)
+
+
+def rot_y(angle) -> np.ndarray:
+    """Active rotation matrices about Y, (..., 3, 3)."""
+    return _rotation(1, angle)
+
+
+def rot_z(angle) -> np.ndarray:
+    """Active rotation matrices about Z, (..., 3, 3)."""
+    return _rotation(2, angle)
+
+
+def skew(v) -> np.ndarray:
+    """[v]x, (..., 3, 3), such that [v]x u = v x u."""
+    v = np.asarray(v, dtype=float)
+    z = np.zeros(v.shape[:-1])
+    x, y, w = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([np.stack([z, -w, y], -1), np.stack([w, z, -x], -1),
+                     np.stack([-y, x, z], -1)], -2)
+
+
+def vee(m) -> np.ndarray:
+    """The vector of the antisymmetric part of m: vee((M - M^T) / 2), (..., 3)."""
+    m = np.asarray(m, dtype=float)
+    return 0.5 * np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0],
+                           m[..., 1, 0] - m[..., 0, 1]], -1)
+
+
+def rotation_log(r) -> np.ndarray:
+    """Rotation vector (axis x angle, rad) of rotation matrices r (..., 3, 3): the matrix log.
+
+    Valid for angles below pi - 1e-6 (the attitude steps of a 20-100 Hz update are far
+    smaller); equals scipy's ``Rotation.as_rotvec`` there (tested).
+    """
+    r = np.asarray(r, dtype=float)
+    cos_angle = np.clip((np.trace(r, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos_angle)
+    if np.any(angle > np.pi - 1e-6):
+        raise PlanningError(f"rotation of {np.degrees(angle.max()):.4f} deg is too close to 180 deg for its logarithm")
+    v = vee(r)  # axis * sin(angle)
+    small = angle < 1e-4
+    # angle / sin(angle), with its series where sin(angle) is tiny.
+    scale = np.where(small, 1.0 + angle**2 / 6.0 + 7.0 * angle**4 / 360.0,
+                     angle / np.where(small, 1.0, np.sin(angle)))
+    return v * scale[..., None]
+
+
+def frobenius_error(a, b) -> np.ndarray:
+    """||a - b||_F per matrix: the paper's measure of attitude error (section 5.1)."""
+    d = np.asarray(a) - np.asarray(b)
+    return np.sqrt(np.einsum("...ij,...ij->...", d, d))
+
+
+# --------------------------------------------------------------------------------------
+# The attitude chain (paper, eq. 1)
+
+
+def satellite_attitude(azimuth, elevation, polarization) -> np.ndarray:
+    """eTs of eq. (1), corrected (REFERENCE.md): the satellite frame in East-North-Up.
+
+    Args:
+      azimuth: rad, clockwise from north (the paper's A_e).
+      elevation: rad above the horizon (E_e).
+      polarization: rad (sigma_e).
+    Returns (..., 3, 3): columns X_s, Y_s (polarization), Z_s (the boresight toward the
+    satellite) in East-North-Up.
+    """
+    a, e, s = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (azimuth, elevation, polarization)))
+    ca, sa, ce, se, cs, ss = np.cos(a), np.sin(a), np.cos(e), np.sin(e), np.cos(s), np.sin(s)
+    return np.stack([
+        # Row 1: the printed CE_e of (1,1) and (1,2) corrected to CA_e.
+        np.stack([ca * ss - cs * sa * se, ca * cs + sa * se * ss, ce * sa], -1),
+        np.stack([-sa * ss - ca * cs * se, -cs * sa + ca * se * ss, ca * ce], -1),
+        np.stack([ce * cs, -ce * ss, se], -1),
+    ], -2)
+
+
+def ship_attitude(heading, pitch, roll) -> np.ndarray:
+    """bTe of eq. (1): Earth (ENU) coordinates to ship coordinates, (..., 3, 3).
+
+    bTe = Ry(roll)^T Rx(pitch)^T Rz(heading)^T (the printed passive matrices); its transpose
+    eTb = Rz(heading) Rx(pitch) Ry(roll) is the ship's attitude in the Earth frame.
+    """
+    return np.swapaxes(rot_z(heading) @ rot_x(pitch) @ rot_y(roll), -1, -2)
+
+
+def desired_attitude(heading, pitch, roll, azimuth, elevation, polarization) -> np.ndarray:
+    """N(t) = bTe eTs (eq. 1): the antenna attitude to hold, in the ship frame, (..., 3, 3)."""
+    return ship_attitude(heading, pitch, roll) @ satellite_attitude(azimuth, elevation, polarization)
+
+
+def forward_kinematics(theta) -> np.ndarray:
+    """f(Theta) of eq. (2): the antenna frame in the ship frame, (..., 3, 3).
+
+    f = Rz(t1) Rx(-t2) Rz(t3) C0 Rz(t4) for joint angles theta (..., 4) in rad, written out
+    (a Z-X-Z product; C0 permutes its columns; Rz(t4) mixes the first two); tested against
+    the product of the rotation matrices.
+    """
+    theta = np.asarray(theta, dtype=float)
+    if theta.shape == (4,):  # one pose: plain floats are 10x faster than 0-d arrays
+        c = [math.cos(v) for v in theta.tolist()]
+        s = [math.sin(v) for v in theta.tolist()]
+    else:
+        c = np.moveaxis(np.cos(theta), -1, 0)
+        s = np.moveaxis(np.sin(theta), -1, 0)
+    c1, c2, c3, c4 = c
+    s1, s2, s3, s4 = s
+    m2 = (-s1 * s2, c1 * s2, c2)  # column 2 of M = Rz(t1) Rx(-t2) Rz(t3)
+    if theta.shape == (4,):
+        m0 = (c1 * c3 - s1 * c2 * s3, s1 * c3 + c1 * c2 * s3, -s2 * s3)
+        m1 = (-c1 * s3 - s1 * c2 * c3, -s1 * s3 + c1 * c2 * c3, -s2 * c3)
+        return np.array([[c4 * m2[r] + s4 * m0[r], -s4 * m2[r] + c4 * m0[r], m1[r]]
+                         for r in range(3)])
+    m = np.empty(theta.shape[:-1] + (3, 3))
+    # M = Rz(t1) Rx(-t2) Rz(t3); A = M C0 has columns (M_2, M_0, M_1).
+    m0 = (c1 * c3 - s1 * c2 * s3, s1 * c3 + c1 * c2 * s3, -s2 * s3)  # M column 0
+    m1 = (-c1 * s3 - s1 * c2 * c3, -s1 * s3 + c1 * c2 * c3, -s2 * c3)  # M column 1
+    for row in range(3):
+        m[..., row, 0] = c4 * m2[row] + s4 * m0[row]
+        m[..., row, 1] = -s4 * m2[row] + c4 * m0[row]
+        m[..., row, 2] = m1[row]
+    return m
+
+
+def jacobian(theta) -> np.ndarray:
+    """J(Theta) of eq. (4), (..., 3, 4): the four joint axes in the ship frame.
+
+    The antenna's angular velocity in the ship frame is J(Theta) dTheta/dt.
+    """
+    theta = np.asarray(theta, dtype=float)
+    if theta.shape == (4,):
+        c1, s1 = math.cos(theta[0]), math.sin(theta[0])
+        c2, s2 = math.cos(theta[1]), math.sin(theta[1])
+        a4 = forward_kinematics(theta)[:, 2]
+        return np.array([[0.0, -c1, -s1 * s2, a4[0]], [0.0, -s1, c1 * s2, a4[1]],
+                         [1.0, 0.0, c2, a4[2]]])
+    t1, t2 = theta[..., 0], theta[..., 1]
+    c1, s1, c2, s2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
+    zero, one = np.zeros_like(c1), np.ones_like(c1)
+    a1 = np.stack([zero, zero, one], -1)
+    a2 = np.stack([-c1, -s1, zero], -1)  # Rz(t1) (-X)
+    a3 = np.stack([-s1 * s2, c1 * s2, c2], -1)  # Rz(t1) Rx(-t2) Z
+    a4 = forward_kinematics(theta)[..., :, 2]  # the boresight
+    return np.stack([a1, a2, a3, a4], -1)
+
+
+def joint_angles_at_rest(azimuth, elevation, polarization) -> np.ndarray:
+    """Theta with f(Theta) = eTs on a level ship at heading 0: (-Az, -El, 0, sigma) (eq. 15).
+
+    Azimuth is wrapped to (-180, 180] deg, so the paper's Az 223.49 deg gives 136.51 deg.
+    """
+    t1 = np.angle(np.exp(-1j * np.asarray(azimuth, dtype=float)))
+    return np.stack(np.broadcast_arrays(t1, -np.asarray(elevation, dtype=float), 0.0 * t1,
+                                        np.asarray(polarization, dtype=float)), -1)
+
+
+# --------------------------------------------------------------------------------------
+# Angular velocity (eq. 6) and the weighted pseudo-inverse (eq. 7)
+
+
+def angular_velocity_eq6(n_now, n_next, dt: float) -> np.ndarray:
+    """Angular velocity (rad/s, ship frame) between two attitudes by eq. (6).
+
+    From its definition: [w]x dt = N(t + dt) N(t)^T - I to first order; the antisymmetric
+    part is read (the printed equation divides the identity by dt too: an erratum).
+    """
+    return vee(np.asarray(n_next) @ np.swapaxes(n_now, -1, -2)) / dt
+
+
+def angular_velocity_log(n_now, n_next, dt: float) -> np.ndarray:
+    """The constant angular velocity (rad/s, ship frame) that turns N(t) into N(t + dt)."""
+    return rotation_log(np.asarray(n_next) @ np.swapaxes(n_now, -1, -2)) / dt
+
+
+def weighted_pseudo_inverse(jac, weights=PAPER_WEIGHTS, damping: float = 0.0) -> np.ndarray:
+    """W^-1 J^T (J W^-1 J^T + damping^2 I)^-1, (..., 4, 3) (eq. 7; damped when damping > 0).
+
+    ``weights`` are the diagonal of W: the solution minimizes sum_i w_i thetadot_i^2 among
+    the joint rates that give the angular velocity. Raises SingularityError when
+    J W^-1 J^T is singular and damping is 0.
+    """
+    jac = np.asarray(jac, dtype=float)
+    w_inv = 1.0 / np.asarray(weights, dtype=float)
+    jw = jac * w_inv[..., None, :]
+    gram = jw @ np.swapaxes(jac, -1, -2) + damping**2 * np.eye(3)
+    try:
+        return np.swapaxes(jw, -1, -2) @ np.linalg.inv(gram)
+    except np.linalg.LinAlgError:
+        raise SingularityError("J W^-1 J^T is singular: the four axes span less than 3 dimensions") from None
+
+
+def weighted_singular_value(jac, weights=PAPER_WEIGHTS) -> np.ndarray:
+    """Smallest singular value of J W^-1/2 (rad/s of antenna per unit weighted joint rate)."""
+    jac = np.asarray(jac, dtype=float)
+    return np.linalg.svd(jac / np.sqrt(np.asarray(weights, dtype=float)), compute_uv=False)[..., -1]
+
+
+@dataclass(frozen=True)
+class AntennaLimits:
+    """What the joint-rate solution must respect.
+
+    Attributes:
+      rate: (4,) joint rate limits, rad/s.
+      singular_threshold: below this smallest singular value of J W^-1/2 the solution is
+        damped (Nakamura and Hanafusa's variable damping), rad/s per weighted rad/s.
+      max_damping: damping at an exact singularity (same units).
+    """
+
+    rate: np.ndarray = field(default_factory=lambda: np.full(4, np.inf))
+    singular_threshold: float = 0.05
+    max_damping: float = 0.05
+
+
+def _damping(jac, weights, limits: AntennaLimits) -> float:
+    sigma = float(weighted_singular_value(jac, weights))
+    if sigma >= limits.singular_threshold:
+        return 0.0
+    return limits.max_damping * np.sqrt(1.0 - (sigma / limits.singular_threshold) ** 2)
+
+
+def joint_rates(theta, omega, weights=PAPER_WEIGHTS, limits: AntennaLimits | None = None):
+    """Joint rates for an antenna angular velocity (eq. 7/9), with the safeguards.
+
+    Without ``limits``: exactly eq. (7). With ``limits``: damped near a singularity, and
+    limit-aware: a joint whose rate would exceed its limit gets its weight raised by
+    (rate / limit)^2 and the rates are solved again (up to 4 times; the other axes take the
+    motion over), then, if still over, all rates are scaled down together (the direction is
+    kept; the attitude then lags and the next updates catch up).
+    Returns (rates (4,), damped: bool, rate_limited: bool).
+    """
+    jac = jacobian(theta)
+    if limits is None:
+        return weighted_pseudo_inverse(jac, weights) @ omega, False, False
+    damping = _damping(jac, weights, limits)
+    w = np.asarray(weights, dtype=float)
+    rates = weighted_pseudo_inverse(jac, w, damping) @ omega
+    limited = False
+    for _ in range(4):
+        ratio = np.abs(rates) / limits.rate
+        if ratio.max() <= 1.0:
+            break
+        limited = True
+        w = w * np.maximum(ratio, 1.0) ** 2
+        rates = weighted_pseudo_inverse(jac, w, damping) @ omega
+    ratio = (np.abs(rates) / limits.rate).max()
+    if ratio > 1.0:
+        limited = True
+        rates = rates / ratio
+    return rates, damping > 0.0, limited
+
+
+# --------------------------------------------------------------------------------------
+# Joint positions: the baseline (section 5.2), CRR (section 4.2) and full correction
+
+
+@dataclass
+class StepInfo:
+    """What one joint-position update did (for summaries and plots)."""
+
+    error_fro: float = 0.0  # ||f(Theta_{n+1}) - N(t_{n+1})||_F
+    iterations: int = 0  # Newton iterations
+    damped: bool = False
+    rate_limited: bool = False
+
+
+def _angular_velocity(n_now, n_next, dt, method):
+    if method == "eq6":
+        return angular_velocity_eq6(n_now, n_next, dt)
+    if method == "log":
+        return angular_velocity_log(n_now, n_next, dt)
+    raise PlanningError(f"angular velocity method {method!r} is not 'eq6' or 'log'")
+
+
+def pinv_integration_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS,
+                          omega_method: str = "eq6"):
+    """The paper's baseline (section 5.2): Theta_{n+1} = Theta_n + Thetadot_n dt, eq. (6)-(7).
+
+    Open-loop integration of the joint rates; its attitude error accumulates (Figure 4).
+    Returns (Theta_{n+1}, StepInfo).
+    """
+    omega = _angular_velocity(n_now, n_next, dt, omega_method)
+    rates, _, _ = joint_rates(theta, omega, weights)
+    new = theta + rates * dt
+    return new, StepInfo(float(frobenius_error(forward_kinematics(new), n_next)))
+
+
+def crr_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
+             limits: AntennaLimits | None = None, omega_method: str = "eq6",
+             full_correction: bool = False, tol: float = 1e-15, max_iter: int = 20):
+    """One update of the constant-rotation-ratio algorithm (section 4.2, steps 3-7).
+
+    Step 3: the average angular velocity over the update, eq. (6) (``omega_method="log"``:
+    the exact one). Step 4: joint rates by the weighted pseudo-inverse, eq. (9). Step 5: RK4
+    (eq. 11) of dTheta/dt = W^-1 J(Theta)^T (J W^-1 J^T)^-1 w over dt gives the average joint
+    velocity K. Step 6: its direction k = K / |K| is the constant rotation ratio (eq. 12-14):
+    DeltaTheta = k xi dt. Step 7: Newton's method for the base speed xi (starting at |K|) on
+    f(Theta_n + k xi dt) = N(t_{n+1}) (eq. 10), in the least-squares sense: one scalar xi
+    cannot match three rotation components exactly, so Gauss-Newton drives the rotation
+    residual log(N f^T) orthogonal to J k; it stops when the xi step moves the joints less
+    than ``tol`` rad.
+
+    ``full_correction``: then Newton steps on the whole attitude with the weighted
+    minimum-norm inverse, Theta += W^-1 J^T (J W^-1 J^T)^-1 log(N f^T), to machine precision.
+    ``limits``: damping near singularities and rate limits (see ``joint_rates``); the
+    increment is also capped at the rate limits.
+    Returns (Theta_{n+1} (4,), StepInfo).
+    """
+    theta = np.asarray(theta, dtype=float)
+    omega = _angular_velocity(n_now, n_next, dt, omega_method)
+    info = StepInfo()
+
+    def rate(th):
+        r, damped, limited = joint_rates(th, omega, weights, limits)
+        info.damped |= damped
+        info.rate_limited |= limited
+        return r
+
+    k1 = rate(theta)
+    k2 = rate(theta + 0.5 * dt * k1)
+    k3 = rate(theta + 0.5 * dt * k2)
+    k4 = rate(theta + dt * k3)
+    average = (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0  # eq. (11)
+    speed = float(np.linalg.norm(average))
+    new = theta
+    if speed > 0.0:
+        ratio = average / speed  # k of eq. (12)-(14)
+        xi = speed
+        for iteration in range(1, max_iter + 1):
+            new = theta + ratio * (xi * dt)
+            residual = rotation_log(n_next @ forward_kinematics(new).T)
+            slope = jacobian(new) @ ratio * dt  # d(rotation)/d(xi)
+            step = float(slope @ residual / (slope @ slope))
+            xi += step
+            info.iterations = iteration
+            if abs(step) * dt < tol:
+                break
+        if limits is not None:
+            cap = float(np.min(limits.rate / np.maximum(np.abs(ratio), 1e-300)))
+            if abs(xi) > cap:
+                xi = np.sign(xi) * cap
+                info.rate_limited = True
+        new = theta + ratio * (xi * dt)
+    if full_correction:
+        w_corr = np.asarray(weights, dtype=float)
+        for _ in range(max_iter):
+            residual = rotation_log(n_next @ forward_kinematics(new).T)
+            if np.abs(residual).max() < 1e-15:
+                break
+            jac = jacobian(new)
+            damping = 0.0 if limits is None else _damping(jac, w_corr, limits)
+            new = new + weighted_pseudo_inverse(jac, w_corr, damping) @ residual
+            info.iterations += 1
+    info.error_fro = float(frobenius_error(forward_kinematics(new), n_next))
+    return new, info
+
+
+METHODS = ("pinv", "crr", "crr-full")
+
+
+@dataclass
+class JointPath:
+    """Joint positions for an attitude sequence, with per-update diagnostics.
+
+    Attributes:
+      t: (n,) times, s.
+      theta: (n, 4) joint angles, rad; row 0 is the start.
+      error_fro: (n,) ||f(Theta_n) - N(t_n)||_F (the paper's Figures 4 and 7).
+      iterations: (n,) Newton iterations per update (0 for the start and for "pinv").
+      damped, rate_limited: (n,) bool, the safeguards of ``joint_rates`` were active.
+      method: "pinv", "crr" or "crr-full".
+    """
+
+    t: np.ndarray
+    theta: np.ndarray
+    error_fro: np.ndarray
+    iterations: np.ndarray
+    damped: np.ndarray
+    rate_limited: np.ndarray
+    method: str
+
+    def rates(self) -> np.ndarray:
+        """(n - 1, 4) average joint rates between updates, rad/s (the paper's Figure 8)."""
+        return np.diff(self.theta, axis=0) / np.diff(self.t)[:, None]
+
+
+def solve_joint_path(attitudes, dt: float, theta0, method: str = "crr",
+                     weights=PAPER_WEIGHTS, limits: AntennaLimits | None = None,
+                     omega_method: str = "eq6", t0: float = 0.0) -> JointPath:
+    """Joint angles that hold the attitudes N(t0 + n dt) (n, 3, 3), from Theta0.
+
+    method: "pinv" (the paper's baseline, section 5.2), "crr" (section 4.2) or "crr-full"
+    (CRR then a full weighted Newton correction).
+    """
+    if method not in METHODS:
+        raise PlanningError(f"joint-position method {method!r} is not one of {', '.join(METHODS)}")
+    attitudes = np.asarray(attitudes, dtype=float)
+    if attitudes.ndim != 3 or attitudes.shape[1:] != (3, 3):
+        raise PlanningError(f"attitudes must have shape (n, 3, 3), not {attitudes.shape}")
+    if not np.isfinite(attitudes).all():
+        raise PlanningError("attitudes contain NaN or inf")
+    if not np.isfinite(dt) or dt <= 0:
+        raise PlanningError(f"update interval dt = {dt!r} s must be > 0")
+    theta0 = np.asarray(theta0, dtype=float)
+    if theta0.shape != (4,) or not np.isfinite(theta0).all():
+        raise PlanningError(f"Theta0 must be 4 finite angles, not {theta0!r}")
+    n = attitudes.shape[0]
+    theta = np.empty((n, 4))
+    theta[0] = theta0
+    error = np.empty(n)
+    error[0] = frobenius_error(forward_kinematics(theta0), attitudes[0])
+    iterations = np.zeros(n, dtype=int)
+    damped = np.zeros(n, dtype=bool)
+    limited = np.zeros(n, dtype=bool)
+    for i in range(n - 1):
+        if method == "pinv":
+            theta[i + 1], info = pinv_integration_step(theta[i], attitudes[i], attitudes[i + 1],
+                                                       dt, weights, omega_method)
+        else:
+            theta[i + 1], info = crr_step(theta[i], attitudes[i], attitudes[i + 1], dt, weights,
+                                          limits=limits, omega_method=omega_method,
+                                          full_correction=method == "crr-full")
+        error[i + 1] = info.error_fro
+        iterations[i + 1] = info.iterations
+        damped[i + 1] = info.damped
+        limited[i + 1] = info.rate_limited
+    return JointPath(t0 + dt * np.arange(n), theta, error, iterations, damped, limited, method)
+
+
+class JointPathTrajectory:
+    """A JointPath as a Trajectory: a C2 cubic spline through the joint angles (scipy)."""
+
+    labels: Sequence[str] = JOINT_LABELS
+
+    def __init__(self, path: JointPath):
+        self.path = path
+        self._spline = CubicSpline(path.t, path.theta, axis=0)
+
+    @property
+    def duration(self) -> float:
+        return float(self.path.t[-1] - self.path.t[0])
+
+    def sample(self, t) -> TrajectorySample:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        s = self._spline
+        return TrajectorySample(t, s(t), s(t, 1), s(t, 2))
+
+
+def check_rates(rates, limits: AntennaLimits, where: str = "") -> None:
+    """Raise LimitError naming the joint whose rate (rad/s, (n, 4)) breaks its limit."""
+    rates = np.atleast_2d(rates)
+    peak = np.abs(rates).max(axis=0)
+    for name, value, limit in zip(JOINT_LABELS, peak, limits.rate):
+        if value > limit:
+            raise LimitError(f"{name} rate {np.degrees(value):.2f} deg/s is beyond its limit "
+                             f"{np.degrees(limit):.2f} deg/s{where}")
