@@ -301,11 +301,28 @@ class AntennaLimits:
     max_damping: float = 0.05
 
 
-def _damping(jac, weights, limits: AntennaLimits) -> float:
-    sigma = float(weighted_singular_value(jac, weights))
-    if sigma >= limits.singular_threshold:
+def _damping(gram: np.ndarray, limits: AntennaLimits) -> float:
+    """Variable damping from the smallest eigenvalue of J W^-1 J^T (= sigma_min^2).
+
+    The eigenvalues are only computed when the cheap bound lambda_min >= 4 det / trace^2
+    (lambda_mid lambda_max <= (trace / 2)^2) cannot rule the singularity out.
+    """
+    threshold2 = limits.singular_threshold**2
+    trace = gram[0, 0] + gram[1, 1] + gram[2, 2]
+    if 4.0 * np.linalg.det(gram) >= threshold2 * trace * trace:
         return 0.0
-    return limits.max_damping * np.sqrt(1.0 - (sigma / limits.singular_threshold) ** 2)
+    sigma2 = max(float(np.linalg.eigvalsh(gram)[0]), 0.0)
+    if sigma2 >= threshold2:
+        return 0.0
+    return limits.max_damping * math.sqrt(1.0 - sigma2 / threshold2)
+
+
+def _solve_rates(jac, w_inv, omega, damping: float = 0.0):
+    """W^-1 J^T (J W^-1 J^T + damping^2 I)^-1 omega for one pose, and the undamped gram."""
+    jw = jac * w_inv
+    gram = jw @ jac.T
+    system = gram + damping * damping * np.eye(3) if damping else gram
+    return jw.T @ np.linalg.solve(system, omega), gram
 
 
 def joint_rates(theta, omega, weights=PAPER_WEIGHTS, limits: AntennaLimits | None = None):
@@ -319,19 +336,26 @@ def joint_rates(theta, omega, weights=PAPER_WEIGHTS, limits: AntennaLimits | Non
     Returns (rates (4,), damped: bool, rate_limited: bool).
     """
     jac = jacobian(theta)
+    w_inv = 1.0 / np.asarray(weights, dtype=float)
+    try:
+        rates, gram = _solve_rates(jac, w_inv, omega)
+    except np.linalg.LinAlgError:
+        if limits is None:
+            raise SingularityError("J W^-1 J^T is singular: the four axes span less than 3 dimensions") from None
+        rates, gram = None, (jac * w_inv) @ jac.T
     if limits is None:
-        return weighted_pseudo_inverse(jac, weights) @ omega, False, False
-    damping = _damping(jac, weights, limits)
-    w = np.asarray(weights, dtype=float)
-    rates = weighted_pseudo_inverse(jac, w, damping) @ omega
+        return rates, False, False
+    damping = _damping(gram, limits)
+    if damping:
+        rates = _solve_rates(jac, w_inv, omega, damping)[0]
     limited = False
     for _ in range(4):
         ratio = np.abs(rates) / limits.rate
         if ratio.max() <= 1.0:
             break
         limited = True
-        w = w * np.maximum(ratio, 1.0) ** 2
-        rates = weighted_pseudo_inverse(jac, w, damping) @ omega
+        w_inv = w_inv / np.maximum(ratio, 1.0) ** 2
+        rates = _solve_rates(jac, w_inv, omega, damping)[0]
     ratio = (np.abs(rates) / limits.rate).max()
     if ratio > 1.0:
         limited = True
@@ -437,8 +461,8 @@ def crr_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
             if np.abs(residual).max() < 1e-15:
                 break
             jac = jacobian(new)
-            damping = 0.0 if limits is None else _damping(jac, w_corr, limits)
-            new = new + weighted_pseudo_inverse(jac, w_corr, damping) @ residual
+            damping = 0.0 if limits is None else _damping((jac / w_corr) @ jac.T, limits)
+            new = new + _solve_rates(jac, 1.0 / w_corr, residual, damping)[0]
             info.iterations += 1
     info.error_fro = float(frobenius_error(forward_kinematics(new), n_next))
     return new, info
