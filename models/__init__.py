@@ -1,9 +1,9 @@
 """planbench's MJCF models, one Menagerie-style folder per mechanism.
 
 ``load(name)`` compiles ``models/<name>/scene.xml`` into a ``mujoco.MjModel``. The specs
-(``loader_spec()``...) read dimensions and limits from the same MJCF with ElementTree, so
-the planners (pure numpy) and MuJoCo share one source of truth for every number; tests compare
-the planners' kinematics with MuJoCo's at random poses.
+(``loader_spec()``, ``antenna_spec()``) read dimensions and limits from the same MJCF with
+ElementTree, so the planners (pure numpy) and MuJoCo share one source of truth for every
+number; tests compare the planners' kinematics with MuJoCo's at random poses.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 MODELS_DIR = Path(__file__).resolve().parent
-MECHANISMS = ("loader", "hexapod")
+MECHANISMS = ("loader", "hexapod", "antenna")
 
 
 def model_dir(name: str) -> Path:
@@ -100,7 +100,8 @@ class SerialChainSpec:
     """A serial chain read from an MJCF: joints in order from the base, and named sites.
 
     ``sites`` maps a site name to (body name, (3,) position in that body's frame, m).
-    ``base_pos``/``base_quat`` place the parent of the chain's first body in the world.
+    ``base_pos``/``base_quat`` place the parent of the chain's first body in the frame named
+    ``frame``: the world, or a moving body above the chain (the antenna's deck).
     """
 
     joints: tuple[JointSpec, ...]
@@ -108,6 +109,7 @@ class SerialChainSpec:
     sites: dict
     base_pos: np.ndarray
     base_quat: np.ndarray
+    frame: str = "world"
 
     @property
     def names(self) -> list[str]:
@@ -123,22 +125,63 @@ class SerialChainSpec:
     kv = _JointColumn()
 
 
-def _serial_chain(xml_path: Path, root_body: str) -> SerialChainSpec:
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of two (w, x, y, z) quaternions."""
+    aw, av = a[0], a[1:]
+    bw, bv = b[0], b[1:]
+    return np.concatenate([[aw * bw - av @ bv], aw * bv + bw * av + np.cross(av, bv)])
+
+
+def _quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate the vector v by the unit quaternion q (w, x, y, z)."""
+    w, u = q[0], q[1:]
+    return v + 2.0 * np.cross(u, np.cross(u, v) + w * v)
+
+
+def _fixed_pose(parents: dict, base, frame: str) -> tuple[np.ndarray, np.ndarray]:
+    """Pose of the body ``base`` in the frame of its ancestor body ``frame``.
+
+    Every body from ``base`` up to (not including) ``frame`` must be welded (no joint).
+    """
+    path = []
+    node = base
+    while node.get("name") != frame:
+        if node.tag != "body":
+            raise ValueError(f"body {frame!r} is not an ancestor of {base.get('name')!r}")
+        if node.findall("joint") or node.findall("freejoint"):
+            raise ValueError(f"body {node.get('name')!r} between {frame!r} and the chain moves")
+        path.append(node)
+        node = parents[node]
+    pos, quat = np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
+    for node in reversed(path):
+        pos = pos + _quat_rotate(quat, _floats(node.get("pos"), (0.0, 0.0, 0.0)))
+        q = _floats(node.get("quat"), (1.0, 0.0, 0.0, 0.0))
+        quat = _quat_mul(quat, q / np.linalg.norm(q))
+    return pos, quat
+
+
+def _serial_chain(xml_path: Path, root_body: str, frame: str | None = None) -> SerialChainSpec:
     """Read the serial chain below ``root_body`` (inclusive) of an MJCF.
 
     The model files of planbench give every position, quaternion, axis and range explicitly
     on the element (no inherited pos/axis), which is what this reader relies on; the spec
-    test compares it with the compiled model.
+    test compares it with the compiled model. Without ``frame`` the chain's parent must be a
+    child of the worldbody and ``base_pos``/``base_quat`` are its pose in the world; with
+    ``frame`` (a body name) they are the parent's pose in that body's frame, composed over
+    the welded bodies between them.
     """
     root = ET.parse(xml_path).getroot()
     actuators = {a.get("joint"): a for a in root.iter("general")}
     parents = {child: parent for parent in root.iter() for child in parent}
     body = next(b for b in root.iter("body") if b.get("name") == root_body)
     base = parents[body]
-    if base.tag == "body" and parents[base].tag != "worldbody":
-        raise ValueError(f"the parent of {root_body!r} must be a child of the worldbody")
-    base_pos = _floats(base.get("pos"), (0.0, 0.0, 0.0))
-    base_quat = _floats(base.get("quat"), (1.0, 0.0, 0.0, 0.0))
+    if frame is None:
+        if base.tag == "body" and parents[base].tag != "worldbody":
+            raise ValueError(f"the parent of {root_body!r} must be a child of the worldbody")
+        base_pos = _floats(base.get("pos"), (0.0, 0.0, 0.0))
+        base_quat = _floats(base.get("quat"), (1.0, 0.0, 0.0, 0.0))
+    else:
+        base_pos, base_quat = _fixed_pose(parents, base, frame)
     joints, bodies, sites = [], [], {}
     node = body
     while node is not None:
@@ -182,7 +225,8 @@ def _serial_chain(xml_path: Path, root_body: str) -> SerialChainSpec:
             raise ValueError(f"body {child.get('name')!r} has more than one joint")
         node = child
     return SerialChainSpec(
-        joints=tuple(joints), bodies=tuple(bodies), sites=sites, base_pos=base_pos, base_quat=base_quat
+        joints=tuple(joints), bodies=tuple(bodies), sites=sites, base_pos=base_pos, base_quat=base_quat,
+        frame=frame or "world",
     )
 
 
@@ -194,3 +238,17 @@ def loader_spec() -> SerialChainSpec:
     wrist_yaw, wrist_roll). The chain starts at the body ``carriage``, child of ``base``.
     """
     return _serial_chain(model_dir("loader") / "loader.xml", "carriage")
+
+
+@functools.cache
+def antenna_spec() -> SerialChainSpec:
+    """The ship antenna's 4-axis chain, limits and servo gains, from models/antenna/antenna.xml.
+
+    Joint order is the paper's theta1 ... theta4: azimuth (about the deck's Z), elevation
+    (about -X), cross_elevation (about Z of the elevation frame), polarization (about the
+    boresight); f(Theta) = Rz(t1) Rx(-t2) Rz(t3) C0 Rz(t4). The chain starts at the body
+    ``azimuth``; ``base_pos``/``base_quat`` place its parent, the pedestal on the mast top, in
+    the ``deck`` frame (``frame == "deck"``). Azimuth and polarization are unlimited
+    (lower/upper = -inf/inf); the site ``dish`` is the antenna frame at the axes' intersection.
+    """
+    return _serial_chain(model_dir("antenna") / "antenna.xml", "azimuth", frame="deck")

@@ -1,7 +1,8 @@
 """The ``planbench`` command line (ARCHITECTURE.md, "Contracts").
 
   planbench list
-  planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--elevation DEG] [--duration S]
+  planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--elevation DEG]
+                [--hs M] [--tp S] [--heading DEG] [--duration S]
                 [--video FILE] [--camera overview|closeup] [--quiet]
   planbench plan NAME --out DIR
   planbench bench
@@ -69,6 +70,12 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--wind", type=_finite("wind speed", 0.0), help="mean wind, m/s")
     run.add_argument("--elevation", type=_finite("elevation"),
                      help="telescope elevation, deg (hexapod scenarios: 15 ... 90)")
+    run.add_argument("--hs", type=_finite("significant wave height", 0.0, strict=True),
+                     help="significant wave height, m (sea-state scenarios)")
+    run.add_argument("--tp", type=_finite("peak period", 0.0, strict=True),
+                     help="spectral peak period, s (sea-state scenarios)")
+    run.add_argument("--heading", type=_finite("wave heading"),
+                     help="wave heading off the bow, deg: 180 head seas, 90 beam seas from starboard (sea-state scenarios)")
     run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
     run.add_argument("--video", type=Path, help="write an H.264 video of the run here")
     run.add_argument("--camera", default=None, help="video camera: overview or closeup")
@@ -90,8 +97,11 @@ def _options(scenario, args):
         raise BadInput(f"scenario {scenario.name} has no wind model; --wind is not accepted")
     if args.elevation is not None and "elevation" not in scenario.options:
         raise BadInput(f"scenario {scenario.name} has no elevation; --elevation is not accepted")
+    for option in ("hs", "tp", "heading"):
+        if getattr(args, option) is not None and option not in scenario.options:
+            raise BadInput(f"scenario {scenario.name} has no sea state; --{option} is not accepted")
     return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
-                      elevation=args.elevation)
+                      elevation=args.elevation, hs=args.hs, tp=args.tp, heading=args.heading)
 
 
 def cmd_list(args) -> int:
@@ -157,6 +167,8 @@ def cmd_bench(args) -> int:
     print(bench.format_table(bench.run_all()))
     print()
     print(bench.format_planning(bench.planning_throughput()))
+    print()
+    print(bench.format_antenna(bench.antenna_update_rate()))
     return EXIT_OK
 
 

@@ -126,3 +126,38 @@ def hexapod_report(ts: dict, t: np.ndarray, checks, path) -> None:
         twin.set_ylabel("wind drag [N]", color="0.4")
     ax.set(title="distance to the target pose", xlabel="t [s]", ylabel="um")
     _finish(fig, axes, ax, checks, path, top=False)
+
+
+def antenna_report(ts: dict, t: np.ndarray, checks, path, pointing_limit_deg: float) -> None:
+    """report.png of an antenna run: ship motion, joints, pointing errors, drive loads."""
+    names = [str(n) for n in ts["joint_names"]]
+    fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
+    ax = axes[0, 0]
+    for key in ("ship_heading", "ship_pitch", "ship_roll"):
+        ax.plot(t, np.rad2deg(ts[key]), label=key.removeprefix("ship_"))
+    ax.set(title="ship motion (deck joints)", xlabel="t [s]", ylabel="deg")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    for j, name in enumerate(names):
+        line, = ax.plot(t, np.rad2deg(ts["theta_actual"][:, j]), label=name)
+        ax.plot(t, np.rad2deg(ts["theta_planned"][:, j]), "--", color=line.get_color(), lw=0.8)
+    ax.set(title="joint angles (solid: simulated, dashed: planned for the true motion)",
+           xlabel="t [s]", ylabel="deg")
+    ax.legend(fontsize=8)
+    ax = axes[1, 0]
+    ratio_t = np.abs(ts["torque_demanded"]) / ts["torque_limit"]
+    ratio_v = np.abs(ts["theta_rate"]) / ts["rate_limit"]
+    for j, name in enumerate(names):
+        line, = ax.plot(t, ratio_t[:, j], lw=0.8, label=f"{name} torque")
+        ax.plot(t, ratio_v[:, j], ":", color=line.get_color(), lw=0.8)
+    ax.axhline(1.0, color="r", lw=0.8)
+    ax.set(title="|torque| / limit (solid), |rate| / rated speed (dotted)", xlabel="t [s]",
+           ylabel="ratio")
+    ax.legend(fontsize=8)
+    ax = axes[1, 1]
+    ax.plot(t, ts["pointing_error_deg"], lw=0.8, label="pointing")
+    ax.plot(t, np.abs(ts["polarization_error_deg"]), lw=0.8, label="|polarization|")
+    ax.axhline(pointing_limit_deg, color="r", lw=0.8)
+    ax.set(title="pointing and polarization error", xlabel="t [s]", ylabel="deg")
+    ax.legend(fontsize=8, loc="upper right")
+    _finish(fig, axes, ax, checks, path, top=True)

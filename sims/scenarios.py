@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
-from sims import hexapod, loader
+from sims import antenna, hexapod, loader
 
 
 @dataclass(frozen=True)
@@ -17,12 +17,17 @@ class RunOptions:
       duration: simulated time in s, None for the scenario's default.
       wind: mean wind speed in m/s, None for the scenario's default (wind scenarios only).
       elevation: telescope elevation in deg, None for the default (hexapod scenarios).
+      hs, tp, heading: significant wave height (m), peak period (s) and wave heading off the
+        bow (deg, 180 head seas), None for the defaults (sea-state scenarios).
     """
 
     seed: int = 0
     duration: float | None = None
     wind: float | None = None
     elevation: float | None = None
+    hs: float | None = None
+    tp: float | None = None
+    heading: float | None = None
 
 
 @dataclass(frozen=True)
@@ -83,6 +88,21 @@ SCENARIOS: dict[str, Scenario] = {
             lambda: hexapod.plan(False),
             options=frozenset({"wind", "elevation"}),
             kinds=hexapod.strut_kinds,
+        ),
+        Scenario(
+            "antenna-paper-motion",
+            "ship antenna, 4 axes: the paper's extreme ship motion (pitch 40 deg/8 s, roll 45 deg/10 s, 1 deg/s turn), IMU at 50 Hz, CRR planner, 60 s",
+            antenna.build_paper_motion,
+            antenna.plan_paper_motion,
+            kinds=antenna.joint_kinds,
+        ),
+        Scenario(
+            "antenna-sea-state",
+            "ship antenna, 4 axes: JONSWAP sea Hs 5 m, Tp 10 s, waves 135 deg off the bow, holding a GEO satellite at 15 W from 40 N 20 W, 300 s (--hs, --tp, --heading)",
+            antenna.build_sea_state,
+            antenna.plan_sea_state,
+            options=frozenset({"hs", "tp", "heading"}),
+            kinds=antenna.joint_kinds,
         ),
     )
 }

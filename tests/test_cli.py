@@ -27,7 +27,8 @@ def test_list_names_every_scenario():
     proc = planbench("list")
     assert proc.returncode == 0
     names = [line.split()[0] for line in proc.stdout.splitlines()]
-    assert names == ["loader-supply", "loader-direct", "hexapod-sync-move", "hexapod-async-move"]
+    assert names == ["loader-supply", "loader-direct", "hexapod-sync-move", "hexapod-async-move",
+                     "antenna-paper-motion", "antenna-sea-state"]
 
 
 def test_run_writes_summary_timeseries_report_and_video(tmp_path):
@@ -162,3 +163,42 @@ def test_hexapod_plan(tmp_path):
     plan = np.load(tmp_path / "p" / "plan.npz")
     assert list(plan["labels"]) == [f"strut{i}" for i in range(1, 7)]
     assert np.abs(plan["velocity"]).max() <= 500e-6 and np.abs(plan["acceleration"]).max() <= 500e-6
+
+
+def test_antenna_sea_state_run_with_sea_options(tmp_path):
+    out = tmp_path / "sea"
+    proc = planbench("run", "antenna-sea-state", "--hs", "3", "--tp", "8", "--heading", "90",
+                     "--duration", "4", "--out", out, "--video", out / "sea.mp4", "--quiet")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert "Hs 3 m, Tp 8 s" in summary["metrics"]["ship_motion"]
+    assert "90 deg off the bow" in summary["metrics"]["ship_motion"]
+    assert {c["name"] for c in summary["checks"]} >= {
+        "pointing_error_max", "pointing_error_rms", "polarization_error_max",
+        "attitude_error_fro_max", "joint_rate", "joint_torque"}
+    ts = np.load(out / "timeseries.npz")
+    n = ts["t"].size
+    assert ts["theta_actual"].shape == ts["theta_planned"].shape == (n, 4)
+    assert ts["pointing_error_deg"].shape == (n,) and ts["update_t"].size == 199  # targets 0.04 ... 4.00 s
+    assert imageio_ffmpeg.count_frames_and_secs(str(out / "sea.mp4"))[0] == 4 * 30 + 1
+
+
+@pytest.mark.parametrize("args, words", [
+    (("antenna-sea-state", "--hs", "-2"), ("significant wave height -2", "> 0")),
+    (("antenna-sea-state", "--tp", "nan"), ("peak period nan", "not finite")),
+    (("antenna-paper-motion", "--hs", "4"), ("no sea state", "--hs")),
+    (("hexapod-sync-move", "--heading", "90"), ("no sea state", "--heading")),
+    (("antenna-sea-state", "--wind", "5"), ("no wind model",)),
+])
+def test_antenna_bad_options_exit_2(tmp_path, args, words):
+    assert_one_line_error(planbench("run", *args, "--out", tmp_path / "x"), *words)
+    assert not (tmp_path / "x").exists()
+
+
+def test_antenna_plan(tmp_path):
+    proc = planbench("plan", "antenna-paper-motion", "--out", tmp_path / "p")
+    assert proc.returncode == 0, proc.stderr
+    plan = np.load(tmp_path / "p" / "plan.npz")
+    assert list(plan["labels"]) == ["azimuth", "elevation", "cross_elevation", "polarization"]
+    assert plan["t"][-1] == pytest.approx(60.0)
+    np.testing.assert_allclose(np.degrees(plan["position"][0]), [136.51, -60.0, 0.0, -28.8], atol=1e-9)

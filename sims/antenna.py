@@ -1,0 +1,679 @@
+"""The ship-borne 4-axis satellite antenna in MuJoCo: ship motion, the IMU-driven planner
+controller, checks and scenarios.
+
+Scenarios:
+  antenna-paper-motion  the paper's section 5.1: satellite at Az 223.49, El 60, pol -28.8 deg,
+                        ship motion of eq. (15)-(16) (pitch 40 deg / 8 s, roll 45 deg / 10 s,
+                        1 deg/s turn), 60 s
+  antenna-sea-state     a ship at 40 N 20 W holding a geostationary satellite at 15 W in a
+                        JONSWAP sea (Hs 5 m, Tp 10 s, waves 135 deg off the bow; ``--hs``,
+                        ``--tp``, ``--heading``), 300 s
+
+The ship's motion drives the deck through stiff servo drives with inverse-dynamics
+feed-forward (``ShipMotionDrive``, the sea: not part of the controller), so the antenna feels
+the real base accelerations. The controller (``AntennaController``) sees only what a real one
+sees: the IMU on the pedestal base (orientation and gyro), sampled at 20-50 Hz with noise and
+latency. Per IMU sample it predicts the deck attitude to the end of the next update interval
+from the gyro (rate and its change), forms N = bTe eTs (paper, eq. 1), runs one planner update
+(CRR, paper section 4.2) and ramps the servo set-points to the new joint angles, with the
+servo's velocity feed-forward.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+
+import models
+from planners import antenna as ant
+from planners.errors import LimitError, PlanningError
+from planners.geostationary import look_angles
+from planners.trajectory import TrajectorySample
+from sims.checks import Check
+from sims.controllers import ServoFeedforwardController, demanded_force
+from sims.runner import RunLog, Setup
+from sims.ship_motion import PaperShipMotion, SeaStateMotion, world_from_ship
+
+CONTROL_DT = 0.005  # s: the runner's tick; the IMU rate is a whole number of ticks
+DECK_JOINTS = ("heave", "yaw", "pitch", "roll")
+JOINTS = ant.JOINT_LABELS
+
+#: The IMU (REFERENCE.md and the paper, section 4.1: attitude updates 20-50 times a second).
+#: Noise and latency are assumptions for a marine MEMS/FOG attitude and heading reference
+#: (datasheets give 0.01-0.05 deg RMS dynamic attitude accuracy; a few to tens of ms from
+#: sampling to the controller). The attitude an AHRS outputs is a filtered estimate: its
+#: error wanders slowly (a first-order Gauss-Markov process here), it is not white per
+#: sample; the gyro's rate noise is white.
+IMU_RATE_HZ = 50.0
+IMU_LATENCY_S = 0.020
+IMU_ATTITUDE_NOISE_DEG = 0.02  # 1 sigma per axis of the attitude error
+IMU_ATTITUDE_NOISE_TIME_S = 1.0  # correlation time of the attitude error
+IMU_GYRO_NOISE_DEG_S = 0.02  # 1 sigma per axis, white per sample
+
+#: Check limits (REFERENCE.md, "Ship antenna"; FCC ESV: transmit off within 100 ms above
+#: 0.5 deg; industry 0.2 deg peak, ~0.1 deg RMS; polarization within 1 deg).
+POINTING_MAX_SEA_DEG = 0.2
+POINTING_MAX_PAPER_DEG = 0.5
+POINTING_RMS_DEG = 0.1
+POLARIZATION_MAX_DEG = 1.0
+ATTITUDE_FRO_LIMIT = 1e-6
+
+#: Scenario defaults.
+PAPER_DURATION_S = 60.0
+SEA_DURATION_S = 300.0
+SEA_HS_M = 5.0
+SEA_TP_S = 10.0
+SEA_HEADING_DEG = 135.0  # waves 45 deg off the starboard bow: both roll and pitch
+SHIP_LAT_DEG, SHIP_LON_DEG = 40.0, -20.0  # North Atlantic
+SATELLITE_LON_DEG = -15.0  # a geostationary slot at 15 deg W
+
+
+# ----------------------------------------------------------------------------- physics
+
+
+class AntennaPhysics(dm_mujoco.Physics):
+    """dm_control Physics of models/antenna/scene.xml with named accessors."""
+
+    @classmethod
+    def load(cls) -> "AntennaPhysics":
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(models.load("antenna")))
+        physics.reset(keyframe_id=0)
+        return physics
+
+    def _ids(self, names, kind):
+        model = self.model.ptr
+        return np.array([getattr(model, kind)(n).id for n in names])
+
+    @property
+    def deck_qpos(self) -> np.ndarray:
+        return self.model.ptr.jnt_qposadr[self._ids(DECK_JOINTS, "joint")]
+
+    @property
+    def deck_dofs(self) -> np.ndarray:
+        return self.model.ptr.jnt_dofadr[self._ids(DECK_JOINTS, "joint")]
+
+    @property
+    def antenna_qpos(self) -> np.ndarray:
+        return self.model.ptr.jnt_qposadr[self._ids(JOINTS, "joint")]
+
+    @property
+    def antenna_dofs(self) -> np.ndarray:
+        return self.model.ptr.jnt_dofadr[self._ids(JOINTS, "joint")]
+
+    @property
+    def antenna_actuators(self) -> np.ndarray:
+        return self._ids(JOINTS, "actuator")
+
+    def _actuator_param(self, names, field, column):
+        ids = self._ids(names, "actuator")
+        return np.array(getattr(self.model.ptr, field)[ids, column])
+
+    def drive_gains(self, names=JOINTS):
+        """(kp, kv) of the named drives: kp (setpoint - q) - kv qdot."""
+        return (self._actuator_param(names, "actuator_gainprm", 0),
+                -self._actuator_param(names, "actuator_biasprm", 2))
+
+    def torque_limit(self, names=JOINTS) -> np.ndarray:
+        return self._actuator_param(names, "actuator_forcerange", 1)
+
+    def rate_limit(self, names=JOINTS) -> np.ndarray:
+        """Rated speeds, rad/s: the drives' set-point rate range."""
+        return self._actuator_param(names, "actuator_ctrlrange", 1)
+
+    def sensor(self, name: str) -> np.ndarray:
+        model = self.model.ptr
+        s = model.sensor(name)
+        return self.data.ptr.sensordata[s.adr[0]: s.adr[0] + s.dim[0]]
+
+    def sensor_slice(self, name: str) -> slice:
+        s = self.model.ptr.sensor(name)
+        return slice(int(s.adr[0]), int(s.adr[0] + s.dim[0]))
+
+    def dish_rotation(self, qpos) -> np.ndarray:
+        """(n, 3, 3) world-from-antenna rotations of logged qpos rows: eTb(deck) f(Theta)."""
+        qpos = np.atleast_2d(qpos)
+        deck = qpos[:, self.deck_qpos]
+        return world_from_ship(deck[:, 1], deck[:, 2], deck[:, 3]) @ ant.forward_kinematics(
+            qpos[:, self.antenna_qpos])
+
+    def set_state(self, deck_position, deck_velocity, theta, theta_rate) -> None:
+        """Put the deck and the antenna at a state (SI) and the antenna set-points with it."""
+        data = self.data.ptr
+        data.qpos[self.deck_qpos] = deck_position
+        data.qvel[self.deck_dofs] = deck_velocity
+        data.qpos[self.antenna_qpos] = theta
+        data.qvel[self.antenna_dofs] = theta_rate
+        kp, kv = self.drive_gains()
+        data.act[self.antenna_actuators] = theta + kv / kp * theta_rate
+        mujoco.mj_forward(self.model.ptr, data)
+
+
+# ----------------------------------------------------------------------------- the sea
+
+
+class ShipMotionTrajectory:
+    """A ship motion (sims.ship_motion) as a Trajectory of the deck joints."""
+
+    labels = DECK_JOINTS
+
+    def __init__(self, motion, duration: float):
+        self.motion = motion
+        self._duration = float(duration)
+
+    @property
+    def duration(self) -> float:
+        return self._duration
+
+    def sample(self, t) -> TrajectorySample:
+        state = self.motion.sample(np.atleast_1d(np.asarray(t, dtype=float)))
+        return TrajectorySample(state.t, *state.joint_arrays())
+
+
+class ShipMotionDrive:
+    """The disturbance: the deck follows the ship motion through its stiff drives.
+
+    A servo controller with the model's inverse dynamics as feed-forward, so the deck tracks
+    the prescribed motion to a few thousandths of a degree whatever the antenna does.
+    """
+
+    def __init__(self, physics: AntennaPhysics, motion):
+        kp, kv = physics.drive_gains(DECK_JOINTS)
+        self.motion = motion
+        self.servo = ServoFeedforwardController(kp, kv, physics.deck_dofs, joint_qpos=physics.deck_qpos)
+        self.reference = None
+
+    def reset(self, physics, times, rng) -> None:
+        self.reference = ShipMotionTrajectory(self.motion, times[-1]).sample(times)
+        self.servo.reset(physics, self.reference, times[1] - times[0] if times.size > 1 else CONTROL_DT)
+
+    def __call__(self, tick: int, physics) -> None:
+        self.servo(tick, physics)
+
+    def tracking_error(self, log: RunLog) -> np.ndarray:
+        """(4,) largest |deck joint - ship motion| over the run (m, rad)."""
+        n = log.t.size
+        deck = log.qpos[:, self.servo.qpos_adr]
+        return np.abs(deck - self.reference.position[:n]).max(axis=0)
+
+
+# ----------------------------------------------------------------------------- controller
+
+
+@dataclass(frozen=True)
+class ImuModel:
+    """The attitude sensor as the controller sees it.
+
+    Attributes:
+      rate_hz: samples per second (the paper: 20-50).
+      latency_s: time from sampling to the controller, s (a whole number of control ticks).
+      attitude_noise_deg: standard deviation per axis of the orientation error, deg.
+      attitude_noise_time_s: its correlation time, s (first-order Gauss-Markov:
+        e_k+1 = e_k exp(-h / T) + sigma sqrt(1 - exp(-2 h / T)) n_k); 0 for white noise.
+      gyro_noise_deg_s: white noise per axis on the angular rate, deg/s (1 sigma).
+    """
+
+    rate_hz: float = IMU_RATE_HZ
+    latency_s: float = IMU_LATENCY_S
+    attitude_noise_deg: float = IMU_ATTITUDE_NOISE_DEG
+    attitude_noise_time_s: float = IMU_ATTITUDE_NOISE_TIME_S
+    gyro_noise_deg_s: float = IMU_GYRO_NOISE_DEG_S
+
+    def ticks(self, control_dt: float) -> tuple[int, int]:
+        """(ticks per sample, latency in ticks); raises PlanningError if not whole numbers."""
+        if not np.isfinite(self.rate_hz) or self.rate_hz <= 0:
+            raise PlanningError(f"IMU rate {self.rate_hz!r} Hz must be > 0")
+        period = 1.0 / (self.rate_hz * control_dt)
+        latency = self.latency_s / control_dt
+        if abs(period - round(period)) > 1e-9 or round(period) < 1:
+            raise PlanningError(f"IMU rate {self.rate_hz:g} Hz is not the control rate "
+                                f"{1 / control_dt:g} Hz divided by a whole number")
+        if self.latency_s < 0 or abs(latency - round(latency)) > 1e-9:
+            raise PlanningError(f"IMU latency {self.latency_s:g} s is not a whole number of "
+                                f"{control_dt * 1e3:g} ms control ticks >= 0")
+        return int(round(period)), int(round(latency))
+
+
+class AntennaController:
+    """Reads the IMU, runs the joint-position planner per sample, drives the antenna servos.
+
+    Per control tick: every ``n`` ticks (the IMU period) the IMU is sampled with noise; a
+    sample reaches the controller ``latency`` ticks later. On each arrival the deck attitude
+    is predicted to the next arrival (``predict``: from the gyro rate and its change over the
+    last sample, R(t) = R_m exp([w tau + a tau^2 / 2]x); without: the last sample is used as
+    is), N = R^T eTs (eq. 1) and one planner step gives the joint angles for that time. The
+    set-points ramp to them linearly, plus kv/kp times the joint rates that hold the attitude
+    against the (predicted) gyro rate, ramped between updates (the servo's velocity
+    feed-forward), so the drive force is a PD on the error to the ramp.
+
+    Args:
+      satellite: eTs, (3, 3), the satellite frame in East-North-Up.
+      imu: ImuModel.
+      method: "crr" or "crr-full" (planners.antenna).
+      predict: False to use each IMU sample as it is (its age becomes lag).
+      limits: planners.antenna.AntennaLimits for the rate-aware solution (None: the model's).
+      omega_method: the angular velocity of CRR's step 3: "log" (exact) or "eq6" (the paper's
+        first-order reading); at the IMU's 20 ms the first-order one leaves ~1e-7 of
+        attitude error per update under the paper's motion, the exact one ~1e-11.
+      seed: seed of the IMU noise.
+    """
+
+    def __init__(self, satellite: np.ndarray, imu: ImuModel = ImuModel(), method: str = "crr",
+                 predict: bool = True, limits: ant.AntennaLimits | None = None,
+                 weights=ant.PAPER_WEIGHTS, omega_method: str = "log", seed: int = 0):
+        if method not in ("crr", "crr-full"):
+            raise PlanningError(f"controller method {method!r} is not 'crr' or 'crr-full'")
+        self.satellite = np.asarray(satellite, dtype=float)
+        self.imu = imu
+        self.method = method
+        self.predict = predict
+        self.limits = limits
+        self.weights = np.asarray(weights, dtype=float)
+        self.omega_method = omega_method
+        self.seed = seed
+
+    # Per-update log, filled during the run.
+    def _new_log(self, size: int) -> None:
+        self.update_t = np.full(size, np.nan)
+        self.update_theta = np.full((size, 4), np.nan)
+        self.update_error_fro = np.full(size, np.nan)
+        self.update_iterations = np.zeros(size, dtype=int)
+        self.update_damped = np.zeros(size, dtype=bool)
+        self.update_rate_limited = np.zeros(size, dtype=bool)
+        self.updates = 0
+
+    def reset(self, physics: AntennaPhysics, reference: TrajectorySample, control_dt: float) -> None:
+        self.dt = control_dt
+        self.period, self.latency = self.imu.ticks(control_dt)
+        self.rng = np.random.default_rng([self.seed, 0x1A7E])
+        self.att_sigma = math.radians(self.imu.attitude_noise_deg)
+        h, corr = self.period * control_dt, self.imu.attitude_noise_time_s
+        self.att_decay = math.exp(-h / corr) if corr > 0 else 0.0
+        self.att_error = self.rng.normal(0.0, self.att_sigma, 3)  # stationary start
+        self.gyro_sigma = math.radians(self.imu.gyro_noise_deg_s)
+        model = physics.model.ptr
+        self.physics_dt = model.opt.timestep
+        self.quat_slice = physics.sensor_slice("imu_quat")
+        self.gyro_slice = physics.sensor_slice("imu_gyro")
+        self.actuators = physics.antenna_actuators
+        self.qpos_adr = physics.antenna_qpos
+        kp, kv = physics.drive_gains()
+        self.lead = kv / kp  # s: velocity feed-forward through the set-point
+        if self.limits is None:
+            self.limits = ant.AntennaLimits(rate=physics.rate_limit())
+        data = physics.data.ptr
+        theta = data.qpos[self.qpos_adr].copy()
+        self.theta_from, self.theta_to = theta.copy(), theta.copy()
+        self.ff_from = data.qvel[physics.antenna_dofs].copy()
+        self.ff_to = self.ff_from.copy()
+        self.tick_from, self.tick_to = 0, 0
+        self.attitude = ant.forward_kinematics(theta)  # N at tick_to
+        self.queue = deque()
+        self.last_gyro = None
+        n_ticks = reference.t.size
+        self._new_log(n_ticks // self.period + 2)
+        # The first sample is taken and used at t = 0 (the run starts in steady tracking).
+        self._measure(0, data, lag=0.0)  # mj_forward just evaluated the sensors at t = 0
+        self._update(0, self.queue.popleft())
+
+    def _measure(self, tick: int, data, lag: float | None = None) -> None:
+        sd = data.sensordata
+        q = sd[self.quat_slice]
+        rotation = np.empty(9)
+        mujoco.mju_quat2Mat(rotation, q)
+        rotation = rotation.reshape(3, 3)
+        if self.att_sigma > 0:
+            if tick > 0:
+                drive = self.att_sigma * math.sqrt(1.0 - self.att_decay**2)
+                self.att_error = self.att_decay * self.att_error + self.rng.normal(0.0, drive, 3)
+            rotation = rotation @ _exp_so3(self.att_error)
+        gyro = sd[self.gyro_slice].copy()
+        if self.gyro_sigma > 0:
+            gyro = gyro + self.rng.normal(0.0, self.gyro_sigma, 3)
+        # After mj_step the sensors hold the state at the start of its last physics step.
+        lag = self.physics_dt if lag is None else lag
+        self.queue.append((tick * self.dt - lag, rotation, gyro))
+
+    def _update(self, tick: int, sample) -> None:
+        measured_t, rotation, gyro = sample
+        target_tick = tick + self.period if tick > 0 else self.period + self.latency
+        rate = gyro
+        if self.predict:
+            tau = target_tick * self.dt - measured_t
+            accel = np.zeros(3) if self.last_gyro is None else (gyro - self.last_gyro) / (self.period * self.dt)
+            rotation = rotation @ _exp_so3(gyro * tau + 0.5 * accel * tau * tau)
+            rate = gyro + accel * tau
+        self.last_gyro = gyro
+        attitude = rotation.T @ self.satellite
+        step_dt = (target_tick - self.tick_to) * self.dt
+        theta, info = ant.crr_step(self.theta_to, self.attitude, attitude, step_dt, self.weights,
+                                   limits=self.limits, omega_method=self.omega_method,
+                                   full_correction=self.method == "crr-full")
+        # N = R^T eTs turns at -w_body in the ship frame: the joint rates that hold it, from
+        # the gyro (its noise is far smaller than that of differenced attitudes).
+        feedforward = ant.joint_rates(theta, -rate, self.weights, self.limits)[0]
+        self.theta_from, self.ff_from = self._ramp(tick), self._feedforward(tick)
+        self.tick_from, self.tick_to = tick, target_tick
+        self.theta_to, self.ff_to, self.attitude = theta, feedforward, attitude
+        i = self.updates
+        self.update_t[i] = target_tick * self.dt
+        self.update_theta[i] = theta
+        self.update_error_fro[i] = info.error_fro
+        self.update_iterations[i] = info.iterations
+        self.update_damped[i] = info.damped
+        self.update_rate_limited[i] = info.rate_limited
+        self.updates += 1
+
+    def _fraction(self, tick: int) -> float:
+        span = self.tick_to - self.tick_from
+        return 1.0 if span <= 0 else min(max((tick - self.tick_from) / span, 0.0), 1.0)
+
+    def _feedforward(self, tick: int) -> np.ndarray:
+        return self.ff_from + self._fraction(tick) * (self.ff_to - self.ff_from)
+
+    def _ramp(self, tick: int) -> np.ndarray:
+        return self.theta_from + self._fraction(tick) * (self.theta_to - self.theta_from)
+
+    def __call__(self, tick: int, physics) -> None:
+        data = physics.data.ptr
+        if tick > 0 and tick % self.period == 0:
+            self._measure(tick, data)
+        if self.queue and tick > 0 and self.queue[0][0] + self.physics_dt + self.latency * self.dt <= tick * self.dt + 1e-9:
+            sample = self.queue.popleft()
+            while self.queue and self.queue[0][0] + self.physics_dt + self.latency * self.dt <= tick * self.dt + 1e-9:
+                sample = self.queue.popleft()
+            self._update(tick, sample)
+        target = self._ramp(tick + 1) + self.lead * self._feedforward(tick + 1)
+        data.ctrl[self.actuators] = (target - data.act[self.actuators]) / self.dt
+
+    def update_log(self) -> dict:
+        n = self.updates
+        return {
+            "t": self.update_t[:n], "theta": self.update_theta[:n],
+            "error_fro": self.update_error_fro[:n], "iterations": self.update_iterations[:n],
+            "damped": self.update_damped[:n], "rate_limited": self.update_rate_limited[:n],
+        }
+
+
+def _exp_so3(rotvec) -> np.ndarray:
+    """Rotation matrix of a rotation vector (MuJoCo's quaternion functions)."""
+    quat = np.empty(4)
+    angle = float(np.linalg.norm(rotvec))
+    if angle < 1e-300:
+        return np.eye(3)
+    mujoco.mju_axisAngle2Quat(quat, rotvec / angle, angle)
+    mat = np.empty(9)
+    mujoco.mju_quat2Mat(mat, quat)
+    return mat.reshape(3, 3)
+
+
+# ----------------------------------------------------------------------------- evaluation
+
+
+def pointing_errors(dish: np.ndarray, satellite: np.ndarray):
+    """(pointing, polarization) errors in rad of world-from-antenna rotations (n, 3, 3).
+
+    Pointing: the angle between the boresight Z_a and the satellite direction Z_s.
+    Polarization: the twist about the boresight of eTs^T R (swing-twist decomposition).
+    """
+    z = dish[:, :, 2]
+    target = satellite[:, 2]
+    pointing = np.arctan2(np.linalg.norm(np.cross(z, target), axis=1), z @ target)
+    relative = satellite.T @ dish
+    twist = np.arctan2(relative[:, 1, 0] - relative[:, 0, 1], relative[:, 0, 0] + relative[:, 1, 1])
+    return pointing, twist
+
+
+class AntennaEvaluation:
+    """Checks and outputs of an antenna run."""
+
+    def __init__(self, physics: AntennaPhysics, satellite, controller: AntennaController,
+                 drive: "ShipMotionDrive", pointing_max_deg: float, rms_limit_deg: float | None,
+                 description: dict):
+        self.physics = physics
+        self.drive = drive
+        self.satellite = satellite
+        self.controller = controller
+        self.pointing_max_deg = pointing_max_deg
+        self.rms_limit_deg = rms_limit_deg
+        self.description = description
+
+    def _joint_log(self, log: RunLog):
+        p = self.physics
+        return log.qpos[:, p.antenna_qpos], log.qvel[:, p.antenna_dofs]
+
+    def errors_deg(self, log: RunLog):
+        pointing, twist = pointing_errors(self.physics.dish_rotation(log.qpos), self.satellite)
+        return np.degrees(pointing), np.degrees(twist)
+
+    def __call__(self, log: RunLog):
+        p = self.physics
+        pointing, polarization = self.errors_deg(log)
+        q, qd = self._joint_log(log)
+        kp, kv = p.drive_gains()
+        torque = demanded_force(kp, kv, log.act[:, p.antenna_actuators], q, qd)
+        torque_ratio = np.abs(torque).max(0) / p.torque_limit()
+        rate_ratio = np.abs(qd).max(0) / p.rate_limit()
+        ctrl_ratio = np.abs(log.ctrl[:, p.antenna_actuators]).max(0) / p.rate_limit()
+        updates = self.controller.update_log()
+        deck_error = self.drive.tracking_error(log)
+        checks = [
+            Check("pointing_error_max", float(pointing.max()), self.pointing_max_deg, "deg",
+                  note=f"at t = {log.t[int(np.argmax(pointing))]:.2f} s"),
+        ]
+        if self.rms_limit_deg is not None:
+            checks.append(Check("pointing_error_rms", float(np.sqrt(np.mean(pointing**2))),
+                                self.rms_limit_deg, "deg"))
+        damped_t = updates["t"][updates["damped"]]
+        limited_t = updates["t"][updates["rate_limited"]]
+        checks += [
+            Check("polarization_error_max", float(np.abs(polarization).max()), POLARIZATION_MAX_DEG, "deg"),
+            Check("attitude_error_fro_max", float(np.max(updates["error_fro"], initial=0.0)),
+                  ATTITUDE_FRO_LIMIT, "",
+                  note=f"the planner's ||f(Theta) - N||_F over {updates['t'].size} updates"),
+            Check("joint_rate", float(rate_ratio.max()), 1.0, "of limit",
+                  note=f"measured joint speed / rated speed, worst {JOINTS[int(np.argmax(rate_ratio))]}"),
+            Check("joint_torque", float(torque_ratio.max()), 1.0, "of limit",
+                  note=f"demanded / drive limit, worst {JOINTS[int(np.argmax(torque_ratio))]}"),
+        ]
+        metrics = dict(self.description)
+        metrics.update({
+            "pointing_error_rms_deg": float(np.sqrt(np.mean(pointing**2))),
+            "pointing_error_p99_deg": float(np.percentile(pointing, 99)),
+            "polarization_error_rms_deg": float(np.sqrt(np.mean(polarization**2))),
+            "peak_joint_rate_deg_s": dict(zip(JOINTS, np.degrees(np.abs(qd).max(0)).round(3).tolist())),
+            "commanded_rate_of_limit": dict(zip(JOINTS, ctrl_ratio.round(4).tolist())),
+            "peak_torque_N_m": dict(zip(JOINTS, np.abs(torque).max(0).round(3).tolist())),
+            "joint_range_deg": {n: [float(np.degrees(q[:, j].min()).round(3)), float(np.degrees(q[:, j].max()).round(3))]
+                                for j, n in enumerate(JOINTS)},
+            "planner_updates": int(updates["t"].size),
+            "newton_iterations_mean": float(np.mean(updates["iterations"])) if updates["t"].size else 0.0,
+            "newton_iterations_max": int(np.max(updates["iterations"], initial=0)),
+            "singularity_damping_updates": int(updates["damped"].sum()),
+            "singularity_damping_first_t_s": float(damped_t[0]) if damped_t.size else None,
+            "singularity_damping_last_t_s": float(damped_t[-1]) if damped_t.size else None,
+            "rate_limited_updates": int(updates["rate_limited"].sum()),
+            "rate_limited_first_t_s": float(limited_t[0]) if limited_t.size else None,
+            "deck_tracking_error_deg": float(np.degrees(deck_error[1:].max())),
+            "deck_heave_error_mm": float(1e3 * deck_error[0]),
+        })
+        return checks, metrics
+
+    def timeseries(self, log: RunLog) -> dict:
+        p = self.physics
+        q, qd = self._joint_log(log)
+        kp, kv = p.drive_gains()
+        pointing, polarization = self.errors_deg(log)
+        updates = self.controller.update_log()
+        deck = log.qpos[:, p.deck_qpos]
+        return {
+            "joint_names": np.array(JOINTS),
+            "ship_heave": deck[:, 0], "ship_heading": deck[:, 1],
+            "ship_pitch": deck[:, 2], "ship_roll": deck[:, 3],
+            "theta_planned": log.reference.position, "theta_actual": q, "theta_rate": qd,
+            "setpoint": log.act[:, p.antenna_actuators],
+            "torque_demanded": demanded_force(kp, kv, log.act[:, p.antenna_actuators], q, qd),
+            "torque_limit": p.torque_limit(), "rate_limit": p.rate_limit(),
+            "pointing_error_deg": pointing, "polarization_error_deg": polarization,
+            "update_t": updates["t"], "update_theta": updates["theta"],
+            "update_error_fro": updates["error_fro"], "update_iterations": updates["iterations"],
+            "update_damped": updates["damped"], "update_rate_limited": updates["rate_limited"],
+        }
+
+    def report(self, log: RunLog, checks, path) -> None:
+        from sims.report import antenna_report
+
+        antenna_report(self.timeseries(log), log.t, checks, path, self.pointing_max_deg)
+
+
+# ----------------------------------------------------------------------------- scenarios
+
+#: Interval of the ideal joint path (the reference for plots and the initial state), s.
+REFERENCE_DT = 0.05
+
+
+def ideal_path(motion, satellite: np.ndarray, duration: float, theta0) -> ant.JointPathTrajectory:
+    """Joint angles for the true ship motion, CRR with full correction every REFERENCE_DT."""
+    n = int(math.ceil(duration / REFERENCE_DT)) + 1
+    t = np.arange(n) * REFERENCE_DT
+    ship = motion.sample(t)
+    attitudes = ant.ship_attitude(ship.heading, ship.pitch, ship.roll) @ satellite
+    return ant.JointPathTrajectory(ant.solve_joint_path(attitudes, REFERENCE_DT, theta0, "crr-full"))
+
+
+def start_angles(motion, satellite: np.ndarray, azimuth: float, elevation: float,
+                 polarization: float) -> np.ndarray:
+    """Joint angles for the attitude at t = 0: from the level-ship solution (eq. 15),
+    corrected to the ship's attitude at 0 by weighted Newton steps (planners.antenna)."""
+    theta = ant.joint_angles_at_rest(azimuth, elevation, polarization)
+    ship = motion.sample(0.0)
+    target = ant.ship_attitude(ship.heading[0], ship.pitch[0], ship.roll[0]) @ satellite
+    level = ant.forward_kinematics(theta)
+    # Turn from the level attitude to the target in small steps (the path stays on the
+    # weighted minimum-norm branch).
+    path = ant.solve_joint_path(_slerp(level, target, 50), 1.0, theta, "crr-full")
+    return path.theta[-1]
+
+
+def _slerp(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
+    rotvec = ant.rotation_log(b @ a.T)
+    s = np.linspace(0.0, 1.0, n + 1)
+    return np.stack([_exp_so3(f * rotvec) @ a for f in s])
+
+
+@dataclass(frozen=True)
+class AntennaOptions:
+    """How the antenna's controller is set up (tests and users vary it; the CLI runs the
+    defaults)."""
+
+    imu: ImuModel = ImuModel()
+    predict: bool = True
+    method: str = "crr"
+    omega_method: str = "log"
+
+
+def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_max_deg,
+           rms_limit_deg, description, antenna_options: AntennaOptions,
+           video_length_s: float = 60.0) -> Setup:
+    physics = AntennaPhysics.load()
+    satellite = ant.satellite_attitude(azimuth, elevation, polarization)
+    theta0 = start_angles(motion, satellite, azimuth, elevation, polarization)
+    reference = ideal_path(motion, satellite, duration, theta0)
+    start = reference.sample(0.0)
+    ship0 = motion.sample(0.0)
+    deck_pos, deck_vel, _ = ship0.joint_arrays()
+    physics.set_state(deck_pos[0], deck_vel[0], start.position[0], start.velocity[0])
+    drive = ShipMotionDrive(physics, motion)
+    controller = AntennaController(satellite, antenna_options.imu, antenna_options.method,
+                                   antenna_options.predict, omega_method=antenna_options.omega_method,
+                                   seed=seed)
+    description = dict(description)
+    description.update({
+        "imu_rate_hz": antenna_options.imu.rate_hz,
+        "imu_latency_s": antenna_options.imu.latency_s,
+        "imu_attitude_noise_deg": antenna_options.imu.attitude_noise_deg,
+        "imu_attitude_noise_time_s": antenna_options.imu.attitude_noise_time_s,
+        "imu_gyro_noise_deg_s": antenna_options.imu.gyro_noise_deg_s,
+        "prediction": antenna_options.predict,
+        "planner": antenna_options.method,
+        "planner_angular_velocity": antenna_options.omega_method,
+    })
+    evaluation = AntennaEvaluation(physics, satellite, controller, drive, pointing_max_deg,
+                                   rms_limit_deg, description)
+    return Setup(
+        physics=physics,
+        trajectory=reference,
+        controller=controller,
+        control_dt=CONTROL_DT,
+        duration=duration,
+        evaluate=evaluation,
+        timeseries=evaluation.timeseries,
+        report=evaluation.report,
+        disturbance=drive,
+        # Time-lapse so the video lasts at most video_length_s.
+        video_speed=max(1.0, duration / video_length_s),
+        seed=seed,
+    )
+
+
+def build_paper_motion(options, antenna_options: AntennaOptions = AntennaOptions()) -> Setup:
+    """The paper's section 5.1: eq. (15)-(16) ship motion, satellite at 223.49/60/-28.8 deg."""
+    az, el, pol = np.radians(ant.PAPER_SATELLITE_DEG)
+    duration = PAPER_DURATION_S if options.duration is None else options.duration
+    description = {"ship_motion": "paper eq. (15)-(16)",
+                   "satellite_az_el_pol_deg": list(ant.PAPER_SATELLITE_DEG)}
+    # A 30 s video: the 8 s and 10 s periods shown at 4 s and 5 s.
+    return _setup(PaperShipMotion(), az, el, pol, duration, options.seed, POINTING_MAX_PAPER_DEG,
+                  None, description, antenna_options, video_length_s=30.0)
+
+
+def sea_state_motion(hs: float, tp: float, heading_deg: float, seed: int) -> SeaStateMotion:
+    return SeaStateMotion(hs, tp, heading_deg, np.random.default_rng([seed, 0x5EA]))
+
+
+def build_sea_state(options, antenna_options: AntennaOptions = AntennaOptions()) -> Setup:
+    """A JONSWAP sea state; the satellite named by its orbital slot and the ship's position."""
+    hs = SEA_HS_M if options.hs is None else options.hs
+    tp = SEA_TP_S if options.tp is None else options.tp
+    heading = SEA_HEADING_DEG if options.heading is None else options.heading
+    motion = sea_state_motion(hs, tp, heading, options.seed)
+    az, el, pol = look_angles(np.radians(SATELLITE_LON_DEG), np.radians(SHIP_LAT_DEG),
+                              np.radians(SHIP_LON_DEG))
+    duration = SEA_DURATION_S if options.duration is None else options.duration
+    sd = motion.standard_deviation()
+    description = {
+        "ship_motion": f"JONSWAP Hs {hs:g} m, Tp {tp:g} s, gamma {motion.gamma:g}, waves {heading:g} deg off the bow",
+        "ship_motion_std": {"heave_m": float(sd[0]), "yaw_deg": float(np.degrees(sd[1])),
+                            "pitch_deg": float(np.degrees(sd[2])), "roll_deg": float(np.degrees(sd[3]))},
+        "ship_position_deg": [SHIP_LAT_DEG, SHIP_LON_DEG],
+        "satellite_lon_deg": SATELLITE_LON_DEG,
+        "satellite_az_el_pol_deg": np.degrees([az, el, pol]).round(4).tolist(),
+    }
+    return _setup(motion, az, el, pol, duration, options.seed, POINTING_MAX_SEA_DEG,
+                  POINTING_RMS_DEG, description, antenna_options)
+
+
+def plan_paper_motion() -> ant.JointPathTrajectory:
+    """The paper's case without physics: joint angles for the true ship motion."""
+    az, el, pol = np.radians(ant.PAPER_SATELLITE_DEG)
+    satellite = ant.satellite_attitude(az, el, pol)
+    return ideal_path(PaperShipMotion(), satellite, PAPER_DURATION_S,
+                      ant.joint_angles_at_rest(az, el, pol))
+
+
+def plan_sea_state(seed: int = 0) -> ant.JointPathTrajectory:
+    """The default sea state without physics: joint angles for the true ship motion."""
+    motion = sea_state_motion(SEA_HS_M, SEA_TP_S, SEA_HEADING_DEG, seed)
+    az, el, pol = look_angles(np.radians(SATELLITE_LON_DEG), np.radians(SHIP_LAT_DEG),
+                              np.radians(SHIP_LON_DEG))
+    satellite = ant.satellite_attitude(az, el, pol)
+    return ideal_path(motion, satellite, SEA_DURATION_S, start_angles(motion, satellite, az, el, pol))
+
+
+def joint_kinds() -> list[str]:
+    return ["hinge"] * 4

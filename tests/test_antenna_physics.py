@@ -1,0 +1,146 @@
+"""The ship antenna in MuJoCo (sims/antenna.py): short runs of both scenarios, the IMU and
+deck against the ship motion, the planner's kinematics against MuJoCo's, the prediction,
+determinism and bad input. The full-length runs belong to ``make demo`` and the benchmark."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from planners import antenna as ant
+from planners.errors import PlanningError
+from sims import antenna, runner
+from sims.scenarios import RunOptions
+from sims.ship_motion import PaperShipMotion
+
+
+def _run(build, duration, antenna_options=antenna.AntennaOptions(), **options):
+    setup = build(RunOptions(duration=duration, **options), antenna_options)
+    return setup, runner.run("antenna", setup)
+
+
+def _checks(result):
+    return {c.name: c for c in result.checks}
+
+
+@pytest.fixture(scope="module")
+def paper_run():
+    return _run(antenna.build_paper_motion, 12.0)
+
+
+@pytest.fixture(scope="module")
+def sea_run():
+    return _run(antenna.build_sea_state, 40.0)
+
+
+def test_paper_motion_checks_hold(paper_run):
+    setup, result = paper_run
+    checks = _checks(result)
+    assert result.passed, [c for c in result.checks if not c.passed]
+    assert checks["pointing_error_max"].value < antenna.POINTING_MAX_PAPER_DEG
+    assert checks["attitude_error_fro_max"].value < 1e-6
+    assert result.metrics["planner_updates"] == pytest.approx(12.0 * antenna.IMU_RATE_HZ, abs=2)
+
+
+def test_sea_state_checks_hold(sea_run):
+    setup, result = sea_run
+    checks = _checks(result)
+    assert result.passed, [c for c in result.checks if not c.passed]
+    assert checks["pointing_error_rms"].value < antenna.POINTING_RMS_DEG
+    # The sea really moves the ship: roll of degrees, not a calm.
+    assert np.degrees(np.abs(result.log.qpos[:, setup.physics.deck_qpos[3]]).max()) > 2.0
+
+
+def test_without_prediction_the_pointing_error_is_measurably_worse(paper_run):
+    """The IMU sample is 20 ms old on arrival and the set-point ramps for another 20 ms; the
+    gyro-based prediction removes that lag."""
+    _, predicted = paper_run
+    _, lagging = _run(antenna.build_paper_motion, 12.0, antenna.AntennaOptions(predict=False))
+    with_prediction = _checks(predicted)["pointing_error_max"].value
+    without = _checks(lagging)["pointing_error_max"].value
+    assert without > 5 * with_prediction
+    assert not _checks(lagging)["pointing_error_max"].passed
+    rms_with = predicted.metrics["pointing_error_rms_deg"]
+    rms_without = lagging.metrics["pointing_error_rms_deg"]
+    assert rms_without > 5 * rms_with
+
+
+def test_a_twice_faster_ship_breaks_the_rate_and_torque_checks():
+    """The checks can fail: the paper's motion at twice its speed (periods 4 s and 5 s)."""
+    options = RunOptions(duration=6.0)
+    setup = antenna._setup(PaperShipMotion(sample_time=0.005), *np.radians(ant.PAPER_SATELLITE_DEG),
+                           options.duration, 0, antenna.POINTING_MAX_PAPER_DEG, None, {},
+                           antenna.AntennaOptions())
+    checks = _checks(runner.run("fast ship", setup))
+    assert not checks["joint_torque"].passed
+    assert checks["joint_torque"].value > 1.0
+
+
+def test_deck_follows_the_ship_motion_and_the_imu_reads_it(paper_run):
+    setup, result = paper_run
+    log, physics = result.log, setup.physics
+    assert result.metrics["deck_tracking_error_deg"] < 1e-3
+    ship = PaperShipMotion().sample(log.t)
+    # The gyro reads the deck's body-frame rate (sensors lag the state by one physics step).
+    gyro = log.sensordata[:, physics.sensor_slice("imu_gyro")]
+    lagged = PaperShipMotion().sample(log.t - physics.model.opt.timestep).body_angular_velocity()
+    # The deck tracks the motion to ~1e-4 deg; its rate to ~0.01 deg/s of ~30 deg/s.
+    np.testing.assert_allclose(gyro[1:], lagged[1:], atol=np.radians(0.03))
+    # The IMU's orientation is the deck's: eTb of the ship motion.
+    quat = log.sensordata[:, physics.sensor_slice("imu_quat")]
+    mats = np.empty((quat.shape[0], 9))
+    for i, q in enumerate(quat):
+        mujoco.mju_quat2Mat(mats[i], q)
+    lagged_rot = PaperShipMotion().sample(log.t - physics.model.opt.timestep).world_from_ship()
+    assert np.abs(mats[1:].reshape(-1, 3, 3) - lagged_rot[1:]).max() < np.radians(0.01)
+    assert np.abs(ship.heading - log.qpos[:, physics.deck_qpos[1]]).max() < np.radians(1e-3)
+
+
+def test_dish_rotation_of_the_planner_equals_mujoco():
+    """eTb(deck joints) f(Theta) (planners) equals MuJoCo's dish site at random states."""
+    physics = antenna.AntennaPhysics.load()
+    model, data = physics.model.ptr, physics.data.ptr
+    rng = np.random.default_rng(3)
+    site = model.site("dish").id
+    for _ in range(20):
+        data.qpos[physics.deck_qpos] = rng.uniform(-0.6, 0.6, 4)
+        data.qpos[physics.antenna_qpos] = rng.uniform([-3, -2.5, -1.2, -3], [3, 0, 1.2, 3])
+        mujoco.mj_kinematics(model, data)
+        expected = data.site_xmat[site].reshape(3, 3)
+        np.testing.assert_allclose(physics.dish_rotation(data.qpos)[0], expected, atol=1e-12)
+
+
+def test_same_seed_same_run_and_the_noise_follows_the_seed():
+    _, a = _run(antenna.build_sea_state, 3.0, seed=5)
+    _, b = _run(antenna.build_sea_state, 3.0, seed=5)
+    _, c = _run(antenna.build_sea_state, 3.0, seed=6)
+    np.testing.assert_array_equal(a.log.qpos, b.log.qpos)
+    np.testing.assert_array_equal(a.log.ctrl, b.log.ctrl)
+    assert not np.array_equal(a.log.qpos, c.log.qpos)
+
+
+def test_imu_noise_enters_the_pointing_error():
+    quiet = antenna.AntennaOptions(imu=antenna.ImuModel(attitude_noise_deg=0.0, gyro_noise_deg_s=0.0))
+    _, clean = _run(antenna.build_sea_state, 20.0, quiet)
+    _, noisy = _run(antenna.build_sea_state, 20.0)
+    assert noisy.metrics["pointing_error_rms_deg"] > 2 * clean.metrics["pointing_error_rms_deg"]
+
+
+def test_slower_imu_still_holds_the_sea_state():
+    options = antenna.AntennaOptions(imu=antenna.ImuModel(rate_hz=20.0, latency_s=0.03))
+    _, result = _run(antenna.build_sea_state, 20.0, options)
+    assert result.passed, [c for c in result.checks if not c.passed]
+    assert result.metrics["planner_updates"] == pytest.approx(20.0 * 20.0, abs=2)
+
+
+def test_bad_imu_settings_are_named():
+    with pytest.raises(PlanningError, match="IMU rate 30 Hz"):
+        antenna.ImuModel(rate_hz=30.0).ticks(antenna.CONTROL_DT)
+    with pytest.raises(PlanningError, match="latency 0.012 s"):
+        antenna.ImuModel(latency_s=0.012).ticks(antenna.CONTROL_DT)
+    with pytest.raises(PlanningError, match="method 'pinv'"):
+        antenna.AntennaController(np.eye(3), method="pinv")
+
+
+def test_bad_sea_state_is_named():
+    with pytest.raises(ValueError, match="hs = -1"):
+        antenna.build_sea_state(RunOptions(hs=-1.0))
