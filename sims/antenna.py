@@ -21,8 +21,8 @@ servo's velocity feed-forward.
 
 from __future__ import annotations
 
-import copy
 import math
+import time
 from collections import deque
 from dataclasses import dataclass
 
@@ -286,6 +286,7 @@ class AntennaController:
         self.update_damped = np.zeros(size, dtype=bool)
         self.update_rate_limited = np.zeros(size, dtype=bool)
         self.updates = 0
+        self.planner_wall_s = 0.0  # wall time spent in the planner updates
 
     def reset(self, physics: AntennaPhysics, reference: TrajectorySample, control_dt: float) -> None:
         self.dt = control_dt
@@ -340,6 +341,7 @@ class AntennaController:
         self.queue.append((tick * self.dt - lag, rotation, gyro))
 
     def _update(self, tick: int, sample) -> None:
+        start = time.perf_counter()
         measured_t, rotation, gyro = sample
         target_tick = tick + self.period if tick > 0 else self.period + self.latency
         rate = gyro
@@ -368,6 +370,7 @@ class AntennaController:
         self.update_damped[i] = info.damped
         self.update_rate_limited[i] = info.rate_limited
         self.updates += 1
+        self.planner_wall_s += time.perf_counter() - start
 
     def _fraction(self, tick: int) -> float:
         span = self.tick_to - self.tick_from
@@ -469,6 +472,7 @@ class AntennaEvaluation:
         if self.rms_limit_deg is not None:
             checks.append(Check("pointing_error_rms", float(np.sqrt(np.mean(pointing**2))),
                                 self.rms_limit_deg, "deg"))
+        sigma = ant.weighted_singular_value(ant.jacobian(q))
         damped_t = updates["t"][updates["damped"]]
         limited_t = updates["t"][updates["rate_limited"]]
         checks += [
@@ -492,8 +496,13 @@ class AntennaEvaluation:
             "joint_range_deg": {n: [float(np.degrees(q[:, j].min()).round(3)), float(np.degrees(q[:, j].max()).round(3))]
                                 for j, n in enumerate(JOINTS)},
             "planner_updates": int(updates["t"].size),
+            "planner_wall_s": self.controller.planner_wall_s,
             "newton_iterations_mean": float(np.mean(updates["iterations"])) if updates["t"].size else 0.0,
             "newton_iterations_max": int(np.max(updates["iterations"], initial=0)),
+            # Distance to a singularity along the run: sigma_min of J W^-1/2 (0 = singular;
+            # damping starts below AntennaLimits.singular_threshold).
+            "weighted_singular_value_min": float(sigma.min()),
+            "weighted_singular_value_min_t_s": float(log.t[int(np.argmin(sigma))]),
             "singularity_damping_updates": int(updates["damped"].sum()),
             "singularity_damping_first_t_s": float(damped_t[0]) if damped_t.size else None,
             "singularity_damping_last_t_s": float(damped_t[-1]) if damped_t.size else None,
@@ -673,6 +682,36 @@ def plan_sea_state(seed: int = 0) -> ant.JointPathTrajectory:
                               np.radians(SHIP_LON_DEG))
     satellite = ant.satellite_attitude(az, el, pol)
     return ideal_path(motion, satellite, SEA_DURATION_S, start_angles(motion, satellite, az, el, pol))
+
+
+def compare_methods(duration: float = PAPER_DURATION_S) -> dict:
+    """The paper's section 5 experiment: pinv integration, CRR (eq. 6 and exact angular
+    velocity) and CRR with full correction over eq. (15)-(16) at dT = 0.01 s."""
+    t = np.arange(int(round(duration / ant.PAPER_DT)) + 1) * ant.PAPER_DT
+    ship = PaperShipMotion().sample(t)
+    az, el, pol = np.radians(ant.PAPER_SATELLITE_DEG)
+    attitudes = ant.desired_attitude(ship.heading, ship.pitch, ship.roll, az, el, pol)
+    theta0 = np.radians(ant.PAPER_THETA0_DEG)
+    runs = {"pinv": ("pinv", "eq6"), "crr": ("crr", "eq6"), "crr_log": ("crr", "log"),
+            "crr_full": ("crr-full", "eq6")}
+    return {key: ant.solve_joint_path(attitudes, ant.PAPER_DT, theta0, method, omega_method=omega)
+            for key, (method, omega) in runs.items()}
+
+
+def write_method_comparison(out_dir) -> None:
+    """methods.npz and methods.png: the paper's Figures 2-8 for the three methods."""
+    from pathlib import Path
+
+    from sims.report import antenna_methods_plot
+
+    paths = compare_methods()
+    arrays = {"t": paths["pinv"].t}
+    for key, path in paths.items():
+        arrays[f"theta_{key}"] = path.theta
+        arrays[f"error_fro_{key}"] = path.error_fro
+        arrays[f"iterations_{key}"] = path.iterations
+    np.savez_compressed(Path(out_dir) / "methods.npz", **arrays)
+    antenna_methods_plot(paths, Path(out_dir) / "methods.png")
 
 
 def joint_kinds() -> list[str]:

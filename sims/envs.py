@@ -94,3 +94,71 @@ def hexapod_environment(synchronous: bool = True, elevation_deg: float = 45.0,
     return control.Environment(
         physics, task, time_limit=trajectory.duration + SETTLE_S, n_sub_steps=n_sub
     )
+
+
+class AntennaTask(TrajectoryTrackingTask):
+    """Hold the satellite while the ship moves: the ship antenna for a user's controller.
+
+    The action is the four antenna drives' set-point rates (rad/s); the deck follows the ship
+    motion by itself (the sea). Observations add what a real controller has: the IMU's
+    orientation quaternion and gyro; ``reference_positions`` are the joint angles for the
+    true ship motion (what a perfect controller would reach; a real one must estimate them
+    from the IMU). The reward is exp(-pointing error / scale).
+    """
+
+    def __init__(self, setup, error_scale: float = np.deg2rad(0.1)):
+        super().__init__(setup.trajectory, list(setup.trajectory.labels), error_scale)
+        self._setup = setup
+        self._times = None
+
+    def initialize_episode(self, physics):
+        from sims.antenna import AntennaPhysics  # noqa: F401  (the setup's physics type)
+
+        physics.set_state(*self._initial)
+        self._setup.disturbance.reset(physics, self._times, np.random.default_rng(0))
+
+    def prepare(self, physics, control_dt: float, duration: float):
+        from planners.trajectory import control_ticks
+
+        self._times = control_ticks(duration, control_dt)
+        data = physics.data.ptr
+        self._initial = (data.qpos[physics.deck_qpos].copy(), data.qvel[physics.deck_dofs].copy(),
+                         data.qpos[physics.antenna_qpos].copy(), data.qvel[physics.antenna_dofs].copy())
+        self._dt = control_dt
+
+    def before_step(self, action, physics):
+        tick = int(round(physics.data.time / self._dt))
+        self._setup.disturbance(min(tick, self._times.size - 1), physics)
+        physics.data.ctrl[physics.antenna_actuators] = action
+
+    def action_spec(self, physics):
+        from dm_env import specs
+
+        lo, hi = physics.model.actuator_ctrlrange[physics.antenna_actuators].T
+        return specs.BoundedArray((4,), float, lo, hi, name="antenna_setpoint_rates")
+
+    def get_observation(self, physics):
+        obs = super().get_observation(physics)
+        obs["imu_quat"] = physics.sensor("imu_quat").copy()
+        obs["imu_gyro"] = physics.sensor("imu_gyro").copy()
+        return obs
+
+    def get_reward(self, physics):
+        from sims.antenna import pointing_errors
+
+        pointing, _ = pointing_errors(physics.dish_rotation(physics.data.qpos), self._setup.evaluate.satellite)
+        return float(np.exp(-pointing[0] / self._scale))
+
+
+def antenna_environment(sea_state: bool = True, duration: float = 60.0,
+                        control_dt: float = 0.005) -> control.Environment:
+    """The ship antenna as a dm_control Environment (default: the default sea state)."""
+    from sims import antenna
+    from sims.scenarios import RunOptions
+
+    build = antenna.build_sea_state if sea_state else antenna.build_paper_motion
+    setup = build(RunOptions(duration=duration))
+    task = AntennaTask(setup)
+    task.prepare(setup.physics, control_dt, duration)
+    n_sub = int(round(control_dt / setup.physics.model.opt.timestep))
+    return control.Environment(setup.physics, task, time_limit=duration, n_sub_steps=n_sub)

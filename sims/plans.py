@@ -14,7 +14,8 @@ PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
 
 
 def write_plan(scenario, out_dir: Path) -> Path:
-    """Write plan.npz (t, position, velocity, acceleration, labels, key points) and plan.png."""
+    """Write plan.npz (t, position, velocity, acceleration, labels, key points), plan.png and
+    the scenario's extra files."""
     trajectory = scenario.plan()
     sample = trajectory.sample(control_ticks(trajectory.duration, PLAN_DT))
     kinds = scenario.kinds()
@@ -29,4 +30,6 @@ def write_plan(scenario, out_dir: Path) -> Path:
         np.savez_compressed(tmp / "plan.npz", **arrays)
         plan_plot(sample, trajectory.labels, kinds, tmp / "plan.png",
                   title=f"{scenario.name}: planned motion", key_times=key_times, key_points=key_points)
+        if scenario.plan_extras is not None:
+            scenario.plan_extras(tmp)
     return Path(out_dir)

@@ -43,6 +43,8 @@ class Scenario:
       expect_pass: False for a scenario that demonstrates a failure (loader-direct).
       camera: the default camera of its video.
       kinds: () -> "slide" or "hinge" per planned channel (units of plots).
+      plan_extras: optional (out_dir) -> None, more files for ``planbench plan`` (the
+        antenna's comparison of the paper's methods).
     """
 
     name: str
@@ -53,6 +55,7 @@ class Scenario:
     expect_pass: bool = True
     camera: str = "overview"
     kinds: Callable = lambda: ()
+    plan_extras: Callable | None = None
 
 
 SCENARIOS: dict[str, Scenario] = {
@@ -95,6 +98,7 @@ SCENARIOS: dict[str, Scenario] = {
             antenna.build_paper_motion,
             antenna.plan_paper_motion,
             kinds=antenna.joint_kinds,
+            plan_extras=antenna.write_method_comparison,
         ),
         Scenario(
             "antenna-sea-state",

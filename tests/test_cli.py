@@ -202,3 +202,7 @@ def test_antenna_plan(tmp_path):
     assert list(plan["labels"]) == ["azimuth", "elevation", "cross_elevation", "polarization"]
     assert plan["t"][-1] == pytest.approx(60.0)
     np.testing.assert_allclose(np.degrees(plan["position"][0]), [136.51, -60.0, 0.0, -28.8], atol=1e-9)
+    methods = np.load(tmp_path / "p" / "methods.npz")
+    assert methods["error_fro_pinv"][-1] > 1e-3  # the drift of section 5.2
+    assert methods["error_fro_crr"].max() < 1e-6 and methods["error_fro_crr_full"].max() < 1e-10
+    assert (tmp_path / "p" / "methods.png").stat().st_size > 10_000
