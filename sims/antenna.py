@@ -630,7 +630,21 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
     )
 
 
-def build_paper_motion(options, antenna_options: AntennaOptions = AntennaOptions()) -> Setup:
+def _antenna_options(options, antenna_options: AntennaOptions | None) -> AntennaOptions:
+    """The controller's options: ``antenna_options`` if given, else the defaults with the IMU
+    rate, latency and prediction of the RunOptions (the CLI's --imu-rate, --imu-latency,
+    --no-prediction)."""
+    if antenna_options is not None:
+        return antenna_options
+    imu = ImuModel(
+        rate_hz=IMU_RATE_HZ if options.imu_rate is None else options.imu_rate,
+        latency_s=IMU_LATENCY_S if options.imu_latency is None else options.imu_latency,
+    )
+    imu.ticks(CONTROL_DT)  # bad rate or latency: a clear error before anything is built
+    return AntennaOptions(imu=imu, predict=options.predict)
+
+
+def build_paper_motion(options, antenna_options: AntennaOptions | None = None) -> Setup:
     """The paper's section 5.1: eq. (15)-(16) ship motion, satellite at 223.49/60/-28.8 deg."""
     az, el, pol = np.radians(ant.PAPER_SATELLITE_DEG)
     duration = PAPER_DURATION_S if options.duration is None else options.duration
@@ -638,14 +652,15 @@ def build_paper_motion(options, antenna_options: AntennaOptions = AntennaOptions
                    "satellite_az_el_pol_deg": list(ant.PAPER_SATELLITE_DEG)}
     # A 30 s video: the 8 s and 10 s periods shown at 4 s and 5 s.
     return _setup(PaperShipMotion(), az, el, pol, duration, options.seed, POINTING_MAX_PAPER_DEG,
-                  None, description, antenna_options, video_length_s=30.0)
+                  None, description, _antenna_options(options, antenna_options),
+                  video_length_s=30.0)
 
 
 def sea_state_motion(hs: float, tp: float, heading_deg: float, seed: int) -> SeaStateMotion:
     return SeaStateMotion(hs, tp, heading_deg, np.random.default_rng([seed, 0x5EA]))
 
 
-def build_sea_state(options, antenna_options: AntennaOptions = AntennaOptions()) -> Setup:
+def build_sea_state(options, antenna_options: AntennaOptions | None = None) -> Setup:
     """A JONSWAP sea state; the satellite named by its orbital slot and the ship's position."""
     hs = SEA_HS_M if options.hs is None else options.hs
     tp = SEA_TP_S if options.tp is None else options.tp
@@ -664,7 +679,7 @@ def build_sea_state(options, antenna_options: AntennaOptions = AntennaOptions())
         "satellite_az_el_pol_deg": np.degrees([az, el, pol]).round(4).tolist(),
     }
     return _setup(motion, az, el, pol, duration, options.seed, POINTING_MAX_SEA_DEG,
-                  POINTING_RMS_DEG, description, antenna_options)
+                  POINTING_RMS_DEG, description, _antenna_options(options, antenna_options))
 
 
 def plan_paper_motion() -> ant.JointPathTrajectory:

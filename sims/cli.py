@@ -2,7 +2,8 @@
 
   planbench list
   planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--elevation DEG]
-                [--hs M] [--tp S] [--heading DEG] [--duration S]
+                [--hs M] [--tp S] [--heading DEG] [--imu-rate HZ] [--imu-latency S]
+                [--no-prediction] [--duration S]
                 [--video FILE] [--camera overview|closeup] [--quiet]
   planbench plan NAME --out DIR
   planbench bench
@@ -76,6 +77,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="spectral peak period, s (sea-state scenarios)")
     run.add_argument("--heading", type=_finite("wave heading"),
                      help="wave heading off the bow, deg: 180 head seas, 90 beam seas from starboard (sea-state scenarios)")
+    run.add_argument("--imu-rate", type=_finite("IMU rate", 0.0, strict=True),
+                     help="antenna IMU samples per second, Hz (200 / a whole number: 20, 25, 40, 50)")
+    run.add_argument("--imu-latency", type=_finite("IMU latency", 0.0),
+                     help="antenna IMU latency, s (a multiple of 5 ms)")
+    run.add_argument("--no-prediction", action="store_true",
+                     help="antenna controller: use each IMU sample as it is, no gyro prediction")
     run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
     run.add_argument("--video", type=Path, help="write an H.264 video of the run here")
     run.add_argument("--camera", default=None, help="video camera: overview or closeup")
@@ -100,8 +107,14 @@ def _options(scenario, args):
     for option in ("hs", "tp", "heading"):
         if getattr(args, option) is not None and option not in scenario.options:
             raise BadInput(f"scenario {scenario.name} has no sea state; --{option} is not accepted")
+    imu_given = args.imu_rate is not None or args.imu_latency is not None or args.no_prediction
+    if imu_given and "imu" not in scenario.options:
+        raise BadInput(f"scenario {scenario.name} has no IMU; --imu-rate, --imu-latency and "
+                       "--no-prediction are not accepted")
     return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
-                      elevation=args.elevation, hs=args.hs, tp=args.tp, heading=args.heading)
+                      elevation=args.elevation, hs=args.hs, tp=args.tp, heading=args.heading,
+                      imu_rate=args.imu_rate, imu_latency=args.imu_latency,
+                      predict=not args.no_prediction)
 
 
 def cmd_list(args) -> int:

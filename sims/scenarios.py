@@ -19,6 +19,8 @@ class RunOptions:
       elevation: telescope elevation in deg, None for the default (hexapod scenarios).
       hs, tp, heading: significant wave height (m), peak period (s) and wave heading off the
         bow (deg, 180 head seas), None for the defaults (sea-state scenarios).
+      imu_rate, imu_latency: the antenna IMU's sample rate (Hz) and latency (s), None for the
+        defaults; predict: False to switch the antenna controller's prediction off.
     """
 
     seed: int = 0
@@ -28,6 +30,9 @@ class RunOptions:
     hs: float | None = None
     tp: float | None = None
     heading: float | None = None
+    imu_rate: float | None = None
+    imu_latency: float | None = None
+    predict: bool = True
 
 
 @dataclass(frozen=True)
@@ -94,18 +99,19 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "antenna-paper-motion",
-            "ship antenna, 4 axes: the paper's extreme ship motion (pitch 40 deg/8 s, roll 45 deg/10 s, 1 deg/s turn), IMU at 50 Hz, CRR planner, 60 s",
+            "ship antenna, 4 axes: the paper's extreme ship motion (pitch 40 deg/8 s, roll 45 deg/10 s, 1 deg/s turn), IMU at 50 Hz, CRR planner, 60 s (--imu-rate, --imu-latency, --no-prediction)",
             antenna.build_paper_motion,
             antenna.plan_paper_motion,
+            options=frozenset({"imu"}),
             kinds=antenna.joint_kinds,
             plan_extras=antenna.write_method_comparison,
         ),
         Scenario(
             "antenna-sea-state",
-            "ship antenna, 4 axes: JONSWAP sea Hs 5 m, Tp 10 s, waves 135 deg off the bow, holding a GEO satellite at 15 W from 40 N 20 W, 300 s (--hs, --tp, --heading)",
+            "ship antenna, 4 axes: JONSWAP sea Hs 5 m, Tp 10 s, waves 135 deg off the bow, holding a GEO satellite at 15 W from 40 N 20 W, 300 s (--hs, --tp, --heading, --imu-rate, --imu-latency, --no-prediction)",
             antenna.build_sea_state,
             antenna.plan_sea_state,
-            options=frozenset({"hs", "tp", "heading"}),
+            options=frozenset({"hs", "tp", "heading", "imu"}),
             kinds=antenna.joint_kinds,
         ),
     )

@@ -353,3 +353,26 @@ def test_satellite_below_the_horizon_is_a_limit_error():
         look_angles(0.0, 2.0, 0.0)
     with pytest.raises(PlanningError, match="polarization 'circular'"):
         look_angles(0.0, 0.5, 0.0, polarization="circular")
+
+
+@settings(max_examples=60, deadline=None)
+@given(joint_angles, st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array),
+       st.floats(0.005, 0.05))
+def test_crr_step_properties(theta, omega, dt):
+    """One update from an exact attitude: CRR leaves a residual of higher order in the step
+    (only a 1-D family of increments is searched), the full correction none; eq. (6) loses
+    to the exact angular velocity."""
+    jac = ant.jacobian(theta)
+    if ant.weighted_singular_value(jac) < 0.2:
+        return  # near the singular set the first-order increments are ill-conditioned
+    n0 = ant.forward_kinematics(theta)
+    n1 = Rotation.from_rotvec(omega * dt).as_matrix() @ n0
+    step = np.linalg.norm(omega) * dt  # rad
+    _, log = ant.crr_step(theta, n0, n1, dt, omega_method="log")
+    _, eq6 = ant.crr_step(theta, n0, n1, dt, omega_method="eq6")
+    _, full = ant.crr_step(theta, n0, n1, dt, full_correction=True)
+    assert log.error_fro <= 2e-3 * step**2 + 1e-14
+    assert eq6.error_fro <= 0.2 * step**3 + 2e-3 * step**2 + 1e-14
+    assert full.error_fro < 1e-13
+    # Without an update the error would be the whole step: ||R - I||_F = 2 sqrt(2) sin(a / 2).
+    assert log.error_fro < 2e-3 * 2 * np.sqrt(2) * np.sin(step / 2) + 1e-14

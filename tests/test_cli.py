@@ -189,6 +189,9 @@ def test_antenna_sea_state_run_with_sea_options(tmp_path):
     (("antenna-paper-motion", "--hs", "4"), ("no sea state", "--hs")),
     (("hexapod-sync-move", "--heading", "90"), ("no sea state", "--heading")),
     (("antenna-sea-state", "--wind", "5"), ("no wind model",)),
+    (("antenna-sea-state", "--imu-rate", "30"), ("IMU rate 30 Hz", "whole number")),
+    (("antenna-paper-motion", "--imu-latency", "0.012"), ("IMU latency 0.012 s", "5 ms")),
+    (("loader-supply", "--no-prediction"), ("no IMU",)),
 ])
 def test_antenna_bad_options_exit_2(tmp_path, args, words):
     assert_one_line_error(planbench("run", *args, "--out", tmp_path / "x"), *words)
@@ -206,3 +209,16 @@ def test_antenna_plan(tmp_path):
     assert methods["error_fro_pinv"][-1] > 1e-3  # the drift of section 5.2
     assert methods["error_fro_crr"].max() < 1e-6 and methods["error_fro_crr_full"].max() < 1e-10
     assert (tmp_path / "p" / "methods.png").stat().st_size > 10_000
+
+
+def test_antenna_without_prediction_fails_the_paper_motion(tmp_path):
+    """--no-prediction: the 20 ms IMU latency and the 20 ms update interval become lag."""
+    proc = planbench("run", "antenna-paper-motion", "--no-prediction", "--imu-rate", "25",
+                     "--imu-latency", "0.04", "--duration", "3", "--out", tmp_path / "np", "--quiet")
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    summary = json.loads((tmp_path / "np" / "summary.json").read_text())
+    metrics = summary["metrics"]
+    assert metrics["prediction"] is False and metrics["imu_rate_hz"] == 25.0
+    assert metrics["imu_latency_s"] == 0.04 and metrics["planner_updates"] == 3 * 25 - 1
+    failed = {c["name"] for c in summary["checks"] if not c["passed"]}
+    assert "pointing_error_max" in failed
