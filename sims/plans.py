@@ -11,13 +11,15 @@ from sims.outputs import atomic_dir
 from sims.report import plan_plot
 
 PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
+MAX_PLAN_SAMPLES = 60_000  # longer plans are sampled coarser (a 300 s plan at 5 ms)
 
 
 def write_plan(scenario, out_dir: Path) -> Path:
     """Write plan.npz (t, position, velocity, acceleration, labels, key points), plan.png and
     the scenario's extra files."""
     trajectory = scenario.plan()
-    sample = trajectory.sample(control_ticks(trajectory.duration, PLAN_DT))
+    dt = max(PLAN_DT, trajectory.duration / MAX_PLAN_SAMPLES)
+    sample = trajectory.sample(control_ticks(trajectory.duration, dt))
     kinds = scenario.kinds()
     with atomic_dir(out_dir) as tmp:
         arrays = dict(t=sample.t, position=sample.position, velocity=sample.velocity,

@@ -91,6 +91,12 @@ def _joint_ids(model, names):
     return [model.joint(n).id for n in names]
 
 
+def _random_data(model, seed):
+    """(MjData at a random deck and antenna pose, deck, theta)."""
+    deck, theta = _random_pose(np.random.default_rng(seed))
+    return _data_at(model, deck, theta), deck, theta
+
+
 def _random_pose(rng):
     deck = np.array([rng.uniform(-5, 5), rng.uniform(-np.pi, np.pi), *rng.uniform(-1.0, 1.0, 2)])
     theta = np.array([rng.uniform(-np.pi, np.pi), rng.uniform(-3.0, 0.08),
@@ -116,12 +122,9 @@ def test_structure_names_and_order(model):
 
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 2**32 - 1))
-def test_world_from_deck_is_rz_rx_ry(seed):
+def test_world_from_deck_is_rz_rx_ry(model, seed):
     """Deck attitude = Rz(yaw) Rx(pitch) Ry(roll); the deck origin moves with heave only."""
-    model = models.load("antenna")
-    rng = np.random.default_rng(seed)
-    deck, theta = _random_pose(rng)
-    data = _data_at(model, deck, theta)
+    data, deck, theta = _random_data(model, seed)
     np.testing.assert_allclose(data.body("deck").xmat.reshape(3, 3), world_from_deck(*deck[1:]), atol=1e-12)
     np.testing.assert_allclose(data.body("deck").xpos, [0, 0, deck[0]], atol=1e-12)
     # The mast top (pedestal base) is MAST_TOP above the centre of rotation along the deck's up.
@@ -131,11 +134,8 @@ def test_world_from_deck_is_rz_rx_ry(seed):
 
 @settings(max_examples=50, deadline=None)
 @given(st.integers(0, 2**32 - 1))
-def test_dish_orientation_in_the_deck_frame_equals_f(seed):
-    model = models.load("antenna")
-    rng = np.random.default_rng(seed)
-    deck, theta = _random_pose(rng)
-    data = _data_at(model, deck, theta)
+def test_dish_orientation_in_the_deck_frame_equals_f(model, seed):
+    data, deck, theta = _random_data(model, seed)
     r_deck = data.body("deck").xmat.reshape(3, 3)
     r_dish = data.site("dish").xmat.reshape(3, 3)
     np.testing.assert_allclose(r_deck.T @ r_dish, f(theta), atol=1e-12)
