@@ -320,7 +320,7 @@ class AntennaController:
         self._new_log(n_ticks // self.period + 2)
         # The first sample is taken and used at t = 0 (the run starts in steady tracking).
         self._measure(0, data, lag=0.0)  # mj_forward just evaluated the sensors at t = 0
-        self._update(0, self.queue.popleft())
+        self._update(0, self.queue.popleft()[1])
 
     def _measure(self, tick: int, data, lag: float | None = None) -> None:
         sd = data.sensordata
@@ -338,7 +338,8 @@ class AntennaController:
             gyro = gyro + self.rng.normal(0.0, self.gyro_sigma, 3)
         # After mj_step the sensors hold the state at the start of its last physics step.
         lag = self.physics_dt if lag is None else lag
-        self.queue.append((tick * self.dt - lag, rotation, gyro))
+        arrival = tick + self.latency if tick > 0 else 0
+        self.queue.append((arrival, (tick * self.dt - lag, rotation, gyro)))
 
     def _update(self, tick: int, sample) -> None:
         start = time.perf_counter()
@@ -386,10 +387,10 @@ class AntennaController:
         data = physics.data.ptr
         if tick > 0 and tick % self.period == 0:
             self._measure(tick, data)
-        if self.queue and tick > 0 and self.queue[0][0] + self.physics_dt + self.latency * self.dt <= tick * self.dt + 1e-9:
-            sample = self.queue.popleft()
-            while self.queue and self.queue[0][0] + self.physics_dt + self.latency * self.dt <= tick * self.dt + 1e-9:
-                sample = self.queue.popleft()
+        sample = None
+        while self.queue and self.queue[0][0] <= tick:  # the newest sample that has arrived
+            sample = self.queue.popleft()[1]
+        if sample is not None:
             self._update(tick, sample)
         target = self._ramp(tick + 1) + self.lead * self._feedforward(tick + 1)
         data.ctrl[self.actuators] = (target - data.act[self.actuators]) / self.dt
