@@ -124,6 +124,45 @@ FAST = FastGeometry()
 FAST_LIMITS = FastLimits()
 
 
+def _paired_ring(radius: float, centres_deg, half_gap_deg: float, z: float) -> np.ndarray:
+    angles = [c + sign * half_gap_deg for c in centres_deg for sign in (-1.0, 1.0)]
+    return _ring(radius, angles, z)
+
+
+@dataclass(frozen=True)
+class StewartGeometry:
+    """The Stewart stabilizer between the A-B rotator and the feed platform (assumptions).
+
+    Not given by the paper or REFERENCE.md; chosen for a stabilizer inside a 13 m cabin that
+    carries the receivers (the 19-beam receiver's cryostat is about 1 t):
+      base_anchors: (6, 3) upper joints in the AB frame, m: pairs 30 deg apart around 0, 120,
+        240 deg on a 1.6 m radius, 1.5 m below the rotator's centre.
+      platform_anchors: (6, 3) lower joints in the S frame, m: pairs 30 deg apart around 60,
+        180, 300 deg on a 1.1 m radius, in the platform plane. Leg i joins base anchor i to
+        platform anchor (i + 1) mod 6's neighbour so the legs cross in the usual zig-zag.
+      stroke: +/- leg length change from nominal, m.
+    """
+
+    base_anchors: np.ndarray = field(default_factory=lambda: _paired_ring(1.6, [0, 120, 240], 15.0, -1.5))
+    platform_anchors: np.ndarray = field(default_factory=lambda: np.roll(
+        _paired_ring(1.1, [60, 180, 300], 15.0, 0.0), 1, axis=0))
+    stroke: float = 0.25
+
+
+STEWART = StewartGeometry()
+
+
+def stewart_leg_lengths(offset=None, rotation=None, geometry: FastGeometry = FAST,
+                        stewart: StewartGeometry = STEWART) -> np.ndarray:
+    """(..., 6) Stewart leg lengths, m, for a platform displaced by ``offset`` (..., 3) in the
+    AB frame and turned by ``rotation`` (..., 3, 3) from its nominal pose at r_AB-s (the same
+    leg formula as the cables and the hexapod, planners.legs)."""
+    position = geometry.r_ab_s if offset is None else geometry.r_ab_s + np.asarray(offset, dtype=float)
+    if rotation is None:
+        rotation = np.broadcast_to(np.eye(3), np.shape(position)[:-1] + (3, 3))
+    return leg_lengths(stewart.base_anchors, stewart.platform_anchors, position, rotation)
+
+
 # ----------------------------------------------------------------------------- rotations
 
 

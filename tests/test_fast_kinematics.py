@@ -156,3 +156,18 @@ def test_infeasible_pose_is_a_clear_error():
     s40 = fast.source_direction(0.0, np.radians(50.0))
     with pytest.raises(LimitError, match="below the minimum 400 kN"):
         fast.split_tilt(fast.feed_position(s40), s40, limits=strict)
+
+
+def test_stewart_legs_at_nominal_and_under_a_correction():
+    nominal = fast.stewart_leg_lengths()
+    np.testing.assert_allclose(nominal, nominal[0], rtol=1e-12)  # symmetric zig-zag
+    assert 1.5 < nominal[0] < 3.0
+    # A pure drop of the platform lengthens every leg by the same amount (to first order).
+    down = fast.stewart_leg_lengths(offset=[0.0, 0.0, -0.01])
+    np.testing.assert_allclose(down - nominal, (down - nominal)[0], rtol=1e-9)
+    assert (down - nominal)[0] > 0
+    # A sideways shift lengthens some legs and shortens others, within the stroke.
+    side = fast.stewart_leg_lengths(offset=[0.05, 0.0, 0.0]) - nominal
+    assert side.min() < 0 < side.max() and np.abs(side).max() < fast.STEWART.stroke
+    # Batched.
+    assert fast.stewart_leg_lengths(offset=np.zeros((7, 3))).shape == (7, 6)
