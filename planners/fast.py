@@ -445,3 +445,53 @@ def check_tensions(tensions, limits: FastLimits = FAST_LIMITS, times=None) -> No
             where = f" at t = {float(np.ravel(times)[i]):.3f} s" if times is not None else f" (pose {i})"
             raise LimitError(f"{CABLE_LABELS[j]} tension {t[i, j] / 1e3:.1f} kN{where} is {word} "
                              f"{limit / 1e3:.0f} kN: no cabin tilt keeps the cables in range")
+
+
+# ----------------------------------------------------------------------------- tilt law
+
+_TILT_LAWS: dict = {}
+
+
+class TiltLaw:
+    """The cabin tilt as a smooth function of the feed axis, for plans.
+
+    ``split_tilt`` on every sample of a plan would cost a golden-section search per sample and
+    its round-off would show in the rates. Instead the best split is computed once on a grid
+    of axis directions over the focal sphere (u, v) = (s_x, s_y), |(u, v)| = sin ZA, up to the
+    40 deg zenith angle (49 x 49 points; outside the limit the radially clamped value), and a
+    bicubic spline (scipy RectBivariateSpline) interpolates it, clipped to each pose's
+    admissible interval [max(0, ZA - ab_tilt), min(cabin_tilt, ZA)]. Tensions are always
+    computed for the actual pose.
+    """
+
+    def __init__(self, geometry: FastGeometry = FAST, limits: FastLimits = FAST_LIMITS,
+                 points: int = 49):
+        from scipy.interpolate import RectBivariateSpline
+
+        self.geometry, self.limits = geometry, limits
+        edge = math.sin(MAX_ZENITH_ANGLE)
+        grid = np.linspace(-edge, edge, points)
+        u, v = np.meshgrid(grid, grid, indexing="ij")
+        rho = np.minimum(np.hypot(u, v), edge)
+        scale = np.where(np.hypot(u, v) > 0, rho / np.maximum(np.hypot(u, v), 1e-300), 1.0)
+        uu, vv = u * scale, v * scale
+        axis = np.stack([uu, vv, np.sqrt(1.0 - uu**2 - vv**2)], axis=-1)
+        split = split_tilt(-FOCAL_SURFACE_RADIUS * axis, axis, geometry, limits, check=False)
+        self._spline = RectBivariateSpline(grid, grid, split.pose.cabin_tilt, kx=3, ky=3)
+
+    def __call__(self, axis) -> np.ndarray:
+        axis = np.asarray(axis, dtype=float)
+        axis = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+        tilt = self._spline(axis[..., 0].ravel(), axis[..., 1].ravel(), grid=False).reshape(axis.shape[:-1])
+        za = zenith_angle(axis)
+        lo = np.maximum(0.0, za - self.limits.ab_tilt)
+        hi = np.maximum(np.minimum(self.limits.cabin_tilt, za), lo)
+        return np.clip(tilt, lo, hi)
+
+
+def tilt_law(geometry: FastGeometry = FAST, limits: FastLimits = FAST_LIMITS) -> TiltLaw:
+    """The TiltLaw of a geometry and limits, built once per pair of objects."""
+    key = (id(geometry), id(limits))
+    if key not in _TILT_LAWS:
+        _TILT_LAWS[key] = (TiltLaw(geometry, limits), geometry, limits)  # keep them alive
+    return _TILT_LAWS[key][0]

@@ -714,8 +714,9 @@ def compare_methods(duration: float = PAPER_DURATION_S) -> dict:
             for key, (method, omega) in runs.items()}
 
 
-def write_method_comparison(out_dir) -> None:
-    """methods.npz and methods.png: the paper's Figures 2-8 for the three methods."""
+def write_method_comparison(plan, out_dir) -> None:
+    """methods.npz and methods.png: the paper's Figures 2-8 for the three methods (the
+    scenario's own plan is not needed: the comparison runs the paper's conditions)."""
     from pathlib import Path
 
     from sims.report import antenna_methods_plot

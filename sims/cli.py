@@ -165,7 +165,7 @@ def cmd_plan(args) -> int:
     from sims import outputs, plans, scenarios
 
     try:
-        scenario = scenarios.get(args.name)
+        scenario = scenarios.get_plan(args.name)
     except ValueError as e:
         raise BadInput(str(e)) from None
     outputs.check_writable(args.out, "output dir")

@@ -33,5 +33,5 @@ def write_plan(scenario, out_dir: Path) -> Path:
         plan_plot(sample, trajectory.labels, kinds, tmp / "plan.png",
                   title=f"{scenario.name}: planned motion", key_times=key_times, key_points=key_points)
         if scenario.plan_extras is not None:
-            scenario.plan_extras(tmp)
+            scenario.plan_extras(trajectory, tmp)
     return Path(out_dir)

@@ -202,3 +202,47 @@ def antenna_methods_plot(paths: dict, path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def fast_plan_figure(plan, t: np.ndarray, path) -> None:
+    """The paper's Figures 16-17 for a FAST plan: the feed's speed and acceleration (with each
+    segment's limit), one cable's rate and acceleration, the tensions and tilts."""
+    state = plan.state(t)
+    sample = plan.sample(t)
+    fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
+    for seg in plan.segments:
+        for ax in axes.flat:
+            ax.axvline(seg.t0, color="0.85", lw=0.6)
+    ax = axes[0, 0]
+    ax.plot(t, 1e3 * np.linalg.norm(state.feed_velocity, axis=1), label="|v|")
+    for j, c in enumerate("xyz"):
+        ax.plot(t, 1e3 * state.feed_velocity[:, j], lw=0.7, label=f"v{c}")
+    ax.set(title="feed velocity (Fig. 16 left)", xlabel="t [s]", ylabel="mm/s")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    ax.plot(t, 1e3 * np.linalg.norm(state.feed_acceleration, axis=1), label="|a|")
+    limit = np.array([plan.segments[k].accel_limit for k in state.segment])
+    ax.plot(t, 1e3 * limit, "r", lw=0.8, label="segment limit")
+    ax.set(title="feed acceleration (Fig. 16 right)", xlabel="t [s]", ylabel="mm/s²")
+    ax.legend(fontsize=8)
+    ax = axes[1, 0]
+    ax.plot(t, 1e3 * sample.velocity[:, 7], label="cable1 rate [mm/s]")
+    ax.plot(t, 1e3 * sample.acceleration[:, 7], label="cable1 acceleration [mm/s²]")
+    ax.set(title="one cable (Fig. 17)", xlabel="t [s]")
+    ax.legend(fontsize=8)
+    ax = axes[1, 1]
+    ax.plot(t, state.tension.min(axis=1) / 1e3, label="smallest tension [kN]")
+    ax.plot(t, state.tension.max(axis=1) / 1e3, label="largest tension [kN]")
+    ax.axhline(plan.limits.tension_min / 1e3, color="r", lw=0.8)
+    twin = ax.twinx()
+    twin.plot(t, np.rad2deg(state.zenith_angle), "k--", lw=0.8, label="zenith angle")
+    twin.plot(t, np.rad2deg(state.cabin_tilt), "k:", lw=0.8, label="cabin tilt")
+    twin.set_ylabel("deg")
+    twin.legend(fontsize=8, loc="lower right")
+    ax.set(title="static cable tensions, zenith angle, cabin tilt", xlabel="t [s]", ylabel="kN")
+    ax.legend(fontsize=8, loc="upper left")
+    for a in axes.flat:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
-from sims import antenna, hexapod, loader
+from sims import antenna, fast, hexapod, loader
 
 
 @dataclass(frozen=True)
@@ -48,8 +48,8 @@ class Scenario:
       expect_pass: False for a scenario that demonstrates a failure (loader-direct).
       camera: the default camera of its video.
       kinds: () -> "slide" or "hinge" per planned channel (units of plots).
-      plan_extras: optional (out_dir) -> None, more files for ``planbench plan`` (the
-        antenna's comparison of the paper's methods).
+      plan_extras: optional (plan, out_dir) -> None, more files for ``planbench plan`` (the
+        antenna's comparison of the paper's methods, FAST's figures).
     """
 
     name: str
@@ -126,3 +126,37 @@ def get(name: str) -> Scenario:
         raise ValueError(
             f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}"
         ) from None
+
+
+#: Plans without a MuJoCo run yet (the FAST model is issue 6): ``planbench plan`` only.
+PLANS: dict[str, Scenario] = {
+    s.name: s
+    for s in (
+        Scenario(
+            "fast-tracking",
+            "FAST feed: park -> 3C 286 (straight line + focal arc), start, 20 min of tracking across its transit, termination",
+            None,
+            fast.tracking_plan,
+            kinds=fast.plan_kinds,
+            plan_extras=fast.write_figures,
+        ),
+        Scenario(
+            "fast-source-switch",
+            "FAST feed: park -> 3C 286, 5 min of tracking, switch along the focal surface to 3C 295, 5 min of tracking",
+            None,
+            fast.source_switch_plan,
+            kinds=fast.plan_kinds,
+            plan_extras=fast.write_figures,
+        ),
+    )
+}
+
+
+def get_plan(name: str) -> Scenario:
+    """A scenario or a plan-only entry called ``name`` (``planbench plan``)."""
+    if name in PLANS:
+        return PLANS[name]
+    try:
+        return get(name)
+    except ValueError:
+        raise ValueError(f"unknown scenario {name!r}; known: {', '.join([*SCENARIOS, *PLANS])}") from None

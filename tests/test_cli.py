@@ -222,3 +222,20 @@ def test_antenna_without_prediction_fails_the_paper_motion(tmp_path):
     assert metrics["imu_latency_s"] == 0.04 and metrics["planner_updates"] == 3 * 25 - 1
     failed = {c["name"] for c in summary["checks"] if not c["passed"]}
     assert "pointing_error_max" in failed
+
+
+@pytest.mark.parametrize("name", ["fast-tracking", "fast-source-switch"])
+def test_fast_plans(tmp_path, name):
+    out = tmp_path / name
+    proc = planbench("plan", name, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    assert {p.name for p in out.iterdir()} == {"plan.npz", "plan.png", "figures.png", "segments.json"}
+    plan = np.load(out / "plan.npz")
+    assert list(plan["labels"][:3]) == ["feed_x", "feed_y", "feed_z"] and plan["position"].shape[1] == 13
+    assert np.linalg.norm(plan["velocity"][:, :3], axis=1).max() <= 0.4 + 1e-12
+    segments = json.loads((out / "segments.json").read_text())["segments"]
+    assert segments[0]["name"] == "switch-line" and any(s["name"] == "termination" for s in segments)
+
+
+def test_fast_plan_cannot_run_yet(tmp_path):
+    assert_one_line_error(planbench("run", "fast-tracking", "--out", tmp_path / "x"), "unknown scenario")

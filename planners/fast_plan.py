@@ -1,0 +1,485 @@
+"""FAST feed support: the complete motion plan (the paper's section 3).
+
+Paper: Yao et al. 2020 (``shared/papers/fast-feed-support-motion-planning.txt``). A plan is a
+sequence of feed segments (Figure 5): source switching P0 -> Ph (a straight line to the closest
+focal-surface point) -> P1 (along the focal surface), start planning P1 -> Ps, the observation
+Ps -> Pt (tracking, or a motion scan with transition segments), termination planning Pt -> P2.
+Every segment's speed along its path is a profile of ``planners.profiles`` (first-degree
+acceleration, Figure 6) except the observation, which follows the sky.
+
+From the feed position the rest follows (planners.fast): the feed axis points along the
+focal-sphere radius (P_feed = -r s), the tilt is split between the cabin and the A-B rotator
+by the smooth tilt law (``fast.tilt_law``: the max-min-tension split tabulated over the sky),
+eq. (3)-(9) give the cabin pose and the A-B angles, the cable lengths and
+static tensions follow, and the Stewart stabilizer sits at its nominal pose (its corrections
+are the controller's, issue 6).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import CubicHermiteSpline, CubicSpline
+
+from planners import fast
+from planners import profiles as prof
+from planners.errors import LimitError, PlanningError
+from planners.trajectory import TrajectorySample
+
+R_FOCAL = fast.FOCAL_SURFACE_RADIUS
+MIN_LENGTH = 1e-6  # m: shorter lines and arcs are left out of a switch
+
+
+@dataclass(frozen=True)
+class MechanismLimits:
+    """Speed and acceleration limits of the angular mechanisms for eq. (10).
+
+    Not given by the paper or REFERENCE.md; assumptions for mechanisms that carry a 30 t cabin
+    (the cabin's tilt through its cables) and the rotators inside it, a few times slower than
+    the feed's switching motion in angle:
+      cabin: the cable robot's tilt, rad/s and rad/s^2 (0.2 deg/s, 0.02 deg/s^2);
+      ab: the A-B rotator's axes (0.5 deg/s, 0.05 deg/s^2);
+      multifeed: the 19-beam receiver's rotation (1 deg/s, 0.1 deg/s^2).
+    """
+
+    cabin_rate: float = math.radians(0.2)
+    cabin_accel: float = math.radians(0.02)
+    ab_rate: float = math.radians(0.5)
+    ab_accel: float = math.radians(0.05)
+    multifeed_rate: float = math.radians(1.0)
+    multifeed_accel: float = math.radians(0.1)
+
+
+MECHANISM_LIMITS = MechanismLimits()
+
+
+# ----------------------------------------------------------------------------- segments
+
+
+@dataclass
+class Segment:
+    """One piece of the feed's path, at absolute times [t0, t0 + duration].
+
+    ``accel_limit`` is the paper's acceleration limit of this kind of segment (Table 1).
+    ``evaluate(tau)`` gives position, velocity, acceleration (n, 3) at local times tau.
+    """
+
+    name: str
+    t0: float
+    duration: float
+    accel_limit: float
+
+    def evaluate(self, tau):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @property
+    def t1(self) -> float:
+        return self.t0 + self.duration
+
+
+@dataclass
+class LineSegment(Segment):
+    """A straight line from ``start`` to ``end`` with a speed profile along it."""
+
+    start: np.ndarray = None
+    end: np.ndarray = None
+    profile: prof.Profile = None
+
+    def evaluate(self, tau):
+        d = self.end - self.start
+        length = float(np.linalg.norm(d))
+        unit = d / length if length > 0 else np.zeros(3)
+        p = self.profile.evaluate(tau)
+        return (self.start + p.position[:, None] * unit, p.velocity[:, None] * unit,
+                p.acceleration[:, None] * unit)
+
+
+@dataclass
+class ArcSegment(Segment):
+    """A great-circle arc of the focal sphere from ``start`` toward ``direction`` (unit tangent
+    at the start), with a speed profile in arc length (m)."""
+
+    start: np.ndarray = None
+    direction: np.ndarray = None
+    profile: prof.Profile = None
+    radius: float = R_FOCAL
+
+    def evaluate(self, tau):
+        a = self.start / np.linalg.norm(self.start)
+        c = self.direction / np.linalg.norm(self.direction)
+        p = self.profile.evaluate(tau)
+        angle = p.position / self.radius
+        cos, sin = np.cos(angle)[:, None], np.sin(angle)[:, None]
+        radial = cos * a + sin * c
+        tangent = -sin * a + cos * c
+        pos = self.radius * radial
+        vel = p.velocity[:, None] * tangent
+        acc = p.acceleration[:, None] * tangent - (p.velocity**2 / self.radius)[:, None] * radial
+        return pos, vel, acc
+
+
+@dataclass
+class SampledSegment(Segment):
+    """A path given by samples (the observation, the transitions): a C2 cubic spline (scipy)
+    through feed positions at local times; velocity and acceleration are its derivatives."""
+
+    spline: CubicSpline = None
+
+    def evaluate(self, tau):
+        s = self.spline
+        return s(tau), s(tau, 1), s(tau, 2)
+
+
+def tangential_limit(a_max: float, v_max: float, radius: float = R_FOCAL) -> float:
+    """The along-path acceleration limit on a focal arc: |a|^2 = a_t^2 + (v^2 / r)^2 must stay
+    under a_max^2 at speeds up to v_max (at 400 mm/s the centripetal part is 0.99 mm/s^2)."""
+    centripetal = v_max * v_max / radius
+    if centripetal >= a_max:
+        raise LimitError(f"speed {v_max:g} m/s on the focal sphere needs {centripetal:g} m/s^2 "
+                         f"of centripetal acceleration, beyond the limit {a_max:g} m/s^2")
+    return math.sqrt(a_max * a_max - centripetal * centripetal)
+
+
+def _arc_between(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
+    """(unit tangent at a toward b, arc length on the focal sphere)."""
+    ua, ub = a / np.linalg.norm(a), b / np.linalg.norm(b)
+    angle = math.atan2(np.linalg.norm(np.cross(ua, ub)), float(ua @ ub))
+    tangent = ub - (ua @ ub) * ua
+    norm = np.linalg.norm(tangent)
+    if norm < 1e-15:
+        return np.zeros(3), 0.0
+    return tangent / norm, R_FOCAL * angle
+
+
+# ----------------------------------------------------------------------------- switching
+
+
+@dataclass(frozen=True)
+class SwitchTimes:
+    """Eq. (10) and its parts, s."""
+
+    t_p_line: float
+    t_cable_line: float
+    t_ab_line: float
+    t_multifeed_line: float
+    t_line: float
+    t_focal: float
+    t_ab: float
+    t_multifeed: float
+
+
+def _tilt_state(point: np.ndarray, geometry, limits):
+    """(cabin tilt, (theta_A, theta_B)) at a feed point, the axis along the focal radius."""
+    axis = -point / np.linalg.norm(point)
+    pose = fast.cabin_pose(point, axis, fast.tilt_law(geometry, limits)(axis), geometry)
+    return float(pose.cabin_tilt), (float(pose.theta_a), float(pose.theta_b))
+
+
+def switch_times(p0, p1, multifeed0: float = 0.0, multifeed1: float = 0.0,
+                 mechanisms: MechanismLimits = MECHANISM_LIMITS,
+                 geometry: fast.FastGeometry = fast.FAST,
+                 limits: fast.FastLimits = fast.FAST_LIMITS) -> SwitchTimes:
+    """Segment times of a source switch P0 -> Ph -> P1 (section 3.2, eq. 10).
+
+    T_focal: the feed's minimum time along the focal arc Ph -> P1 (V_s-max, A_s-max).
+    T_line = max(T_p-line, T_cable-line, T_AB-line, T_multifeed-line): the feed's time on the
+    line P0 -> Ph; the cable robot's tilt change on the line; the A-B rotator's whole switching
+    time T_AB (its larger angle change P0 -> P1) less T_focal; the same for the multi-feed
+    rotation.
+    """
+    p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
+    ph = fast.closest_focal_point(p0)
+    _, arc = _arc_between(ph, p1)
+    a_arc = tangential_limit(fast.A_S_MAX, fast.V_S_MAX)
+    t_focal = prof.min_move_time(arc, fast.V_S_MAX, a_arc) if arc > MIN_LENGTH else 0.0
+    line = float(np.linalg.norm(ph - p0))
+    t_p_line = prof.min_move_time(line, fast.V_S_MAX, fast.A_S_MAX) if line > MIN_LENGTH else 0.0
+    tilt0, ab0 = _tilt_state(p0, geometry, limits)
+    tilt_h, _ = _tilt_state(ph, geometry, limits)
+    _, ab1 = _tilt_state(p1, geometry, limits)
+    d_tilt = abs(tilt_h - tilt0)
+    t_cable = prof.min_move_time(d_tilt, mechanisms.cabin_rate, mechanisms.cabin_accel) if d_tilt > 0 else 0.0
+    d_ab = max(abs(ab1[0] - ab0[0]), abs(ab1[1] - ab0[1]))
+    t_ab = prof.min_move_time(d_ab, mechanisms.ab_rate, mechanisms.ab_accel) if d_ab > 0 else 0.0
+    d_mf = abs(multifeed1 - multifeed0)
+    t_mf = prof.min_move_time(d_mf, mechanisms.multifeed_rate, mechanisms.multifeed_accel) if d_mf > 0 else 0.0
+    t_ab_line = max(t_ab - t_focal, 0.0)
+    t_mf_line = max(t_mf - t_focal, 0.0)
+    t_line = max(t_p_line, t_cable, t_ab_line, t_mf_line)
+    return SwitchTimes(t_p_line, t_cable, t_ab_line, t_mf_line, t_line, t_focal, t_ab, t_mf)
+
+
+def switch_segments(p0, p1, t0: float = 0.0, **kwargs) -> tuple[list[Segment], SwitchTimes]:
+    """The source switch P0 -> Ph (line) -> P1 (focal arc), each from rest to rest."""
+    p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
+    times = switch_times(p0, p1, **kwargs)
+    ph = fast.closest_focal_point(p0)
+    segments: list[Segment] = []
+    line = float(np.linalg.norm(ph - p0))
+    if line > MIN_LENGTH:
+        profile = prof.move_in_time(line, times.t_line, fast.V_S_MAX, fast.A_S_MAX)
+        segments.append(LineSegment("switch-line", t0, times.t_line, fast.A_S_MAX, p0, ph, profile))
+        t0 += times.t_line
+    direction, arc = _arc_between(ph, p1)
+    if arc > MIN_LENGTH:
+        profile = prof.move_min_time(arc, fast.V_S_MAX, tangential_limit(fast.A_S_MAX, fast.V_S_MAX))
+        segments.append(ArcSegment("switch-focal", t0, profile.duration, fast.A_S_MAX, ph, direction, profile))
+    return segments, times
+
+
+# ----------------------------------------------------------------------------- start, stop
+
+
+def start_segment(observation: Segment, a_max: float = fast.A_MAX) -> ArcSegment:
+    """Start planning (section 3.1): from rest at P1 along the focal sphere to the
+    observation's first point Ps, arriving with its velocity (one pulse of peak A_max)."""
+    ps, vs, _ = (x[0] for x in observation.evaluate(np.array([0.0])))
+    speed = float(np.linalg.norm(vs))
+    if speed == 0.0:
+        raise PlanningError("the observation starts at rest: no start segment is needed")
+    profile = prof.velocity_change(0.0, speed, tangential_limit(a_max, speed))
+    length = profile.end_position
+    # Back along the great circle through Ps tangent to the observation's velocity.
+    tangent = vs / speed
+    angle = length / R_FOCAL
+    a = ps / np.linalg.norm(ps)
+    p1 = R_FOCAL * (math.cos(angle) * a - math.sin(angle) * tangent)
+    direction = math.cos(angle) * tangent + math.sin(angle) * a  # the arc's tangent at P1
+    return ArcSegment("start", observation.t0 - profile.duration, profile.duration, a_max, p1,
+                      direction, profile)
+
+
+def termination_segment(observation: Segment, a_max: float = fast.A_MAX) -> ArcSegment:
+    """Termination planning (section 3.1): from the observation's end Pt with its velocity
+    along the focal sphere to rest at P2."""
+    pt, vt, _ = (x[0] for x in observation.evaluate(np.array([observation.duration])))
+    speed = float(np.linalg.norm(vt))
+    if speed == 0.0:
+        raise PlanningError("the observation ends at rest: no termination segment is needed")
+    profile = prof.velocity_change(speed, 0.0, tangential_limit(a_max, speed))
+    return ArcSegment("termination", observation.t1, profile.duration, a_max, pt, vt / speed, profile)
+
+
+# ----------------------------------------------------------------------------- observation
+
+
+def observation_segment(times, directions, t0: float = 0.0, name: str = "observation",
+                        a_max: float = fast.A_MAX) -> SampledSegment:
+    """The feed following a sky path: P_feed = -r s(t) through a cubic spline in time."""
+    times = np.asarray(times, dtype=float)
+    points = fast.feed_position(np.asarray(directions, dtype=float))
+    spline = CubicSpline(times - times[0], points, axis=0)
+    return SampledSegment(name, t0, float(times[-1] - times[0]), a_max, spline)
+
+
+def transition_segment(p0, v0, p1, v1, duration: float, t0: float,
+                       a_limit: float = fast.A_T_MAX, name: str = "transition") -> SampledSegment:
+    """A transition between two observation legs (section 3.3): the cubic Hermite curve from
+    (P, V) at one leg's end to (P, V) at the next leg's start in ``duration``, projected on the
+    focal sphere, as a spline on a 0.5 s grid."""
+    n = max(int(math.ceil(duration / 0.5)), 4) + 1
+    tau = np.linspace(0.0, duration, n)
+    hermite = CubicHermiteSpline([0.0, duration], np.stack([p0, p1]), np.stack([v0, v1]), axis=0)
+    points = hermite(tau)
+    points = R_FOCAL * points / np.linalg.norm(points, axis=1, keepdims=True)
+    spline = CubicSpline(tau, points, axis=0, bc_type=((1, np.asarray(v0)), (1, np.asarray(v1))))
+    return SampledSegment(name, t0, duration, a_limit, spline)
+
+
+def hermite_peak_acceleration(p0, v0, p1, v1, duration: float) -> float:
+    """Largest |acceleration| of the cubic Hermite between two states (its ends: linear a)."""
+    p0, v0, p1, v1 = (np.asarray(x, dtype=float) for x in (p0, v0, p1, v1))
+    T = duration
+    a0 = (6 * (p1 - p0) - T * (4 * v0 + 2 * v1)) / T**2
+    a1 = (-6 * (p1 - p0) + T * (2 * v0 + 4 * v1)) / T**2
+    return float(max(np.linalg.norm(a0), np.linalg.norm(a1)))
+
+
+def transition_time(p0, v0, p1, v1, a_limit: float = fast.A_T_MAX) -> float:
+    """The shortest transition time whose Hermite curve keeps |a| <= a_limit (bisection)."""
+    lo, hi = 1e-3, 1.0
+    while hermite_peak_acceleration(p0, v0, p1, v1, hi) > a_limit:
+        hi *= 2.0
+        if hi > 1e5:
+            raise LimitError("no transition within 1e5 s keeps the acceleration under "
+                             f"{a_limit * 1e3:.1f} mm/s^2")
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if hermite_peak_acceleration(p0, v0, p1, v1, mid) > a_limit:
+            lo = mid
+        else:
+            hi = mid
+    return hi
+
+
+# ----------------------------------------------------------------------------- the paper's fits
+
+
+def paper_ra_scan_fits(v_dec_deg_h: float, t2: float) -> dict:
+    """Eq. (11)-(14), the motion scan along right ascension: units as printed.
+
+    V_m = 0.008 V_dec^2 + 0.292 V_dec + 10.19 (mm/s, V_dec in deg/h), p_m = 0.079 V_dec -
+    0.0133, V_c = -0.71 * 60 / t2 + 10.68 (mm/s, t2 in s), l_2 = 0.5 t2 V_c (mm).
+    """
+    v_m = 0.008 * v_dec_deg_h**2 + 0.292 * v_dec_deg_h + 10.19
+    p_m = 0.079 * v_dec_deg_h - 0.0133
+    v_c = -0.71 * 60.0 / t2 + 10.68
+    return {"V_m_mm_s": v_m, "p_m": p_m, "V_c_mm_s": v_c, "l_2_mm": 0.5 * t2 * v_c}
+
+
+def paper_dec_scan_t2(v_asc: float, a_max_mm_s2: float = fast.A_MAX * 1e3,
+                      a_s_max_mm_s2: float = fast.A_S_MAX * 1e3) -> dict:
+    """Eq. (15)-(20), the motion scan along declination; units as printed (mm/s, s, deg/h).
+
+    V_m = -0.751 V_asc + 11.3, V_m-inv = 0.751 V_asc + 11.3, t3 = 2 V_m / A_max +
+    2 V_m-inv / A_max, V_dec = 60 / t3, V_D = 0.008 V_dec^2 + 0.292 V_dec + 10.19 and
+    t2 = ((2 A t3 + 8 V_D) + sqrt((2 A t3 + 8 V_D)^2 - 4 (A t3)^2)) / (2 A) with A = A_Smax.
+    """
+    v_m = -0.751 * v_asc + 11.3
+    v_m_inv = 0.751 * v_asc + 11.3
+    t3 = 2 * v_m / a_max_mm_s2 + 2 * v_m_inv / a_max_mm_s2
+    v_dec = 60.0 / t3
+    v_d = 0.008 * v_dec**2 + 0.292 * v_dec + 10.19
+    a = a_s_max_mm_s2
+    b = 2 * a * t3 + 8 * v_d
+    t2 = (b + math.sqrt(b * b - 4 * (a * t3) ** 2)) / (2 * a)
+    return {"V_m_mm_s": v_m, "V_m_inv_mm_s": v_m_inv, "t3_s": t3, "V_dec_deg_h": v_dec,
+            "V_D_mm_s": v_d, "t2_s": t2}
+
+
+# ----------------------------------------------------------------------------- the plan
+
+PLAN_LABELS = ("feed_x", "feed_y", "feed_z", "cabin_tilt", "theta_a", "theta_b", "multifeed",
+               *fast.CABLE_LABELS)
+PLAN_KINDS = ("slide",) * 3 + ("hinge",) * 4 + ("slide",) * 6
+RATE_STEP = 0.01  # s: central differences of the derived channels' rates
+
+
+@dataclass(frozen=True)
+class FastPlanSample:
+    """Everything a plan commands at the times t (arrays over t).
+
+    feed, feed_velocity, feed_acceleration: (n, 3) m, m/s, m/s^2; axis: (n, 3) unit;
+    zenith_angle, cabin_tilt, ab_tilt, phi, theta_a, theta_b, multifeed: (n,) rad;
+    cabin_rotation: (n, 3, 3); ab_point, cabin_origin: (n, 3) m; cable_length, tension,
+    stewart_leg: (n, 6) m, N, m; segment: (n,) index of the segment.
+    """
+
+    t: np.ndarray
+    segment: np.ndarray
+    feed: np.ndarray
+    feed_velocity: np.ndarray
+    feed_acceleration: np.ndarray
+    axis: np.ndarray
+    zenith_angle: np.ndarray
+    cabin_tilt: np.ndarray
+    ab_tilt: np.ndarray
+    phi: np.ndarray
+    theta_a: np.ndarray
+    theta_b: np.ndarray
+    multifeed: np.ndarray
+    cabin_rotation: np.ndarray
+    ab_point: np.ndarray
+    cabin_origin: np.ndarray
+    cable_length: np.ndarray
+    tension: np.ndarray
+    stewart_leg: np.ndarray
+
+
+@dataclass
+class FastPlan:
+    """A complete plan: segments end to end from t = 0, and the multi-feed rotation.
+
+    ``sample(t)`` follows the repo's Trajectory contract with the channels PLAN_LABELS (feed
+    position, cabin tilt, A-B angles, multi-feed angle, six cable lengths); ``state(t)`` gives
+    everything (FastPlanSample). The feed's velocity and acceleration are the segments'
+    derivatives; those of the derived channels are central differences over RATE_STEP.
+    """
+
+    segments: list
+    multifeed: prof.Profile | None = None
+    geometry: fast.FastGeometry = fast.FAST
+    limits: fast.FastLimits = fast.FAST_LIMITS
+    info: dict = field(default_factory=dict)
+    labels: tuple = PLAN_LABELS
+
+    def __post_init__(self):
+        t = 0.0
+        for seg in self.segments:
+            seg.t0 = t
+            t += seg.duration
+        self._breaks = np.array([s.t0 for s in self.segments] + [t])
+
+    @property
+    def duration(self) -> float:
+        return float(self._breaks[-1])
+
+    def segment_table(self) -> list[dict]:
+        return [{"name": s.name, "t0": s.t0, "duration": s.duration, "accel_limit": s.accel_limit}
+                for s in self.segments]
+
+    def feed(self, t):
+        """(index, position, velocity, acceleration) of the feed at times t (s)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        index = np.clip(np.searchsorted(self._breaks, t, side="right") - 1, 0, len(self.segments) - 1)
+        pos, vel, acc = np.empty((t.size, 3)), np.empty((t.size, 3)), np.empty((t.size, 3))
+        for k in np.unique(index):
+            seg = self.segments[k]
+            mask = index == k
+            tau = np.clip(t[mask] - seg.t0, 0.0, seg.duration)
+            pos[mask], vel[mask], acc[mask] = seg.evaluate(tau)
+            outside = (t[mask] < seg.t0) | (t[mask] > seg.t1)
+            if outside.any():  # before the plan or after it: at rest
+                vel[np.flatnonzero(mask)[outside]] = 0.0
+                acc[np.flatnonzero(mask)[outside]] = 0.0
+        return index, pos, vel, acc
+
+    def _multifeed(self, t):
+        if self.multifeed is None:
+            return np.zeros(t.size)
+        return self.multifeed.evaluate(np.clip(t, 0.0, self.multifeed.duration)).position
+
+    def state(self, t) -> FastPlanSample:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        index, pos, vel, acc = self.feed(t)
+        axis = -pos / np.linalg.norm(pos, axis=1, keepdims=True)
+        tilt = fast.tilt_law(self.geometry, self.limits)(axis)
+        p = fast.cabin_pose(pos, axis, tilt, self.geometry)
+        lengths = fast.cable_lengths(p.origin, p.rotation, self.geometry)
+        tensions = fast.cable_tensions(p.origin, p.rotation, self.geometry)
+        stewart = np.broadcast_to(fast.stewart_leg_lengths(), (t.size, 6))
+        return FastPlanSample(t, index, pos, vel, acc, axis, fast.zenith_angle(axis), p.cabin_tilt,
+                              p.ab_tilt, p.phi, p.theta_a, p.theta_b, self._multifeed(t), p.rotation,
+                              p.ab_point, p.origin, lengths, tensions, stewart.copy())
+
+    def _channels(self, t) -> np.ndarray:
+        s = self.state(t)
+        return np.column_stack([s.feed, s.cabin_tilt, s.theta_a, s.theta_b, s.multifeed, s.cable_length])
+
+    def sample(self, t) -> TrajectorySample:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        h = RATE_STEP
+        mid, plus, minus = self._channels(t), self._channels(t + h), self._channels(t - h)
+        velocity = (plus - minus) / (2 * h)
+        acceleration = (plus - 2 * mid + minus) / (h * h)
+        _, _, vel, acc = self.feed(t)
+        velocity[:, :3], acceleration[:, :3] = vel, acc
+        return TrajectorySample(t, mid, velocity, acceleration)
+
+    def check(self, t=None, dt: float = 0.01) -> None:
+        """LimitError if the plan breaks a limit at its samples (default every 10 ms):
+        zenith angle, tensions, tilts, each segment's feed acceleration limit."""
+        t = np.arange(0.0, self.duration + 1e-9, dt) if t is None else np.asarray(t)
+        s = self.state(t)
+        fast.check_zenith_angle(s.axis, times=t)
+        fast.check_tensions(s.tension, self.limits, times=t)
+        acc = np.linalg.norm(s.feed_acceleration, axis=1)
+        limit = np.array([self.segments[k].accel_limit for k in s.segment])
+        bad = np.flatnonzero(acc > limit * (1 + 1e-6))
+        if bad.size:
+            i = int(bad[0])
+            raise LimitError(f"feed acceleration {acc[i] * 1e3:.3f} mm/s^2 at t = {t[i]:.2f} s on the "
+                             f"{self.segments[s.segment[i]].name} segment is beyond its limit "
+                             f"{limit[i] * 1e3:.1f} mm/s^2")
