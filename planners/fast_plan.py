@@ -483,3 +483,70 @@ class FastPlan:
             raise LimitError(f"feed acceleration {acc[i] * 1e3:.3f} mm/s^2 at t = {t[i]:.2f} s on the "
                              f"{self.segments[s.segment[i]].name} segment is beyond its limit "
                              f"{limit[i] * 1e3:.1f} mm/s^2")
+
+
+# ----------------------------------------------------------------------------- motion scans
+
+
+def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX):
+    """Observation legs and transitions of a motion scan (section 3.3).
+
+    ``scan``: a planners.fast_sky.MotionScan; ``start``: its start UTC. Each leg follows the
+    sky (``observation_segment``); between legs a transition of the scan's t2 joins the end
+    state of one leg to the start state of the next (``transition_segment``). Raises
+    LimitError when a transition would need more than ``a_limit`` (A_t-max).
+    """
+    path = scan.path(start, step=step)
+    directions = path.directions()
+    legs = []
+    for k in range(scan.n_legs):
+        mask = (path.t >= scan.leg_start[k] - 1e-9) & (path.t <= scan.leg_end[k] + 1e-9)
+        legs.append(observation_segment(path.t[mask], directions[mask], name=f"leg {k + 1}"))
+    segments = [legs[0]]
+    peaks = []
+    for k in range(1, scan.n_legs):
+        a, b = legs[k - 1], legs[k]
+        p0, v0, _ = (x[0] for x in a.evaluate(np.array([a.duration])))
+        p1, v1, _ = (x[0] for x in b.evaluate(np.array([0.0])))
+        peak = hermite_peak_acceleration(p0, v0, p1, v1, scan.t2)
+        peaks.append(peak)
+        if peak > a_limit:
+            need = transition_time(p0, v0, p1, v1, a_limit)
+            raise LimitError(f"transition {k} needs {peak * 1e3:.2f} mm/s^2 in t2 = {scan.t2:.1f} s, "
+                             f"beyond A_t-max {a_limit * 1e3:.1f} mm/s^2; t2 >= {need:.1f} s keeps it")
+        segments += [transition_segment(p0, v0, p1, v1, scan.t2, 0.0, a_limit, f"transition {k}"), b]
+    return segments, path, peaks
+
+
+def _transition_peaks(scan, start, step: float) -> list[float]:
+    """Peak Hermite accelerations of a scan's transitions (m/s^2)."""
+    path = scan.path(start, step=step)
+    directions = path.directions()
+    legs = []
+    for k in range(scan.n_legs):
+        mask = (path.t >= scan.leg_start[k] - 1e-9) & (path.t <= scan.leg_end[k] + 1e-9)
+        legs.append(observation_segment(path.t[mask], directions[mask]))
+    peaks = []
+    for a, b in zip(legs, legs[1:]):
+        p0, v0, _ = (x[0] for x in a.evaluate(np.array([a.duration])))
+        p1, v1, _ = (x[0] for x in b.evaluate(np.array([0.0])))
+        peaks.append(hermite_peak_acceleration(p0, v0, p1, v1, scan.t2))
+    return peaks
+
+
+def minimum_t2(make_scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX,
+               tolerance: float = 0.01) -> float:
+    """The shortest t2 (to ``tolerance`` s) whose transitions all keep |a| <= A_t-max: the
+    geometric t2. ``make_scan(t2)`` builds the MotionScan; the sky turns during t2, so the
+    legs' end states depend on it and every trial rebuilds the raster (bisection)."""
+    feasible = lambda t2: max(_transition_peaks(make_scan(t2), start, step), default=0.0) <= a_limit
+    lo, hi = 0.0, 1.0
+    while not feasible(hi):
+        lo, hi = hi, 2.0 * hi
+        if hi > 1e4:
+            raise LimitError(f"no transition time up to 1e4 s keeps the acceleration under "
+                             f"{a_limit * 1e3:.1f} mm/s^2")
+    while hi - lo > tolerance:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if feasible(mid) else (mid, hi)
+    return hi

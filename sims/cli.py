@@ -182,6 +182,8 @@ def cmd_bench(args) -> int:
     print(bench.format_planning(bench.planning_throughput()))
     print()
     print(bench.format_antenna(bench.antenna_update_rate()))
+    print()
+    print(bench.format_fast(bench.fast_plan_rate()))
     return EXIT_OK
 
 

@@ -5,6 +5,14 @@ Plans (planners.fast_plan), all at the FAST site with pyerfa (planners.fast_sky)
                       tracking centred on its transit, termination
   fast-source-switch  park -> 3C 286, 5 min of tracking, termination, switch (focal arc) to
                       3C 295, start, 5 min of tracking, termination
+  fast-ra-scan        the paper's motion scan along RA (legs along Dec, Fig. 8): 4 legs of 1 deg
+                      at 15 deg/h with transitions, around 3C 286
+  fast-dec-scan       the paper's motion scan along Dec (legs along RA, Fig. 11): 3 legs of
+                      0.5 deg at 5 deg/h with transitions
+The scans' t2 is the shortest that keeps each transition under A_t-max; segments.json holds
+it beside the paper's empirical values (eq. 11-14, 15-20). Units of those fits: mm/s for the
+speeds, s for the times, deg/h for V_dec and V_asc (eq. 15-16 print "h/s" for V_asc; its
+slope 0.751 mm/s per unit is r x 1 deg/h = 0.786 mm/s times cos 17 deg, so deg/h is meant).
 """
 
 from __future__ import annotations
@@ -89,3 +97,84 @@ def write_figures(plan: fp.FastPlan, out_dir) -> None:
     fast_plan_figure(plan, t, Path(out_dir) / "figures.png")
     (Path(out_dir) / "segments.json").write_text(json.dumps(
         {"segments": plan.segment_table(), "info": plan.info}, indent=1, default=float))
+
+
+# ----------------------------------------------------------------------------- motion scans
+
+#: The paper's "motion scan along right ascension" (Fig. 8): legs along declination at
+#: V_dec = 15 deg/h (0.25 arcmin/s), 1 deg long, 4 legs 3 arcmin apart in RA, around 3C 286.
+RA_SCAN = {"legs_along": "dec", "speed_deg_h": 15.0, "leg_deg": 1.0, "legs": 4, "spacing_deg": 0.05}
+#: The paper's "motion scan along declination" (Fig. 11): legs along RA at V_asc = 5 deg/h,
+#: 0.5 deg long, 3 legs 3 arcmin apart in Dec.
+DEC_SCAN = {"legs_along": "ra", "speed_deg_h": 5.0, "leg_deg": 0.5, "legs": 3, "spacing_deg": 0.05}
+
+
+def _scan_factory(spec: dict, source: str = "3C 286"):
+    ra, dec = SOURCES[source]
+
+    def make(t2: float):
+        return sky.MotionScan(ra, dec, spec["legs_along"], np.radians(spec["leg_deg"]), spec["legs"],
+                              np.radians(spec["spacing_deg"]), spec["speed_deg_h"] * sky.DEG_PER_HOUR, t2)
+    return make
+
+
+def _leg_state(segment, at_end: bool):
+    tau = np.array([segment.duration if at_end else 0.0])
+    return tuple(x[0] for x in segment.evaluate(tau))
+
+
+def scan_plan(spec: dict) -> fp.FastPlan:
+    """Park -> the raster's start (switch), start, legs with transitions, termination.
+
+    t2 is the geometric one (the shortest that keeps every transition under A_t-max);
+    ``info`` holds it beside the paper's empirical values (eq. 11-14 or 15-20).
+    """
+    make = _scan_factory(spec)
+    jd1, jd2 = _transit("3C 286")
+    first = make(60.0)
+    start_jd = (jd1, jd2 - 0.5 * first.duration / 86400.0)
+    t2 = fp.minimum_t2(make, start_jd)
+    scan = make(t2)
+    segments, path, peaks = fp.scan_segments(scan, start_jd)
+    start, stop = fp.start_segment(segments[0]), fp.termination_segment(segments[-1])
+    switch, times = fp.switch_segments(PARK, start.start)
+    legs = [s for s in segments if s.name.startswith("leg")]
+    transitions = [s for s in segments if s.name.startswith("transition")]
+    p_end, v_end, _ = _leg_state(legs[0], True)
+    p_next, v_next, _ = _leg_state(legs[1], False) if len(legs) > 1 else (p_end, v_end, None)
+    speed = spec["speed_deg_h"]
+    geometric = {
+        "t2_s": t2,
+        "V_m_mm_s": 1e3 * float(np.linalg.norm(v_end)),
+        "V_m_inv_mm_s": 1e3 * float(np.linalg.norm(v_next)),
+        "p_m": float(v_end[1] / v_end[0]) if v_end[0] else float("inf"),
+        "transition_peak_accel_mm_s2": [1e3 * p for p in peaks],
+    }
+    if transitions:
+        tr = transitions[0]
+        tau = np.linspace(0.0, tr.duration, 400)
+        pos, vel, _ = tr.evaluate(tau)
+        length = float(np.sum(np.linalg.norm(np.diff(pos, axis=0), axis=1)))
+        chord = pos[-1] - pos[0]
+        geometric.update({"l_2_mm": 1e3 * length, "V_c_mm_s": 1e3 * 2 * length / tr.duration,
+                          "p_c": float(chord[1] / chord[0]) if chord[0] else float("inf")})
+    if spec["legs_along"] == "dec":
+        paper = fp.paper_ra_scan_fits(speed, t2)
+        name = "motion scan along right ascension (legs along Dec), eq. 11-14"
+    else:
+        paper = fp.paper_dec_scan_t2(speed)
+        v_m, v_inv = geometric["V_m_mm_s"], geometric["V_m_inv_mm_s"]
+        geometric["t3_s"] = 2 * v_m / (fast.A_MAX * 1e3) + 2 * v_inv / (fast.A_MAX * 1e3)
+        name = "motion scan along declination (legs along RA), eq. 15-20"
+    return fp.FastPlan(switch + [start] + segments + [stop], info={
+        "scan": name, "speed_deg_h": speed, "paper_empirical": paper, "geometric": geometric,
+        "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
+        "switch_times_s": times.__dict__})
+
+
+def ra_scan_plan() -> fp.FastPlan:
+    return scan_plan(RA_SCAN)
+
+
+def dec_scan_plan() -> fp.FastPlan:
+    return scan_plan(DEC_SCAN)

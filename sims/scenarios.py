@@ -141,6 +141,22 @@ PLANS: dict[str, Scenario] = {
             plan_extras=fast.write_figures,
         ),
         Scenario(
+            "fast-ra-scan",
+            "FAST feed: the paper's motion scan along RA around 3C 286: 4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max, beside the paper's eq. 11-14",
+            None,
+            fast.ra_scan_plan,
+            kinds=fast.plan_kinds,
+            plan_extras=fast.write_figures,
+        ),
+        Scenario(
+            "fast-dec-scan",
+            "FAST feed: the paper's motion scan along Dec around 3C 286: 3 legs along RA at 5 deg/h, transitions, beside the paper's eq. 15-20",
+            None,
+            fast.dec_scan_plan,
+            kinds=fast.plan_kinds,
+            plan_extras=fast.write_figures,
+        ),
+        Scenario(
             "fast-source-switch",
             "FAST feed: park -> 3C 286, 5 min of tracking, switch along the focal surface to 3C 295, 5 min of tracking",
             None,

@@ -224,7 +224,7 @@ def test_antenna_without_prediction_fails_the_paper_motion(tmp_path):
     assert "pointing_error_max" in failed
 
 
-@pytest.mark.parametrize("name", ["fast-tracking", "fast-source-switch"])
+@pytest.mark.parametrize("name", ["fast-tracking", "fast-source-switch", "fast-ra-scan", "fast-dec-scan"])
 def test_fast_plans(tmp_path, name):
     out = tmp_path / name
     proc = planbench("plan", name, "--out", out)

@@ -136,3 +136,33 @@ def test_paper_t2_of_eq_20_solves_its_quadratic():
 def test_source_beyond_40_deg_is_refused():
     with pytest.raises(LimitError, match="zenith angle"):
         fast_sims.tracking_plan(duration=8 * 3600.0)  # 3C 286 is 40 deg down 3.1 h from transit
+
+
+@pytest.mark.parametrize("build", [fast_sims.ra_scan_plan, fast_sims.dec_scan_plan])
+def test_motion_scans_with_transitions(build):
+    plan = build()
+    names = [s.name for s in plan.segments]
+    assert names.count("transition 1") == 1 and names[-1] == "termination"
+    plan.check()  # |a| <= A_t-max on transitions, A_max on legs, tensions, zenith angle
+    t2 = plan.info["geometric"]["t2_s"]
+    transitions = [s for s in plan.segments if s.name.startswith("transition")]
+    assert all(s.duration == pytest.approx(t2) and s.accel_limit == fast.A_T_MAX for s in transitions)
+    peaks = plan.info["geometric"]["transition_peak_accel_mm_s2"]
+    assert max(peaks) <= 15.0 and max(peaks) > 14.0  # the shortest t2: the limit is nearly met
+    # Continuous velocity across legs and transitions.
+    t = np.arange(0.0, plan.duration, 0.01)
+    v = plan.state(t).feed_velocity
+    assert np.linalg.norm(np.diff(v, axis=0), axis=1).max() <= fast.A_S_MAX * 0.01 * (1 + 1e-6)
+    # The paper's empirical values sit beside the geometric ones, of the same order.
+    paper, geometric = plan.info["paper_empirical"], plan.info["geometric"]
+    assert 0.5 < geometric["V_m_mm_s"] / paper["V_m_mm_s"] < 1.5
+
+
+def test_shorter_t2_breaks_a_t_max():
+    make = fast_sims._scan_factory(fast_sims.DEC_SCAN)
+    jd1, jd2 = fast_sims._transit("3C 286")
+    start = (jd1, jd2)
+    t2 = fp.minimum_t2(make, start)
+    with pytest.raises(LimitError, match="A_t-max 15.0 mm/s"):
+        fp.scan_segments(make(t2 - 0.2), start)
+    fp.scan_segments(make(t2), start)
