@@ -30,6 +30,7 @@ from planners.trajectory import TrajectorySample
 
 R_FOCAL = fast.FOCAL_SURFACE_RADIUS
 MIN_LENGTH = 1e-6  # m: shorter lines and arcs are left out of a switch
+BEAM_SYMMETRY = math.pi / 3  # rad: the 19-beam receiver's hexagonal symmetry
 
 
 @dataclass(frozen=True)
@@ -73,6 +74,12 @@ class Segment:
 
     def evaluate(self, tau):  # pragma: no cover - abstract
         raise NotImplementedError
+
+    def angle(self, tau):
+        """(multi-feed angle, rate), rad and rad/s, at local times tau: the angle profile
+        that FastPlan gives the segment (``angle_start`` + ``angle_profile``)."""
+        p = self.angle_profile.evaluate(np.clip(tau, 0.0, self.angle_profile.duration))
+        return self.angle_start + p.position, p.velocity
 
     @property
     def t1(self) -> float:
@@ -126,10 +133,16 @@ class SampledSegment(Segment):
     through feed positions at local times; velocity and acceleration are its derivatives."""
 
     spline: CubicSpline = None
+    angles: CubicSpline | None = None  # the multi-feed angle along an observation
 
     def evaluate(self, tau):
         s = self.spline
         return s(tau), s(tau, 1), s(tau, 2)
+
+    def angle(self, tau):
+        if self.angles is None:
+            return super().angle(tau)
+        return self.angles(tau), self.angles(tau, 1)
 
 
 def tangential_limit(a_max: float, v_max: float, radius: float = R_FOCAL) -> float:
@@ -251,6 +264,24 @@ def start_segment(observation: Segment, a_max: float = fast.A_MAX) -> ArcSegment
                       direction, profile)
 
 
+def start_angle(observation: Segment, start: Segment) -> float:
+    """The multi-feed angle at the start segment's beginning (see FastPlan._plan_angles): the
+    observation's first angle less q_dot T / 2 of the rate ramp; for eq. (10)'s switch."""
+    if not isinstance(observation, SampledSegment) or observation.angles is None:
+        return 0.0
+    q, qd = (float(x[0]) for x in observation.angle(np.array([0.0])))
+    return q - 0.5 * qd * start.duration
+
+
+def end_angle(observation: Segment, termination: Segment) -> float:
+    """The multi-feed angle at a termination's end: the observation's last angle plus the
+    q_dot T / 2 of the ramp to rest."""
+    if not isinstance(observation, SampledSegment) or observation.angles is None:
+        return 0.0
+    q, qd = (float(x[0]) for x in observation.angle(np.array([observation.duration])))
+    return q + 0.5 * qd * termination.duration
+
+
 def termination_segment(observation: Segment, a_max: float = fast.A_MAX) -> ArcSegment:
     """Termination planning (section 3.1): from the observation's end Pt with its velocity
     along the focal sphere to rest at P2."""
@@ -266,12 +297,21 @@ def termination_segment(observation: Segment, a_max: float = fast.A_MAX) -> ArcS
 
 
 def observation_segment(times, directions, t0: float = 0.0, name: str = "observation",
-                        a_max: float = fast.A_MAX) -> SampledSegment:
-    """The feed following a sky path: P_feed = -r s(t) through a cubic spline in time."""
+                        a_max: float = fast.A_MAX, angles=None) -> SampledSegment:
+    """The feed following a sky path: P_feed = -r s(t) through a cubic spline in time;
+    ``angles`` (rad, at the same times): the multi-feed rotation along it (e.g. the
+    parallactic angle, so the 19 beams keep their pattern on the sky)."""
     times = np.asarray(times, dtype=float)
     points = fast.feed_position(np.asarray(directions, dtype=float))
     spline = CubicSpline(times - times[0], points, axis=0)
-    return SampledSegment(name, t0, float(times[-1] - times[0]), a_max, spline)
+    angle_spline = None
+    if angles is not None:
+        angles = np.unwrap(np.asarray(angles, dtype=float))
+        # The 19 beams sit on a hexagon: a turn by 60 deg maps the pattern onto itself, so the
+        # rotator starts within +/-30 deg of its zero and follows the angle from there.
+        angles = angles - BEAM_SYMMETRY * np.round(angles[0] / BEAM_SYMMETRY)
+        angle_spline = CubicSpline(times - times[0], angles)
+    return SampledSegment(name, t0, float(times[-1] - times[0]), a_max, spline, angle_spline)
 
 
 def transition_segment(p0, v0, p1, v1, duration: float, t0: float,
@@ -399,7 +439,6 @@ class FastPlan:
     """
 
     segments: list
-    multifeed: prof.Profile | None = None
     geometry: fast.FastGeometry = fast.FAST
     limits: fast.FastLimits = fast.FAST_LIMITS
     info: dict = field(default_factory=dict)
@@ -411,6 +450,58 @@ class FastPlan:
             seg.t0 = t
             t += seg.duration
         self._breaks = np.array([s.t0 for s in self.segments] + [t])
+        self._plan_angles()
+
+    def _plan_angles(self) -> None:
+        """The multi-feed rotation of every segment, C1 along the plan.
+
+        Observations carry their own angle (or hold 0). A transition between two legs is the
+        cubic Hermite curve between their angles and rates. A start segment ramps the rate
+        from rest to the observation's with one pulse over its duration (so it starts
+        q_dot T / 2 before the observation's first angle); a termination ramps it back to
+        rest. The segments of a switch move rest to rest from the angle before them to the
+        angle after them in their total time (``move_in_time``; eq. (10) made that time long
+        enough for the rotator's limits).
+        """
+        segs = self.segments
+        for seg in segs:
+            if isinstance(seg, SampledSegment) and seg.angles is None and not seg.name.startswith("transition"):
+                seg.angles = CubicSpline([0.0, max(seg.duration, 1e-9)], [0.0, 0.0])
+        for k, seg in enumerate(segs):
+            if isinstance(seg, SampledSegment) and seg.angles is None:  # a transition
+                q0, qd0 = (float(x[0]) for x in segs[k - 1].angle(np.array([segs[k - 1].duration])))
+                q1, qd1 = (float(x[0]) for x in segs[k + 1].angle(np.array([0.0])))
+                seg.angles = CubicHermiteSpline([0.0, seg.duration], [q0, q1], [qd0, qd1])
+        for k, seg in enumerate(segs):
+            if seg.name == "start" and k + 1 < len(segs):
+                q, qd = (float(x[0]) for x in segs[k + 1].angle(np.array([0.0])))
+                seg.angle_profile = _rate_ramp(0.0, qd, seg.duration)
+                seg.angle_start = q - seg.angle_profile.end_position
+            elif seg.name == "termination" and k > 0:
+                q, qd = (float(x[0]) for x in segs[k - 1].angle(np.array([segs[k - 1].duration])))
+                seg.angle_profile = _rate_ramp(qd, 0.0, seg.duration)
+                seg.angle_start = q
+        has_angle = lambda seg: isinstance(seg, SampledSegment) or hasattr(seg, "angle_profile")
+        k = 0
+        while k < len(segs):
+            if has_angle(segs[k]):
+                k += 1
+                continue
+            run = [k]
+            while run[-1] + 1 < len(segs) and not has_angle(segs[run[-1] + 1]):
+                run.append(run[-1] + 1)
+            first, last = run[0], run[-1]
+            before = float(segs[first - 1].angle(np.array([segs[first - 1].duration]))[0][0]) if first > 0 else 0.0
+            after = float(segs[last + 1].angle(np.array([0.0]))[0][0]) if last + 1 < len(segs) else before
+            total = sum(segs[i].duration for i in run)
+            move = prof.move_in_time(after - before, total, MECHANISM_LIMITS.multifeed_rate,
+                                     MECHANISM_LIMITS.multifeed_accel)
+            offset = 0.0
+            for i in run:
+                segs[i].angle_profile = _Window(move, offset, segs[i].duration)
+                segs[i].angle_start = before
+                offset += segs[i].duration
+            k = last + 1
 
     @property
     def duration(self) -> float:
@@ -437,9 +528,12 @@ class FastPlan:
         return index, pos, vel, acc
 
     def _multifeed(self, t):
-        if self.multifeed is None:
-            return np.zeros(t.size)
-        return self.multifeed.evaluate(np.clip(t, 0.0, self.multifeed.duration)).position
+        index = np.clip(np.searchsorted(self._breaks, t, side="right") - 1, 0, len(self.segments) - 1)
+        out = np.empty(t.size)
+        for k in np.unique(index):
+            seg, mask = self.segments[k], index == k
+            out[mask] = seg.angle(np.clip(t[mask] - seg.t0, 0.0, seg.duration))[0]
+        return out
 
     def state(self, t) -> FastPlanSample:
         t = np.atleast_1d(np.asarray(t, dtype=float))
@@ -496,12 +590,16 @@ def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX)
     state of one leg to the start state of the next (``transition_segment``). Raises
     LimitError when a transition would need more than ``a_limit`` (A_t-max).
     """
+    from planners.fast_sky import parallactic_angle
+
     path = scan.path(start, step=step)
     directions = path.directions()
+    angles = parallactic_angle(path.az, path.el)
     legs = []
     for k in range(scan.n_legs):
         mask = (path.t >= scan.leg_start[k] - 1e-9) & (path.t <= scan.leg_end[k] + 1e-9)
-        legs.append(observation_segment(path.t[mask], directions[mask], name=f"leg {k + 1}"))
+        legs.append(observation_segment(path.t[mask], directions[mask], name=f"leg {k + 1}",
+                                        angles=angles[mask]))
     segments = [legs[0]]
     peaks = []
     for k in range(1, scan.n_legs):
@@ -550,3 +648,22 @@ def minimum_t2(make_scan, start, step: float = 1.0, a_limit: float = fast.A_T_MA
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if feasible(mid) else (mid, hi)
     return hi
+
+
+def _rate_ramp(v0: float, v1: float, duration: float) -> prof.Profile:
+    """One triangular acceleration pulse from rate v0 to v1 over exactly ``duration``."""
+    if duration <= 0 or v0 == v1:
+        return prof.cruise(v0, max(duration, 0.0))
+    peak = 2.0 * (v1 - v0) / duration
+    return prof.Profile([duration / 2, duration / 2], [0.0, peak, 0.0], 0.0, v0)
+
+
+class _Window:
+    """A profile seen through the time window [offset, offset + duration] (one segment of a
+    switch shares the switch's profile)."""
+
+    def __init__(self, profile: prof.Profile, offset: float, duration: float):
+        self.profile, self.offset, self.duration = profile, offset, duration
+
+    def evaluate(self, tau):
+        return self.profile.evaluate(np.asarray(tau) + self.offset)

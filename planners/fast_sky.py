@@ -646,3 +646,12 @@ class MotionScan:
                       f"{math.degrees(self.ra):.4f} deg, Dec {math.degrees(self.dec):.4f} deg",
                       np.pi / 2 - el, t, jd1, jd2, limit)
         return SkyPath(t, jd1, jd2, ra, dec, az, el, on_leg, leg, self.leg_start, self.leg_end)
+
+
+def parallactic_angle(az, el, *, site: Site = FAST_SITE) -> np.ndarray:
+    """Parallactic angle (rad) of the directions (az, el) at the site: the angle at the source
+    between the directions to the zenith and to the celestial pole (erfa ae2hd, hd2pa). The
+    19-beam receiver turns by it to keep its beam pattern fixed on the sky."""
+    az, el = np.broadcast_arrays(np.asarray(az, dtype=float), np.asarray(el, dtype=float))
+    ha, dec = erfa.ae2hd(az, el, site.latitude)
+    return np.asarray(erfa.hd2pa(ha, dec, site.latitude))

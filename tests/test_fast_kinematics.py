@@ -171,3 +171,14 @@ def test_stewart_legs_at_nominal_and_under_a_correction():
     assert side.min() < 0 < side.max() and np.abs(side).max() < fast.STEWART.stroke
     # Batched.
     assert fast.stewart_leg_lengths(offset=np.zeros((7, 3))).shape == (7, 6)
+
+
+def test_eq1_with_a_stewart_correction():
+    """The Stewart platform's offset d (AB frame) moves the feed by R_C R_AB d (eq. 1, 4)."""
+    s = fast.source_direction(1.0, math.radians(60.0))
+    feed = fast.feed_position(s)
+    pose = fast.cabin_pose(feed, s, math.radians(8.0))
+    d = np.array([0.03, -0.02, 0.05])
+    moved = fast.feed_from_cabin(pose.origin, pose.rotation, pose.theta_a, pose.theta_b, stewart_offset=d)
+    r_ab = fast.ab_rotation(pose.theta_a, pose.theta_b)
+    np.testing.assert_allclose(moved - feed, pose.rotation @ r_ab @ d, atol=1e-12)

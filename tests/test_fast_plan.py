@@ -166,3 +166,33 @@ def test_shorter_t2_breaks_a_t_max():
     with pytest.raises(LimitError, match="A_t-max 15.0 mm/s"):
         fp.scan_segments(make(t2 - 0.2), start)
     fp.scan_segments(make(t2), start)
+
+
+def test_multifeed_rotation_follows_the_parallactic_angle_and_stays_c1(switch_plan):
+    from planners import fast_sky
+
+    plan = switch_plan
+    t = np.arange(0.0, plan.duration, 0.01)
+    s = plan.state(t)
+    rate = np.diff(s.multifeed) / 0.01
+    limits = fp.MECHANISM_LIMITS
+    assert np.abs(rate).max() <= limits.multifeed_rate
+    assert np.abs(np.diff(rate)).max() / 0.01 <= limits.multifeed_accel * (1 + 1e-3)
+    # On an observation it is the parallactic angle (modulo the beams' 60 deg symmetry).
+    obs = next(x for x in plan.segments if x.name.startswith("observation"))
+    tt = obs.t0 + np.linspace(0.0, obs.duration, 20)
+    st = plan.state(tt)
+    az = np.arctan2(st.axis[:, 0], st.axis[:, 1])
+    el = np.arcsin(st.axis[:, 2])
+    q = fast_sky.parallactic_angle(az, el)
+    diff = np.angle(np.exp(1j * (st.multifeed - q) * 6)) / 6  # modulo 60 deg
+    assert np.abs(diff).max() < 1e-4
+
+
+def test_eq10_includes_the_multifeed_rotation():
+    p0 = np.array([0.0, 0.0, -fast.FOCAL_SURFACE_RADIUS + 2.0])
+    p1 = _on_sphere(90.0, 80.0)
+    times = fp.switch_times(p0, p1, multifeed0=0.0, multifeed1=math.radians(170.0))
+    assert times.t_multifeed == pytest.approx(prof.min_move_time(
+        math.radians(170.0), fp.MECHANISM_LIMITS.multifeed_rate, fp.MECHANISM_LIMITS.multifeed_accel))
+    assert times.t_line == pytest.approx(times.t_multifeed - times.t_focal)  # the rotator is the slowest
