@@ -83,8 +83,9 @@ API
   ``move_in_time(distance, duration, v_max, a_max, v0=0, v1=0)``.
 Requests that sit on a limit within round-off (d = d_min, T = T_min, to 1e-12 relative) are
 planned on the limit. A pulse shorter than the resolution of the absolute break times
-(h < 8 eps T) is widened to that length with a lower peak and the same speed change. ``move_in_time``'s duration is exact to the last bit where the sum of the
-pieces allows it (the round-off of the sum is moved into the longest piece).
+(h < 8 eps T) is widened to that length with a lower peak and the same speed change.
+``move_in_time``'s duration is exact to the last bit where the sum of the pieces allows it (the
+round-off of the sum is moved into the longest piece).
 """
 
 from __future__ import annotations
@@ -428,7 +429,7 @@ def move_in_time(distance: float, duration: float, v_max: float, a_max: float, v
         return v * T_plan - (x0 * abs(x0) + x1 * abs(x1)) / a
 
     d_low = h(v_bot)
-    if False:
+    if d < d_low * (1.0 - _RTOL):
         raise LimitError(f"duration {_fmt(T)} s is too long to move {_fmt(distance)} m from "
                          f"v0 = {_fmt(v0)} to v1 = {_fmt(v1)} m/s: slowing down (to "
                          f"{_fmt(s * v_bot)} m/s at the most, a_max = {_fmt(a_max)} m/s^2) and "

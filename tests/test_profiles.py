@@ -342,6 +342,25 @@ def test_move_in_time_hand_examples():
     assert "1.4" in str(err.value) and "1.5" in str(err.value) and "2.0 s" in str(err.value)
 
 
+@pytest.mark.parametrize("move, stretch", [
+    ((100.0, 0.01, 1.0, 0.01, 0.0), 1e-9),  # slows by ~1e-11 m/s over a 1e4 s cruise
+    ((1.0000000000000002, 1.0, 1.0, 1.0, 0.9999999999999999), 0.0),  # a 1e-16 s pulse
+    ((1.0, 0.01, 1.0, 0.0, 0.01), 1e-12),
+])
+def test_pulses_below_the_time_resolution(move, stretch):
+    """A speed change far shorter than eps T is widened to 8 eps T with a lower peak: the
+    breaks stay distinct and the speed change and distance stay exact."""
+    d, v_max, a, v0, v1 = move
+    T = min_move_time(d, v_max, a, v0, v1) * (1 + stretch)
+    p = move_in_time(d, T, v_max, a, v0, v1)
+    check_profile(p, d, v0, v1, v_max, a, duration=T)
+    assert np.all(np.diff(p.breaks) > 0)
+    assert np.min(p.durations) >= 4 * np.finfo(float).eps * T
+    q = move_min_time(d, v_max, a, v0, v1)
+    check_profile(q, d, v0, v1, v_max, a)
+    assert np.all(np.diff(q.breaks) > 0)
+
+
 # --------------------------------------------------------------------------- sampling
 
 
