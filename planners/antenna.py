@@ -47,6 +47,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from planners.errors import LimitError, PlanningError
+from planners.rotations import rot_x, rot_y, rot_z
 from planners.trajectory import TrajectorySample
 
 JOINT_LABELS = ("azimuth", "elevation", "cross_elevation", "polarization")
@@ -70,34 +71,6 @@ class SingularityError(PlanningError):
 
 # --------------------------------------------------------------------------------------
 # Rotations
-
-
-def _rotation(axis: int, angle) -> np.ndarray:
-    angle = np.asarray(angle, dtype=float)
-    c, s = np.cos(angle), np.sin(angle)
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    m = np.zeros(angle.shape + (3, 3))
-    m[..., axis, axis] = 1.0
-    m[..., i, i] = c
-    m[..., j, j] = c
-    m[..., i, j] = -s
-    m[..., j, i] = s
-    return m
-
-
-def rot_x(angle) -> np.ndarray:
-    """Active rotation matrices about X, (..., 3, 3), for angles (...) in rad."""
-    return _rotation(0, angle)
-
-
-def rot_y(angle) -> np.ndarray:
-    """Active rotation matrices about Y, (..., 3, 3)."""
-    return _rotation(1, angle)
-
-
-def rot_z(angle) -> np.ndarray:
-    """Active rotation matrices about Z, (..., 3, 3)."""
-    return _rotation(2, angle)
 
 
 def skew(v) -> np.ndarray:

@@ -45,6 +45,7 @@ import numpy as np
 
 from planners.errors import LimitError, PlanningError
 from planners.legs import leg_forces, leg_lengths, structure_matrix
+from planners.rotations import rot_x, rot_y, rot_z
 
 GRAVITY = 9.81
 
@@ -164,31 +165,6 @@ def stewart_leg_lengths(offset=None, rotation=None, geometry: FastGeometry = FAS
 
 
 # ----------------------------------------------------------------------------- rotations
-
-
-def _rotation(axis: int, angle) -> np.ndarray:
-    angle = np.asarray(angle, dtype=float)
-    c, s = np.cos(angle), np.sin(angle)
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    m = np.zeros(angle.shape + (3, 3))
-    m[..., axis, axis] = 1.0
-    m[..., i, i] = c
-    m[..., j, j] = c
-    m[..., i, j] = -s
-    m[..., j, i] = s
-    return m
-
-
-def rot_x(angle):
-    return _rotation(0, angle)
-
-
-def rot_y(angle):
-    return _rotation(1, angle)
-
-
-def rot_z(angle):
-    return _rotation(2, angle)
 
 
 def tilt_torsion(phi, theta, omega=0.0) -> np.ndarray:
