@@ -32,7 +32,7 @@ from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import antenna as ant
-from planners.errors import LimitError, PlanningError
+from planners.errors import PlanningError
 from planners.geostationary import look_angles
 from planners.trajectory import TrajectorySample
 from sims.checks import Check
