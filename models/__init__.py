@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 MODELS_DIR = Path(__file__).resolve().parent
-MECHANISMS = ("loader", "hexapod", "antenna")
+MECHANISMS = ("loader", "hexapod", "antenna", "fast")
 
 
 def model_dir(name: str) -> Path:

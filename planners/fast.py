@@ -33,7 +33,9 @@ the same vertical plane (azimuth phi of s): R_C R_AB z = s.
 Statics: six cables, six degrees of freedom, so the structure matrix is square and the wrench
 balance A t + W = 0 gives the tensions directly (planners.legs). Cable weight: half of each
 cable's weight is lumped at its cabin anchor as a vertical load (REFERENCE.md's common
-approximation); the sag's change of the cable direction at the anchor is left out.
+approximation); the sag's change of the cable direction at the anchor is left out. The A-B
+rotator's tilt moves the cabin's centre of mass (``cabin_com_at``): the tilted part (B frame,
+Stewart stabilizer, feed platform, receiver: 4.9 t) hangs 2.25 m below the rotator's centre.
 """
 
 from __future__ import annotations
@@ -89,6 +91,13 @@ class FastGeometry:
         1 m below 61 kN, 3 m below no feasible split; REFERENCE.md's check (100-107 kN) had it
         in the plane.
       cable_mass_per_length: kg/m (46 mm steel wire rope, ~10 kg/m; REFERENCE.md).
+      ab_mass: the part of the cabin mass that the A-B rotator tilts (its B frame, the Stewart
+        stabilizer, the feed platform and the receiver), kg (assumed, models/fast/README.md).
+        The rotator's A ring is balanced on its axis and is not part of it.
+      ab_com: that part's centre of mass in the AB frame, m, at the Stewart's nominal pose.
+        ``cabin_com`` is the whole cabin's with the rotator level; tilting the rotator by R_AB
+        moves it by (ab_mass / cabin_mass) (R_AB - I) ab_com (``cabin_com_at``).
+        models/fast/fast.xml has the same masses (tests/test_fast_model.py).
     """
 
     tower_anchors: np.ndarray = field(default_factory=lambda: _ring(
@@ -102,6 +111,8 @@ class FastGeometry:
     cabin_mass: float = 30_091.8
     cabin_com: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -1.0]))
     cable_mass_per_length: float = 10.0
+    ab_mass: float = 4860.0
+    ab_com: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -2.251751]))
 
 
 @dataclass(frozen=True)
@@ -314,16 +325,27 @@ def cable_lengths(origin, rotation, geometry: FastGeometry = FAST) -> np.ndarray
 # ----------------------------------------------------------------------------- statics
 
 
-def gravity_wrench(origin, rotation, lengths, geometry: FastGeometry = FAST) -> np.ndarray:
+def cabin_com_at(ab_rotation=None, geometry: FastGeometry = FAST) -> np.ndarray:
+    """(..., 3) the whole cabin's centre of mass in the cabin frame, m, with the A-B rotator
+    at ``ab_rotation`` (..., 3, 3) (None: level): cabin_com + (m_AB / m) (R_AB - I) r_AB-com."""
+    if ab_rotation is None:
+        return geometry.cabin_com
+    shift = np.einsum("...ij,j->...i", np.asarray(ab_rotation, dtype=float), geometry.ab_com) - geometry.ab_com
+    return geometry.cabin_com + (geometry.ab_mass / geometry.cabin_mass) * shift
+
+
+def gravity_wrench(origin, rotation, lengths, geometry: FastGeometry = FAST,
+                   ab_rotation=None) -> np.ndarray:
     """(..., 6) weight of the cabin and the lumped half cable weights, about the cabin origin.
 
-    Force in N, moment in N m (inertial axes).
+    Force in N, moment in N m (inertial axes). ``ab_rotation`` (..., 3, 3): R_AB, whose tilt
+    moves the cabin's centre of mass (``cabin_com_at``); None for a level rotator.
     """
     rotation = np.asarray(rotation, dtype=float)
     weight = geometry.cabin_mass * GRAVITY
     force = np.zeros(rotation.shape[:-2] + (3,))
     force[..., 2] = -weight
-    com_arm = np.einsum("...ij,j->...i", rotation, geometry.cabin_com)
+    com_arm = np.einsum("...ij,...j->...i", rotation, cabin_com_at(ab_rotation, geometry))
     moment = np.cross(com_arm, force)
     half_cable = 0.5 * geometry.cable_mass_per_length * GRAVITY * np.asarray(lengths)  # (..., 6)
     anchor_arms = np.einsum("...ij,nj->...ni", rotation, geometry.cabin_anchors)
@@ -334,18 +356,26 @@ def gravity_wrench(origin, rotation, lengths, geometry: FastGeometry = FAST) -> 
     return np.concatenate([force, moment], axis=-1)
 
 
-def cable_tensions(origin, rotation, geometry: FastGeometry = FAST, extra_wrench=None) -> np.ndarray:
+def cable_tensions(origin, rotation, geometry: FastGeometry = FAST, extra_wrench=None,
+                   ab_rotation=None) -> np.ndarray:
     """(..., 6) static cable tensions, N (positive pulls), from A t + W = 0.
 
-    W: the cabin's weight and the lumped cable weights (``gravity_wrench``), plus
-    ``extra_wrench`` (..., 6) about the cabin origin (e.g. wind), if given.
+    W: the cabin's weight (its centre of mass moved by the A-B tilt ``ab_rotation``, if
+    given) and the lumped cable weights (``gravity_wrench``), plus ``extra_wrench`` (..., 6)
+    about the cabin origin (e.g. wind), if given.
     """
     lengths = cable_lengths(origin, rotation, geometry)
-    wrench = gravity_wrench(origin, rotation, lengths, geometry)
+    wrench = gravity_wrench(origin, rotation, lengths, geometry, ab_rotation)
     if extra_wrench is not None:
         wrench = wrench + np.asarray(extra_wrench, dtype=float)
     a = structure_matrix(geometry.tower_anchors, geometry.cabin_anchors, origin, rotation)
     return leg_forces(a, wrench)
+
+
+def pose_tensions(pose: "CabinPose", geometry: FastGeometry = FAST) -> np.ndarray:
+    """(..., 6) static cable tensions, N, of a ``CabinPose`` (its A-B tilt included)."""
+    return cable_tensions(pose.origin, pose.rotation, geometry,
+                          ab_rotation=ab_rotation(pose.theta_a, pose.theta_b, geometry.alpha))
 
 
 def _softmin(values: np.ndarray, scale: float) -> np.ndarray:
@@ -388,8 +418,7 @@ def split_tilt(feed, axis, geometry: FastGeometry = FAST, limits: FastLimits = F
     hi = np.maximum(hi, lo)
 
     def objective(tilt):
-        pose = cabin_pose(feed, axis, tilt, geometry)
-        return _softmin(cable_tensions(pose.origin, pose.rotation, geometry), softness)
+        return _softmin(pose_tensions(cabin_pose(feed, axis, tilt, geometry), geometry), softness)
 
     golden = (math.sqrt(5.0) - 1.0) / 2.0
     a, b = lo.copy(), hi.copy()
@@ -405,7 +434,7 @@ def split_tilt(feed, axis, geometry: FastGeometry = FAST, limits: FastLimits = F
         fc, fd = np.where(left, value, fd), np.where(left, fc, value)
     tilt = 0.5 * (a + b)
     pose = cabin_pose(feed, axis, tilt, geometry)
-    tensions = cable_tensions(pose.origin, pose.rotation, geometry)
+    tensions = pose_tensions(pose, geometry)
     if check:
         check_tensions(tensions, limits)
     return TiltSplit(pose, tensions)

@@ -542,7 +542,7 @@ class FastPlan:
         tilt = fast.tilt_law(self.geometry, self.limits)(axis)
         p = fast.cabin_pose(pos, axis, tilt, self.geometry)
         lengths = fast.cable_lengths(p.origin, p.rotation, self.geometry)
-        tensions = fast.cable_tensions(p.origin, p.rotation, self.geometry)
+        tensions = fast.pose_tensions(p, self.geometry)
         stewart = np.broadcast_to(fast.stewart_leg_lengths(), (t.size, 6))
         return FastPlanSample(t, index, pos, vel, acc, axis, fast.zenith_angle(axis), p.cabin_tilt,
                               p.ab_tilt, p.phi, p.theta_a, p.theta_b, self._multifeed(t), p.rotation,

@@ -246,3 +246,40 @@ def fast_plan_figure(plan, t: np.ndarray, path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def fast_report(ts: dict, t: np.ndarray, checks, path, tension_min: float) -> None:
+    """report.png of a FAST run: feed and cabin errors, cable tensions, Stewart legs, wind."""
+    fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
+    observing = ts["observing"].astype(bool)
+    for ax in axes.flat:
+        ax.fill_between(t, 0, 1, where=observing, transform=ax.get_xaxis_transform(),
+                        color="0.93", lw=0)
+    ax = axes[0, 0]
+    ax.plot(t, ts["feed_error_mm"], lw=0.7, label="feed |actual - planned|")
+    ax.plot(t, 1e3 * np.linalg.norm(ts["cabin_pos_actual"] - ts["cabin_pos_planned"], axis=1), lw=0.7,
+            label="cabin origin")
+    ax.set(title="position errors (grey: observing)", xlabel="t [s]", ylabel="mm")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    for j, name in enumerate(ts["cable_names"]):
+        line, = ax.plot(t, ts["cable_tension"][:, j] / 1e3, lw=0.7, label=str(name))
+        ax.plot(t, ts["cable_tension_planned"][:, j] / 1e3, "--", color=line.get_color(), lw=0.6)
+    ax.axhline(tension_min / 1e3, color="r", lw=0.8)
+    ax.set(title="cable tensions (dashed: planned statics), T_min in red", xlabel="t [s]", ylabel="kN")
+    ax.legend(fontsize=8, ncol=3)
+    ax = axes[1, 0]
+    for j in range(ts["stewart_leg"].shape[1]):
+        ax.plot(t, 1e3 * ts["stewart_leg"][:, j], lw=0.7, label=f"leg{j + 1}")
+    ax.set(title="Stewart leg length changes", xlabel="t [s]", ylabel="mm")
+    ax.legend(fontsize=8, ncol=3)
+    ax = axes[1, 1]
+    if "wind_speed" in ts:
+        ax.plot(t, ts["wind_speed"], color="0.4", lw=0.6, label="wind speed [m/s]")
+        twin = ax.twinx()
+        twin.plot(t, np.linalg.norm(ts["wind_force"], axis=1) / 1e3, lw=0.6, label="drag on cabin and cables")
+        twin.set_ylabel("kN")
+        twin.legend(fontsize=8, loc="upper right")
+        ax.legend(fontsize=8, loc="upper left")
+    ax.set(title="wind", xlabel="t [s]", ylabel="m/s")
+    _finish(fig, axes, ax, checks, path, top=False)

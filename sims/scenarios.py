@@ -21,6 +21,7 @@ class RunOptions:
         bow (deg, 180 head seas), None for the defaults (sea-state scenarios).
       imu_rate, imu_latency: the antenna IMU's sample rate (Hz) and latency (s), None for the
         defaults; predict: False to switch the antenna controller's prediction off.
+      stewart: FAST's Stewart stabilizer on (True) or off (False), None for the default (on).
     """
 
     seed: int = 0
@@ -33,6 +34,7 @@ class RunOptions:
     imu_rate: float | None = None
     imu_latency: float | None = None
     predict: bool = True
+    stewart: bool | None = None
 
 
 @dataclass(frozen=True)
@@ -114,6 +116,33 @@ SCENARIOS: dict[str, Scenario] = {
             options=frozenset({"hs", "tp", "heading", "imu"}),
             kinds=antenna.joint_kinds,
         ),
+        Scenario(
+            "fast-tracking",
+            "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --stewart on|off)",
+            fast.build_tracking,
+            fast.tracking_plan,
+            options=frozenset({"wind", "stewart"}),
+            kinds=fast.plan_kinds,
+            plan_extras=fast.write_figures,
+        ),
+        Scenario(
+            "fast-ra-scan",
+            "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --stewart on|off)",
+            fast.build_ra_scan,
+            fast.ra_scan_plan,
+            options=frozenset({"wind", "stewart"}),
+            kinds=fast.plan_kinds,
+            plan_extras=fast.write_figures,
+        ),
+        Scenario(
+            "fast-source-switch",
+            "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --stewart on|off)",
+            fast.build_source_switch,
+            fast.source_switch_plan,
+            options=frozenset({"wind", "stewart"}),
+            kinds=fast.plan_kinds,
+            plan_extras=fast.write_figures,
+        ),
     )
 }
 
@@ -128,39 +157,15 @@ def get(name: str) -> Scenario:
         ) from None
 
 
-#: Plans without a MuJoCo run yet (the FAST model is issue 6): ``planbench plan`` only.
+#: Plans with no run of their own (``planbench plan`` only).
 PLANS: dict[str, Scenario] = {
     s.name: s
     for s in (
-        Scenario(
-            "fast-tracking",
-            "FAST feed: park -> 3C 286 (straight line + focal arc), start, 20 min of tracking across its transit, termination",
-            None,
-            fast.tracking_plan,
-            kinds=fast.plan_kinds,
-            plan_extras=fast.write_figures,
-        ),
-        Scenario(
-            "fast-ra-scan",
-            "FAST feed: the paper's motion scan along RA around 3C 286: 4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max, beside the paper's eq. 11-14",
-            None,
-            fast.ra_scan_plan,
-            kinds=fast.plan_kinds,
-            plan_extras=fast.write_figures,
-        ),
         Scenario(
             "fast-dec-scan",
             "FAST feed: the paper's motion scan along Dec around 3C 286: 3 legs along RA at 5 deg/h, transitions, beside the paper's eq. 15-20",
             None,
             fast.dec_scan_plan,
-            kinds=fast.plan_kinds,
-            plan_extras=fast.write_figures,
-        ),
-        Scenario(
-            "fast-source-switch",
-            "FAST feed: park -> 3C 286, 5 min of tracking, switch along the focal surface to 3C 295, 5 min of tracking",
-            None,
-            fast.source_switch_plan,
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
         ),

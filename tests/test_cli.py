@@ -28,7 +28,8 @@ def test_list_names_every_scenario():
     assert proc.returncode == 0
     names = [line.split()[0] for line in proc.stdout.splitlines()]
     assert names == ["loader-supply", "loader-direct", "hexapod-sync-move", "hexapod-async-move",
-                     "antenna-paper-motion", "antenna-sea-state"]
+                     "antenna-paper-motion", "antenna-sea-state", "fast-tracking", "fast-ra-scan",
+                     "fast-source-switch"]
 
 
 def test_run_writes_summary_timeseries_report_and_video(tmp_path):
@@ -237,5 +238,5 @@ def test_fast_plans(tmp_path, name):
     assert segments[0]["name"] == "switch-line" and any(s["name"] == "termination" for s in segments)
 
 
-def test_fast_plan_cannot_run_yet(tmp_path):
-    assert_one_line_error(planbench("run", "fast-tracking", "--out", tmp_path / "x"), "unknown scenario")
+def test_fast_dec_scan_is_a_plan_only(tmp_path):
+    assert_one_line_error(planbench("run", "fast-dec-scan", "--out", tmp_path / "x"), "unknown scenario")

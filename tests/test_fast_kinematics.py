@@ -111,8 +111,15 @@ def test_tensions_balance_the_wrench(azimuth, elevation):
     split = fast.split_tilt(fast.feed_position(s), s)
     pose = split.pose
     a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, pose.origin, pose.rotation)
-    wrench = fast.gravity_wrench(pose.origin, pose.rotation, fast.cable_lengths(pose.origin, pose.rotation))
+    r_ab = fast.ab_rotation(pose.theta_a, pose.theta_b)
+    wrench = fast.gravity_wrench(pose.origin, pose.rotation, fast.cable_lengths(pose.origin, pose.rotation),
+                                 ab_rotation=r_ab)
     np.testing.assert_allclose(a @ split.tensions + wrench, 0, atol=1e-6)
+    # The A-B tilt moves the centre of mass by (m_AB / m)(R_AB - I) r_AB-com in the cabin frame.
+    com = fast.cabin_com_at(r_ab)
+    g = fast.FAST
+    np.testing.assert_allclose(g.cabin_mass * com, g.cabin_mass * g.cabin_com + g.ab_mass * (r_ab @ g.ab_com - g.ab_com),
+                               atol=1e-9)
     assert split.tensions.min() >= fast.FAST_LIMITS.tension_min
     assert split.tensions.max() <= fast.FAST_LIMITS.tension_max
 

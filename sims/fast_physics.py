@@ -1,0 +1,553 @@
+"""FAST in MuJoCo: physics accessors, the cables' elastic-catenary law, wind, and the controller.
+
+The model is models/fast (README.md there has every number's source). Three pieces run once
+per control tick (100 Hz), MuJoCo takes the physics steps between them:
+
+* ``CableLoads`` (the runner's disturbance; it is part of the plant, so a user's controller
+  gets it too): each cable's tension from the elastic catenary (parabolic sag) at the current
+  chord length and the winch's unstretched length, linearized into the cable actuator's gain
+  and bias for the tick; half of each cable's weight at its cabin anchor; wind drag on the
+  cabin and on the cables (half of each cable's drag at its anchor).
+* ``FastController``: winch commands (planned cable lengths less the elastic stretch and the
+  sag under the planned tensions, plus PID feedback on the cabin pose measured at 10 Hz with
+  150 ms latency and noise), the A-B rotator servo (with integral action), the multi-beam
+  rotation, and the Stewart stabilizer (at 100 Hz: inverse kinematics from the measured pose of
+  its base to the planned feed pose).
+
+Elastic catenary (Irvine, "Cable Structures", 1981; parabolic sag, small sag-to-span): a cable
+of unstretched length L0, axial stiffness EA and weight w per length, with horizontal span
+l_h, has the chord length
+
+    L(T) = L0 (1 + T / EA) - w^2 l_h^2 L0 / (24 T^2)
+
+at the tension T. Its tangent stiffness dT/dL = (EA / L0) / (1 + (w l_h)^2 EA / (12 T^3)) is
+EA / L0 with Ernst's equivalent modulus E_eq = E / (1 + (w l_h)^2 E A / (12 T^3))
+(REFERENCE.md). A cable can only pull: the actuator's force range is [-T_max, 0].
+"""
+
+from __future__ import annotations
+
+import copy
+import functools
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+
+import models
+from planners import fast
+from planners.legs import leg_lengths, structure_matrix
+from planners.trajectory import TrajectorySample
+from sims.wind import AIR_DENSITY, wind_speed_series
+
+CONTROL_DT = 0.01  # s: the runner's tick, the Stewart stabilizer's 100 Hz
+
+#: Cables (REFERENCE.md): 46 mm steel wire rope, ~10 kg/m, E A = 1.5e8 N (E ~ 150 GPa on the
+#: rope's metallic area; generic, not a FAST figure).
+CABLE_EA = 1.5e8  # N
+CABLE_WEIGHT = fast.FAST.cable_mass_per_length * fast.GRAVITY  # N/m
+CABLE_DIAMETER = 0.046  # m
+#: Stiffness-proportional damping of the cables, s: beta = 2 zeta / omega gives zeta = 0.5 % at
+#: 0.2 Hz, the measured lowest cabin mode with its >= 0.4 % damping (REFERENCE.md).
+CABLE_DAMPING_S = 2 * 0.007 / (2 * math.pi * 0.2)
+#: Below this tension the catenary law is not solved further (a cable this slack is a failed
+#: check long before), N.
+TENSION_FLOOR = 1e3
+
+#: Drag coefficients: a finite circular cylinder of aspect ratio 7.6 / 13 in cross flow has
+#: Cd ~0.6-0.7 (Hoerner, Fluid-Dynamic Drag, ch. 3); 0.8 covers the cabin's fittings. A stranded
+#: wire rope across the wind: Cd ~1.2 (ISO 4354 / EN 1991-1-4 for ropes).
+CABIN_DRAG_COEFFICIENT = 0.8
+CABLE_DRAG_COEFFICIENT = 1.2
+CABIN_DIAMETER, CABIN_HEIGHT = 13.0, 7.6  # m (REFERENCE.md)
+#: The shell's centre in the cabin frame, m (fast.xml: shell from z = -6.6 to 1.0 m).
+CABIN_CENTRE = np.array([0.0, 0.0, -2.8])
+
+CABLE_ACTUATORS = tuple(f"cable{i}" for i in range(1, 7))
+AB_ACTUATORS = ("ab_a", "ab_b")
+LEG_ACTUATORS = tuple(f"leg{i}" for i in range(1, 7))
+
+
+# ----------------------------------------------------------------------------- cable law
+
+
+def chord_factor(tension, span, ea: float = CABLE_EA, weight: float = CABLE_WEIGHT):
+    """g = L / L0, the chord length over the unstretched length at ``tension`` (N) and the
+    horizontal span ``span`` (m): 1 + T / EA - w^2 l_h^2 / (24 T^2)."""
+    tension = np.asarray(tension, dtype=float)
+    return 1.0 + tension / ea - (weight * np.asarray(span)) ** 2 / (24.0 * tension**2)
+
+
+def tangent_stiffness(tension, span, unstretched, ea: float = CABLE_EA, weight: float = CABLE_WEIGHT):
+    """dT/dL at fixed L0, N/m: (EA / L0) / (1 + (w l_h)^2 EA / (12 T^3)) (Ernst's E_eq A / L0)."""
+    tension = np.asarray(tension, dtype=float)
+    return ea / np.asarray(unstretched) / (1.0 + (weight * np.asarray(span)) ** 2 * ea / (12.0 * tension**3))
+
+
+def unstretched_length(chord, tension, span, ea: float = CABLE_EA, weight: float = CABLE_WEIGHT):
+    """The winch's unstretched length L0 that gives the chord ``chord`` at ``tension``, m."""
+    return np.asarray(chord) / chord_factor(tension, span, ea, weight)
+
+
+def catenary_tension(chord, unstretched, span, guess, iterations: int = 30,
+                     ea: float = CABLE_EA, weight: float = CABLE_WEIGHT):
+    """The tension (N) at which a cable of unstretched length L0 spans the chord ``chord``.
+
+    Newton's method on L0 g(T) - L = 0 from ``guess``; g is increasing in T, so the root is
+    unique (a hanging cable always carries some tension); clamped at TENSION_FLOOR.
+    """
+    chord, unstretched, span = (np.asarray(x, dtype=float) for x in (chord, unstretched, span))
+    a = (weight * span) ** 2 * unstretched / 24.0
+    t = np.maximum(np.asarray(guess, dtype=float), TENSION_FLOOR)
+    for _ in range(iterations):
+        f = unstretched * (1.0 + t / ea) - a / t**2 - chord
+        t = np.maximum(t - f / (unstretched / ea + 2.0 * a / t**3), TENSION_FLOOR)
+    return t
+
+
+# ----------------------------------------------------------------------------- physics
+
+
+def _wxyz_from_matrix(rotation: np.ndarray) -> np.ndarray:
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rotation, dtype=float).ravel())
+    return quat
+
+
+@functools.lru_cache(maxsize=1)
+def _compiled() -> mujoco.MjModel:
+    return models.load("fast")
+
+
+class FastPhysics(dm_mujoco.Physics):
+    """dm_control Physics of models/fast/scene.xml with FAST's accessors."""
+
+    @classmethod
+    def load(cls) -> "FastPhysics":
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(_compiled())))
+        physics.reset(keyframe_id=0)
+        return physics
+
+    # ---- indices (from the compiled model)
+    def _ids(self, kind, names) -> np.ndarray:
+        model = self.model.ptr
+        return np.array([getattr(model, kind)(n).id for n in names])
+
+    @functools.cached_property
+    def cable_ids(self) -> np.ndarray:
+        return self._ids("actuator", CABLE_ACTUATORS)
+
+    @functools.cached_property
+    def ab_ids(self) -> np.ndarray:
+        return self._ids("actuator", AB_ACTUATORS)
+
+    @functools.cached_property
+    def leg_ids(self) -> np.ndarray:
+        return self._ids("actuator", LEG_ACTUATORS)
+
+    @functools.cached_property
+    def multifeed_id(self) -> int:
+        return int(self.model.ptr.actuator("multifeed").id)
+
+    @functools.cached_property
+    def anchor_sites(self) -> np.ndarray:
+        return self._ids("site", [f"anchor{i}" for i in range(1, 7)])
+
+    @functools.cached_property
+    def tower_tops(self) -> np.ndarray:
+        """(6, 3) the cable exits on the tower tops, world, m (fixed)."""
+        model, data = self.model.ptr, self.data.ptr
+        mujoco.mj_kinematics(model, data)
+        return data.site_xpos[self._ids("site", [f"tower{i}_top" for i in range(1, 7)])].copy()
+
+    @functools.cached_property
+    def cabin_body(self) -> int:
+        return int(self.model.ptr.body("cabin").id)
+
+    @functools.cached_property
+    def feed_site(self) -> int:
+        return int(self.model.ptr.site("feed").id)
+
+    def _qpos_adr(self, joint: str) -> int:
+        return int(self.model.ptr.joint(joint).qposadr[0])
+
+    @functools.cached_property
+    def ab_qpos(self) -> np.ndarray:
+        return np.array([self._qpos_adr(n) for n in AB_ACTUATORS])
+
+    @functools.cached_property
+    def ab_dofs(self) -> np.ndarray:
+        return np.array([self.model.ptr.joint(n).dofadr[0] for n in AB_ACTUATORS])
+
+    @functools.cached_property
+    def leg_qpos(self) -> np.ndarray:
+        return np.array([self._qpos_adr(n) for n in LEG_ACTUATORS])
+
+    @functools.cached_property
+    def leg_dofs(self) -> np.ndarray:
+        return np.array([self.model.ptr.joint(n).dofadr[0] for n in LEG_ACTUATORS])
+
+    @functools.cached_property
+    def multifeed_qpos(self) -> int:
+        return self._qpos_adr("multifeed")
+
+    def sensor_columns(self, names) -> np.ndarray:
+        """sensordata indices of 1-d sensors ``names``."""
+        model = self.model.ptr
+        return np.array([model.sensor(n).adr[0] for n in names])
+
+    def sensor_block(self, name: str) -> slice:
+        model = self.model.ptr
+        s = model.sensor(name)
+        return slice(int(s.adr[0]), int(s.adr[0] + s.dim[0]))
+
+    # ---- drive constants
+    def drive_gains(self, ids) -> tuple[np.ndarray, np.ndarray]:
+        """(kp, kv) of position actuators ``ids``."""
+        model = self.model.ptr
+        return model.actuator_gainprm[ids, 0].copy(), -model.actuator_biasprm[ids, 2].copy()
+
+    def force_limit(self, ids) -> np.ndarray:
+        return self.model.ptr.actuator_forcerange[ids, 1].copy()
+
+    @property
+    def tension_max(self) -> float:
+        """T_max, N: the cable actuators' pull limit."""
+        return float(-self.model.ptr.actuator_forcerange[self.cable_ids[0], 0])
+
+    # ---- state
+    def cable_tensions(self) -> np.ndarray:
+        """(6,) cable tensions, N (pull positive): minus the cable actuators' force."""
+        return -self.data.ptr.actuator_force[self.cable_ids].copy()
+
+    def cable_lengths(self) -> np.ndarray:
+        """(6,) chord lengths tower top to cabin anchor, m (MuJoCo's spatial tendons)."""
+        return self.data.ptr.ten_length[:6].copy()
+
+    def cabin_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """(origin (3,), rotation (3, 3)) of the cabin frame in the world."""
+        data = self.data.ptr
+        b = self.cabin_body
+        return data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy()
+
+    def feed_position(self) -> np.ndarray:
+        return self.data.ptr.site_xpos[self.feed_site].copy()
+
+    def ab_angles(self) -> np.ndarray:
+        return self.data.ptr.qpos[self.ab_qpos].copy()
+
+    def stewart_legs(self) -> np.ndarray:
+        """(6,) leg length changes from nominal (the encoders), m."""
+        return self.data.ptr.qpos[self.leg_qpos].copy()
+
+    def subtree_mass(self, bodies) -> tuple[float, np.ndarray]:
+        """(mass kg, centre of mass (3,) world) of the named bodies together (no subtrees)."""
+        model, data = self.model.ptr, self.data.ptr
+        ids = self._ids("body", bodies)
+        mass = model.body_mass[ids]
+        return float(mass.sum()), (mass[:, None] * data.xipos[ids]).sum(axis=0) / mass.sum()
+
+    def set_configuration(self, origin, rotation, theta_a: float, theta_b: float,
+                          multifeed: float = 0.0) -> None:
+        """Put the feed support at rest: cabin pose, A-B angles, Stewart legs nominal (the
+        universal joints and slides at zero, the platform where the loops close)."""
+        model, data = self.model.ptr, self.data.ptr
+        origin = np.asarray(origin, dtype=float)
+        rotation = np.asarray(rotation, dtype=float)
+        data.qpos[:] = model.qpos0
+        cabin = self._qpos_adr("cabin")
+        data.qpos[cabin:cabin + 3] = origin
+        data.qpos[cabin + 3:cabin + 7] = _wxyz_from_matrix(rotation)
+        data.qpos[self.ab_qpos] = theta_a, theta_b
+        g = fast.FAST
+        r_ab = fast.ab_rotation(theta_a, theta_b, g.alpha)
+        plat = self._qpos_adr("feed_platform")
+        data.qpos[plat:plat + 3] = origin + rotation @ (g.ab_center + r_ab @ g.r_ab_s)
+        data.qpos[plat + 3:plat + 7] = _wxyz_from_matrix(rotation @ r_ab)
+        data.qpos[self.multifeed_qpos] = multifeed
+        data.qvel[:] = 0.0
+        data.act[:] = 0.0
+        mujoco.mj_forward(model, data)
+
+    def loop_closure_error(self) -> float:
+        """Largest violation of the Stewart's six ball constraints, m."""
+        data = self.data.ptr
+        rows = data.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        return float(np.abs(data.efc_pos[rows]).max()) if rows.any() else 0.0
+
+
+# ----------------------------------------------------------------------------- the plant's loads
+
+
+class CableLoads:
+    """The cables' physics and the wind, per control tick (the runner's disturbance).
+
+    Per tick, with the winch's unstretched lengths L0 = ``ctrl`` of the cable actuators:
+    the tension T at the current chord (``catenary_tension``, from the last tick's value),
+    the tangent stiffness k and the chord factor g, written into the actuator's affine law so
+    that over the tick force = -(T + k (L' - L) - g k (L0' - L0)) - beta k L'_dot, i.e. the
+    catenary law linearized at the tick's start (the tension changes little in 10 ms); half
+    of each cable's weight at its anchor; with wind: drag on the cabin (its silhouette across
+    the wind at its tilt) and on each cable (the wind's component normal to the chord; half of
+    the cable's drag at its anchor). All as one force and torque on the cabin body
+    (``xfrc_applied``).
+
+    Args:
+      wind_speed: mean wind, m/s (0: none).
+      wind_azimuth_deg: the direction the wind blows toward, deg from +x (east) toward +y.
+      spectrum: "kaimal" or "davenport" (sims.wind).
+    """
+
+    def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal"):
+        if not np.isfinite(wind_speed) or wind_speed < 0:
+            raise ValueError(f"mean wind speed {wind_speed!r} m/s must be finite and >= 0")
+        self.mean_speed = float(wind_speed)
+        az = math.radians(wind_azimuth_deg)
+        self.direction = np.array([math.cos(az), math.sin(az), 0.0])
+        self.spectrum = spectrum
+        self.speed = None
+        self.force = None  # (n, 3) wind force on cabin and cables, N (logged)
+        self.tension = None  # (6,) the catenary tensions of the current tick, N
+        self.tension_log = None  # (n, 6) per tick, before the actuator's force clamp
+
+    def reset(self, physics: FastPhysics, times: np.ndarray, rng: np.random.Generator) -> None:
+        self.speed = wind_speed_series(times, self.mean_speed, rng, self.spectrum)
+        self.force = np.zeros((times.size, 3))
+        self.tension_log = np.zeros((times.size, 6))
+        model, data = physics.model.ptr, physics.data.ptr
+        self._model, self._data = model, data
+        self._cables = physics.cable_ids
+        self._sites = physics.anchor_sites
+        self._towers = physics.tower_tops
+        self._cabin = physics.cabin_body
+        self._xfrc = data.xfrc_applied[self._cabin]
+        mujoco.mj_forward(model, data)
+        chord, span, _ = self._geometry()
+        self.tension = catenary_tension(chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60)
+        self.apply(physics)
+
+    def _geometry(self):
+        data = self._data
+        vectors = data.site_xpos[self._sites] - self._towers
+        chord = np.sqrt(np.einsum("ij,ij->i", vectors, vectors))
+        span = np.hypot(vectors[:, 0], vectors[:, 1])
+        return chord, span, vectors
+
+    def apply(self, physics, tick: int | None = None) -> None:
+        """Update the cable laws and the loads for the coming tick (``tick`` None: no wind,
+        nothing logged)."""
+        model, data = self._model, self._data
+        chord, span, vectors = self._geometry()
+        l0 = data.ctrl[self._cables]
+        t = catenary_tension(chord, l0, span, self.tension, iterations=2)
+        self.tension = t
+        if tick is not None:
+            self.tension_log[tick] = t
+        k = tangent_stiffness(t, span, l0)
+        g = chord_factor(t, span)
+        ids = self._cables
+        model.actuator_gainprm[ids, 0] = g * k
+        model.actuator_biasprm[ids, 0] = -t + k * chord - g * k * l0
+        model.actuator_biasprm[ids, 1] = -k
+        model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
+        anchor_force = np.zeros((6, 3))
+        anchor_force[:, 2] = -0.5 * CABLE_WEIGHT * chord
+        com = data.xipos[self._cabin]
+        anchors = data.site_xpos[self._sites]
+        force = anchor_force.sum(axis=0)
+        torque = np.cross(anchors - com, anchor_force).sum(axis=0)
+        u = 0.0 if tick is None else float(self.speed[tick])
+        if u != 0.0:
+            wind = u * self.direction
+            half_rho = 0.5 * AIR_DENSITY
+            # Cables: the normal component of the wind on each chord, half the drag at the anchor.
+            units = vectors / chord[:, None]
+            normal = wind - (units @ wind)[:, None] * units
+            speed_n = np.sqrt(np.einsum("ij,ij->i", normal, normal))
+            cable_drag = (half_rho * CABLE_DRAG_COEFFICIENT * CABLE_DIAMETER * 0.5 * chord * speed_n)[:, None] * normal
+            # Cabin: a cylinder of the cabin's size along its z axis.
+            rotation = data.xmat[self._cabin].reshape(3, 3)
+            cos_t = min(abs(float(rotation[:, 2] @ self.direction)), 1.0)
+            area = CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + \
+                math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
+            cabin_drag = half_rho * CABIN_DRAG_COEFFICIENT * area * abs(u) * wind
+            centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE
+            wind_force = cable_drag.sum(axis=0) + cabin_drag
+            self.force[tick] = wind_force
+            force = force + wind_force
+            torque = torque + np.cross(anchors - com, cable_drag).sum(axis=0) + np.cross(centre - com, cabin_drag)
+        self._xfrc[:3] = force
+        self._xfrc[3:] = torque
+
+    def __call__(self, tick: int, physics) -> None:
+        self.apply(physics, tick)
+
+
+# ----------------------------------------------------------------------------- control
+
+
+@dataclass(frozen=True)
+class ControllerOptions:
+    """The FAST controller's settings.
+
+    Attributes:
+      stewart: the Stewart stabilizer corrects the feed (False: its legs hold nominal).
+      pose_rate_hz, pose_latency_s: the cabin pose measurement of the cable loop (total
+        stations: 10 Hz, 150 ms; the issue's values).
+      pose_noise_m, pose_noise_rad: its white noise, 1-sigma per axis (assumed: 1 mm and
+        20 urad, a total station's class at 150-300 m).
+      stewart_latency_s, stewart_noise_m, stewart_noise_rad: the 100 Hz measurement of the
+        cabin pose that the stabilizer corrects with (assumed: IMU-aided, 10 ms, 0.5 mm,
+        10 urad white).
+      stewart_filter_s: time constant of the first-order filter (the estimator's bandwidth,
+        ~3 Hz) on that measurement's deviation from the planned pose, s. Unfiltered, the
+        white noise moves the 2 t platform every tick and its reaction shakes the cabin's
+        lightly damped 0.3-0.65 Hz modes until the legs reach their stroke (tested).
+      kp, kd, ki: cable-loop PID on the cabin pose error (1, s, 1/s): the commanded pose
+        correction is kp e + kd de/dt + ki int e, mapped to cable lengths by the Jacobian.
+      derivative_filter_s: time constant of the first-order filter on de/dt, s.
+      ab_integral_s: the A-B servo's integral time, s (removes the gravity droop).
+    """
+
+    stewart: bool = True
+    pose_rate_hz: float = 10.0
+    pose_latency_s: float = 0.15
+    pose_noise_m: float = 1e-3
+    pose_noise_rad: float = 20e-6
+    stewart_latency_s: float = 0.01
+    stewart_noise_m: float = 0.5e-3
+    stewart_noise_rad: float = 10e-6
+    stewart_filter_s: float = 0.05
+    kp: float = 0.0
+    kd: float = 0.1
+    ki: float = 0.05
+    derivative_filter_s: float = 0.05
+    ab_integral_s: float = 1.0
+
+
+def _small_rotation(r_target: np.ndarray, r_actual: np.ndarray) -> np.ndarray:
+    """Rotation vector (3,) that turns r_actual toward r_target (small angles), rad."""
+    m = r_target @ r_actual.T
+    return 0.5 * np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+
+
+class FastController:
+    """Winches, A-B rotator, multi-beam rotation and Stewart stabilizer (see the module doc).
+
+    Args:
+      plan: the planners.fast_plan.FastPlan being followed (the reference's channels are its
+        feed, tilt, A-B and multi-beam angles and cable lengths; the rest comes from
+        ``plan.state``).
+      options: ControllerOptions.
+      seed: seed of the measurement noise.
+    """
+
+    def __init__(self, plan, options: ControllerOptions = ControllerOptions(), seed: int = 0):
+        self.plan = plan
+        self.options = options
+        self.seed = seed
+
+    def reset(self, physics: FastPhysics, reference: TrajectorySample, control_dt: float) -> None:
+        o = self.options
+        g = fast.FAST
+        self.physics = physics
+        self._data = physics.data.ptr
+        n = reference.t.size
+        state = self.plan.state(reference.t)
+        self.state = state
+        # Winch feed-forward: the unstretched lengths that give the planned chords under the
+        # planned tensions (stretch and sag, ``unstretched_length``).
+        anchors = state.cabin_origin[:, None, :] + np.einsum("nij,kj->nki", state.cabin_rotation, g.cabin_anchors)
+        vectors = anchors - physics.tower_tops
+        span = np.hypot(vectors[..., 0], vectors[..., 1])
+        self.l0_ff = unstretched_length(state.cable_length, state.tension, span)
+        self.r_platform = np.einsum("nij,njk->nik", state.cabin_rotation,
+                                    fast.ab_rotation(state.theta_a, state.theta_b, g.alpha))
+        self.p_platform = state.feed - np.einsum("nij,j->ni", self.r_platform, g.r_s_feed)
+        self.nominal_legs = fast.stewart_leg_lengths()
+        # Measurements: the true cabin pose is recorded every tick; the loops read it late.
+        rng = np.random.default_rng([self.seed, 0xFA57])
+        self.pose_every = max(1, int(round(1.0 / (o.pose_rate_hz * control_dt))))
+        self.pose_lag = int(round(o.pose_latency_s / control_dt))
+        self.stewart_lag = int(round(o.stewart_latency_s / control_dt))
+        self.true_pos = np.empty((n, 3))
+        self.true_rot = np.empty((n, 3, 3))
+        self.pose_noise = np.hstack([rng.normal(0.0, o.pose_noise_m, (n, 3)),
+                                     rng.normal(0.0, o.pose_noise_rad, (n, 3))])
+        self.stewart_noise = np.hstack([rng.normal(0.0, o.stewart_noise_m, (n, 3)),
+                                        rng.normal(0.0, o.stewart_noise_rad, (n, 3))])
+        self.correction = np.zeros(6)  # commanded pose correction, m and rad
+        self.integral = np.zeros(6)
+        self.derivative = np.zeros(6)
+        self.last_error = None
+        self.stewart_deviation = np.zeros(6)
+        self._stewart_alpha = control_dt / (o.stewart_filter_s + control_dt)
+        self.ab_integral = np.zeros(2)
+        self._ab_gain = control_dt / o.ab_integral_s
+        self.dt = control_dt
+        self.cable_length_correction = np.zeros((n, 6))  # logged: feedback part of L0, m
+        self.stewart_command = np.zeros((n, 6))
+        self.ab_reference = np.column_stack([state.theta_a, state.theta_b])
+        data = self._data
+        data.ctrl[physics.cable_ids] = self.l0_ff[0]
+        data.ctrl[physics.ab_ids] = self.ab_reference[0]
+        data.ctrl[physics.leg_ids] = 0.0
+        data.ctrl[physics.multifeed_id] = state.multifeed[0]
+
+    def _measured(self, tick: int, lag: int, noise: np.ndarray):
+        j = max(0, tick - lag)
+        pos = self.true_pos[j] + noise[j, :3]
+        w = noise[j, 3:]
+        rot = (np.eye(3) + np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])) @ self.true_rot[j]
+        return j, pos, rot
+
+    def _cable_feedback(self, tick: int) -> None:
+        o, s = self.options, self.state
+        j, pos, rot = self._measured(tick, self.pose_lag, self.pose_noise)
+        error = np.concatenate([s.cabin_origin[j] - pos, _small_rotation(s.cabin_rotation[j], rot)])
+        dt = self.pose_every * self.dt
+        if self.last_error is not None:
+            alpha = dt / (o.derivative_filter_s + dt)
+            self.derivative += alpha * ((error - self.last_error) / dt - self.derivative)
+        self.last_error = error
+        self.integral += error * dt
+        self.correction = o.kp * error + o.kd * self.derivative + o.ki * self.integral
+
+    def __call__(self, tick: int, physics) -> None:
+        data, p, s = self._data, self.physics, self.state
+        b = p.cabin_body
+        self.true_pos[tick] = data.xpos[b]
+        self.true_rot[tick] = data.xmat[b].reshape(3, 3)
+        nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
+        if tick % self.pose_every == 0:
+            self._cable_feedback(tick)
+        # Cable lengths for a pose correction dx: dL = -A^T dx (planners.legs).
+        a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[nxt],
+                             s.cabin_rotation[nxt])
+        dl = -a.T @ self.correction
+        self.cable_length_correction[tick] = dl
+        data.ctrl[p.cable_ids] = self.l0_ff[nxt] + dl
+        # A-B rotator: position servo with integral action on the encoder error.
+        ab = data.qpos[p.ab_qpos]
+        self.ab_integral += self._ab_gain * (self.ab_reference[tick] - ab)
+        data.ctrl[p.ab_ids] = self.ab_reference[nxt] + self.ab_integral
+        data.ctrl[p.multifeed_id] = s.multifeed[nxt]
+        if self.options.stewart:
+            j, pos, rot = self._measured(tick, self.stewart_lag, self.stewart_noise)
+            deviation = np.concatenate([pos - s.cabin_origin[j], _small_rotation(rot, s.cabin_rotation[j])])
+            self.stewart_deviation += self._stewart_alpha * (deviation - self.stewart_deviation)
+            w = self.stewart_deviation[3:]
+            pos = s.cabin_origin[tick] + self.stewart_deviation[:3]
+            rot = (np.eye(3) + np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])) @ s.cabin_rotation[tick]
+            g = fast.FAST
+            r_base = rot @ fast.ab_rotation(ab[0], ab[1], g.alpha)
+            p_base = pos + rot @ g.ab_center
+            # The platform's planned pose in the measured base (AB) frame, and its leg lengths;
+            # beyond the stroke the actuators' ctrlrange clamps (the log keeps the demand).
+            position = r_base.T @ (self.p_platform[nxt] - p_base)
+            legs = leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
+                               r_base.T @ self.r_platform[nxt]) - self.nominal_legs
+            self.stewart_command[tick] = legs
+            data.ctrl[p.leg_ids] = legs
