@@ -248,6 +248,8 @@ class FastEvaluation:
         tension_law = self.loads.tension_log[:n].copy()
         tension_law[n - 1] = tension_law[max(n - 2, 0)]  # the last tick has no physics after it
         legs = log.qpos[:, p.leg_qpos]
+        ctrl = log.ctrl.copy()
+        ctrl[n - 1] = ctrl[max(n - 2, 0)]  # the runner logs the ctrl of ticks with physics after them
         kp, kv = p.drive_gains(p.leg_ids)
         return {
             "feed_planned": log.reference.position[:, :3],
@@ -260,13 +262,13 @@ class FastEvaluation:
             "cable_tension_law": tension_law,
             "cable_tension_planned": state.tension[:n],
             "cable_length": log.sensordata[:, p.sensor_columns([f"cable{i}_length" for i in range(1, 7)])],
-            "cable_unstretched": log.ctrl[:, p.cable_ids],
+            "cable_unstretched": ctrl[:, p.cable_ids],
             "cable_length_feedback": c.cable_length_correction[:n],
             "ab_planned": c.ab_reference[:n],
             "ab_actual": log.qpos[:, p.ab_qpos],
             "stewart_leg": legs,
             "stewart_command": c.stewart_command[:n],
-            "stewart_force_demanded": demanded_force(kp, kv, log.ctrl[:, p.leg_ids], legs, log.qvel[:, p.leg_dofs]),
+            "stewart_force_demanded": demanded_force(kp, kv, ctrl[:, p.leg_ids], legs, log.qvel[:, p.leg_dofs]),
             "observing": observing_mask(self.plan, state.segment[:n]),
         }
 

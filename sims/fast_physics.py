@@ -39,6 +39,7 @@ from dm_control import mujoco as dm_mujoco
 import models
 from planners import fast
 from planners.legs import leg_lengths, structure_matrix
+from planners.rotations import rot_y, rot_z
 from planners.trajectory import TrajectorySample
 from sims.wind import AIR_DENSITY, wind_speed_series
 
@@ -110,6 +111,23 @@ def catenary_tension(chord, unstretched, span, guess, iterations: int = 30,
 # ----------------------------------------------------------------------------- physics
 
 
+#: The Levi-Civita symbol: sum_n a_n x b_n = einsum("ijk,nj,nk->i", ...) in one call (np.cross
+#: costs ~40 us a call on these small arrays, and this runs every tick).
+_LEVI_CIVITA = np.zeros((3, 3, 3))
+_LEVI_CIVITA[0, 1, 2] = _LEVI_CIVITA[1, 2, 0] = _LEVI_CIVITA[2, 0, 1] = 1.0
+_LEVI_CIVITA[0, 2, 1] = _LEVI_CIVITA[2, 1, 0] = _LEVI_CIVITA[1, 0, 2] = -1.0
+
+
+def _moment(arms: np.ndarray, forces: np.ndarray) -> np.ndarray:
+    """sum_n arms_n x forces_n, (3,), for (n, 3) arrays."""
+    return np.einsum("ijk,nj,nk->i", _LEVI_CIVITA, arms, forces)
+
+
+def _skew(w: np.ndarray) -> np.ndarray:
+    """I + [w]x: a small rotation w (rad) to first order."""
+    return np.array([[1.0, -w[2], w[1]], [w[2], 1.0, -w[0]], [-w[1], w[0], 1.0]])
+
+
 def _wxyz_from_matrix(rotation: np.ndarray) -> np.ndarray:
     quat = np.empty(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rotation, dtype=float).ravel())
@@ -165,6 +183,10 @@ class FastPhysics(dm_mujoco.Physics):
     @functools.cached_property
     def cabin_body(self) -> int:
         return int(self.model.ptr.body("cabin").id)
+
+    @functools.cached_property
+    def ab_b_body(self) -> int:
+        return int(self.model.ptr.body("ab_b").id)
 
     @functools.cached_property
     def feed_site(self) -> int:
@@ -341,7 +363,9 @@ class CableLoads:
         model, data = self._model, self._data
         chord, span, vectors = self._geometry()
         l0 = data.ctrl[self._cables]
-        t = catenary_tension(chord, l0, span, self.tension, iterations=2)
+        # One Newton step from the last tick's tension: it moves by a fraction of a percent in
+        # 10 ms, and Newton's error squares (the tests compare with the converged solution).
+        t = catenary_tension(chord, l0, span, self.tension, iterations=1)
         self.tension = t
         if tick is not None:
             self.tension_log[tick] = t
@@ -355,10 +379,9 @@ class CableLoads:
         anchor_force = np.zeros((6, 3))
         anchor_force[:, 2] = -0.5 * CABLE_WEIGHT * chord
         com = data.xipos[self._cabin]
-        anchors = data.site_xpos[self._sites]
-        force = anchor_force.sum(axis=0)
-        torque = np.cross(anchors - com, anchor_force).sum(axis=0)
+        arms = data.site_xpos[self._sites] - com
         u = 0.0 if tick is None else float(self.speed[tick])
+        force, torque = np.zeros(3), np.zeros(3)
         if u != 0.0:
             wind = u * self.direction
             half_rho = 0.5 * AIR_DENSITY
@@ -373,13 +396,12 @@ class CableLoads:
             area = CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + \
                 math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
             cabin_drag = half_rho * CABIN_DRAG_COEFFICIENT * area * abs(u) * wind
-            centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE
-            wind_force = cable_drag.sum(axis=0) + cabin_drag
-            self.force[tick] = wind_force
-            force = force + wind_force
-            torque = torque + np.cross(anchors - com, cable_drag).sum(axis=0) + np.cross(centre - com, cabin_drag)
-        self._xfrc[:3] = force
-        self._xfrc[3:] = torque
+            centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE - com
+            self.force[tick] = cable_drag.sum(axis=0) + cabin_drag
+            anchor_force += cable_drag
+            force, torque = cabin_drag, _moment(centre[None], cabin_drag[None])
+        self._xfrc[:3] = anchor_force.sum(axis=0) + force
+        self._xfrc[3:] = _moment(arms, anchor_force) + torque
 
     def __call__(self, tick: int, physics) -> None:
         self.apply(physics, tick)
@@ -401,14 +423,22 @@ class ControllerOptions:
       stewart_latency_s, stewart_noise_m, stewart_noise_rad: the 100 Hz measurement of the
         cabin pose that the stabilizer corrects with (assumed: IMU-aided, 10 ms, 0.5 mm,
         10 urad white).
-      stewart_filter_s: time constant of the first-order filter (the estimator's bandwidth,
-        ~3 Hz) on that measurement's deviation from the planned pose, s. Unfiltered, the
-        white noise moves the 2 t platform every tick and its reaction shakes the cabin's
-        lightly damped 0.3-0.65 Hz modes until the legs reach their stroke (tested).
+      stewart_bandwidth_hz: bandwidth of the estimator (an alpha-beta tracker, critically
+        damped) of that measurement's deviation from the planned pose and of its rate; the
+        command leads by the latency plus the leg servo's lag kv/kp. Unfiltered, the white
+        noise moves the 2 t platform every tick and its reaction shakes the cabin's lightly
+        damped 0.3-0.65 Hz modes until the legs reach their stroke.
       kp, kd, ki: cable-loop PID on the cabin pose error (1, s, 1/s): the commanded pose
         correction is kp e + kd de/dt + ki int e, mapped to cable lengths by the Jacobian.
+        Integral only by default: with the 150 ms latency, proportional and derivative action
+        destabilize the cabin's 0.3-0.65 Hz modes (kp 0.2 with the stabilizer on at the
+        zenith, kd 0.1 at zenith angle 40 deg: found in simulation), and the slow integral
+        (0.02/s, 50 s) removes the drift the stabilizer would otherwise carry.
       derivative_filter_s: time constant of the first-order filter on de/dt, s.
-      ab_integral_s: the A-B servo's integral time, s (removes the gravity droop).
+      ab_integral_s: the A-B servo's integral time, s (removes what the gravity feed-forward
+        leaves).
+      leg_integral_s: the Stewart legs' integral time on their encoder error, s (removes the
+        servo droop under the platform's weight, 0.2-0.7 mm at kp = 2e7 N/m).
     """
 
     stewart: bool = True
@@ -419,12 +449,32 @@ class ControllerOptions:
     stewart_latency_s: float = 0.01
     stewart_noise_m: float = 0.5e-3
     stewart_noise_rad: float = 10e-6
-    stewart_filter_s: float = 0.05
+    stewart_bandwidth_hz: float = 3.0
     kp: float = 0.0
-    kd: float = 0.1
-    ki: float = 0.05
+    kd: float = 0.0
+    ki: float = 0.02
     derivative_filter_s: float = 0.05
     ab_integral_s: float = 1.0
+    leg_integral_s: float = 0.2
+
+
+def ab_gravity_torque(state, geometry: fast.FastGeometry = fast.FAST) -> np.ndarray:
+    """(n, 2) gravity's torque about the A and B axes, N m, along a plan's states.
+
+    The tilted part (``ab_mass`` at ``ab_com`` in the AB frame; the A ring is balanced) hangs
+    at R_C R_AB ab_com from the rotator's centre; the torque about an axis is the axis' component
+    of r x (m g). Axis A is Rz(alpha) e_y in the cabin frame, axis B Rz(alpha) Ry(theta_A) e_x.
+    The servo's set-point leads by -torque / kp so that it holds the angle without droop.
+    """
+    rot_c = state.cabin_rotation
+    r_ab = fast.ab_rotation(state.theta_a, state.theta_b, geometry.alpha)
+    arm = np.einsum("nij,njk,k->ni", rot_c, r_ab, geometry.ab_com)
+    weight = np.array([0.0, 0.0, -geometry.ab_mass * fast.GRAVITY])
+    moment = np.cross(arm, weight)
+    z_alpha = rot_z(np.full(state.theta_a.shape, geometry.alpha))
+    axis_a = np.einsum("nij,njk,k->ni", rot_c, z_alpha, [0.0, 1.0, 0.0])
+    axis_b = np.einsum("nij,njk,nkl,l->ni", rot_c, z_alpha, rot_y(state.theta_a), [1.0, 0.0, 0.0])
+    return np.column_stack([np.einsum("ni,ni->n", axis_a, moment), np.einsum("ni,ni->n", axis_b, moment)])
 
 
 def _small_rotation(r_target: np.ndarray, r_actual: np.ndarray) -> np.ndarray:
@@ -479,29 +529,38 @@ class FastController:
         self.stewart_noise = np.hstack([rng.normal(0.0, o.stewart_noise_m, (n, 3)),
                                         rng.normal(0.0, o.stewart_noise_rad, (n, 3))])
         self.correction = np.zeros(6)  # commanded pose correction, m and rad
+        self.length_correction = np.zeros(6)  # its cable lengths, m
         self.integral = np.zeros(6)
         self.derivative = np.zeros(6)
         self.last_error = None
+        # Alpha-beta tracker of the cabin's deviation from its plan (critically damped at the
+        # bandwidth w: alpha = 1 - r^2, beta = (1 - r)^2 with r = exp(-w dt)).
+        r = math.exp(-2 * math.pi * o.stewart_bandwidth_hz * control_dt)
+        self._tracker_gains = (1.0 - r * r, (1.0 - r) ** 2 / control_dt)
         self.stewart_deviation = np.zeros(6)
-        self._stewart_alpha = control_dt / (o.stewart_filter_s + control_dt)
+        self.stewart_rate = np.zeros(6)
+        kp_leg, kv_leg = physics.drive_gains(physics.leg_ids)
+        self.stewart_lead = o.stewart_latency_s + float(np.mean(kv_leg / kp_leg))
         self.ab_integral = np.zeros(2)
         self._ab_gain = control_dt / o.ab_integral_s
+        self.leg_integral = np.zeros(6)
+        self._leg_gain = control_dt / o.leg_integral_s
+        self._leg_target = np.zeros(6)
         self.dt = control_dt
         self.cable_length_correction = np.zeros((n, 6))  # logged: feedback part of L0, m
         self.stewart_command = np.zeros((n, 6))
         self.ab_reference = np.column_stack([state.theta_a, state.theta_b])
+        kp_ab, _ = physics.drive_gains(physics.ab_ids)
+        self.ab_setpoint = self.ab_reference - ab_gravity_torque(state) / kp_ab
         data = self._data
         data.ctrl[physics.cable_ids] = self.l0_ff[0]
-        data.ctrl[physics.ab_ids] = self.ab_reference[0]
+        data.ctrl[physics.ab_ids] = self.ab_setpoint[0]
         data.ctrl[physics.leg_ids] = 0.0
         data.ctrl[physics.multifeed_id] = state.multifeed[0]
 
     def _measured(self, tick: int, lag: int, noise: np.ndarray):
         j = max(0, tick - lag)
-        pos = self.true_pos[j] + noise[j, :3]
-        w = noise[j, 3:]
-        rot = (np.eye(3) + np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])) @ self.true_rot[j]
-        return j, pos, rot
+        return j, self.true_pos[j] + noise[j, :3], _skew(noise[j, 3:]) @ self.true_rot[j]
 
     def _cable_feedback(self, tick: int) -> None:
         o, s = self.options, self.state
@@ -523,31 +582,49 @@ class FastController:
         nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
         if tick % self.pose_every == 0:
             self._cable_feedback(tick)
-        # Cable lengths for a pose correction dx: dL = -A^T dx (planners.legs).
-        a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[nxt],
-                             s.cabin_rotation[nxt])
-        dl = -a.T @ self.correction
-        self.cable_length_correction[tick] = dl
-        data.ctrl[p.cable_ids] = self.l0_ff[nxt] + dl
+            # Cable lengths for the pose correction dx: dL = -A^T dx (planners.legs), at the
+            # planned pose (it moves by millimetres between two updates).
+            a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[tick],
+                                 s.cabin_rotation[tick])
+            self.length_correction = -a.T @ self.correction
+        self.cable_length_correction[tick] = self.length_correction
+        data.ctrl[p.cable_ids] = self.l0_ff[nxt] + self.length_correction
         # A-B rotator: position servo with integral action on the encoder error.
         ab = data.qpos[p.ab_qpos]
         self.ab_integral += self._ab_gain * (self.ab_reference[tick] - ab)
-        data.ctrl[p.ab_ids] = self.ab_reference[nxt] + self.ab_integral
+        data.ctrl[p.ab_ids] = self.ab_setpoint[nxt] + self.ab_integral
         data.ctrl[p.multifeed_id] = s.multifeed[nxt]
-        if self.options.stewart:
-            j, pos, rot = self._measured(tick, self.stewart_lag, self.stewart_noise)
-            deviation = np.concatenate([pos - s.cabin_origin[j], _small_rotation(rot, s.cabin_rotation[j])])
-            self.stewart_deviation += self._stewart_alpha * (deviation - self.stewart_deviation)
-            w = self.stewart_deviation[3:]
-            pos = s.cabin_origin[tick] + self.stewart_deviation[:3]
-            rot = (np.eye(3) + np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])) @ s.cabin_rotation[tick]
-            g = fast.FAST
-            r_base = rot @ fast.ab_rotation(ab[0], ab[1], g.alpha)
-            p_base = pos + rot @ g.ab_center
-            # The platform's planned pose in the measured base (AB) frame, and its leg lengths;
-            # beyond the stroke the actuators' ctrlrange clamps (the log keeps the demand).
-            position = r_base.T @ (self.p_platform[nxt] - p_base)
-            legs = leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
-                               r_base.T @ self.r_platform[nxt]) - self.nominal_legs
-            self.stewart_command[tick] = legs
-            data.ctrl[p.leg_ids] = legs
+        legs = self._stewart_legs(tick, nxt) if self.options.stewart else self._leg_target
+        self.stewart_command[tick] = legs
+        # Leg servos: integral action on the encoders toward the last commanded lengths,
+        # bounded by 5 % of the stroke (anti-windup); off, the legs hold nominal the same way.
+        self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (self._leg_target - data.qpos[p.leg_qpos]),
+                                    -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
+        self._leg_target = legs
+        data.ctrl[p.leg_ids] = legs + self.leg_integral
+
+    def _stewart_legs(self, tick: int, nxt: int) -> np.ndarray:
+        """Leg length changes (6,) that put the feed platform at its planned pose for the end of
+        the tick, from the estimated cabin pose and the A-B encoders (inverse kinematics)."""
+        data, p, s = self._data, self.physics, self.state
+        j, pos, rot = self._measured(tick, self.stewart_lag, self.stewart_noise)
+        deviation = np.concatenate([pos - s.cabin_origin[j], _small_rotation(rot, s.cabin_rotation[j])])
+        alpha, beta = self._tracker_gains
+        predicted = self.stewart_deviation + self.stewart_rate * self.dt
+        residual = deviation - predicted
+        self.stewart_deviation = predicted + alpha * residual
+        self.stewart_rate = self.stewart_rate + beta * residual
+        # Where the cabin will be when the legs get there: lead by latency + servo lag.
+        ahead = self.stewart_deviation + self.stewart_lead * self.stewart_rate
+        pos = s.cabin_origin[nxt] + ahead[:3]
+        rot = _skew(ahead[3:]) @ s.cabin_rotation[nxt]
+        # R_AB from the encoders: the B frame relative to the cabin, as the model's kinematics
+        # has it (the encoders are exact here).
+        r_ab = data.xmat[p.cabin_body].reshape(3, 3).T @ data.xmat[p.ab_b_body].reshape(3, 3)
+        r_base = rot @ r_ab
+        p_base = pos + rot @ fast.FAST.ab_center
+        # The platform's planned pose in the measured base (AB) frame, and its leg lengths;
+        # beyond the stroke the actuators' ctrlrange clamps (the log keeps the demand).
+        position = r_base.T @ (self.p_platform[nxt] - p_base)
+        return leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
+                           r_base.T @ self.r_platform[nxt]) - self.nominal_legs

@@ -1,0 +1,171 @@
+"""FAST in MuJoCo: statics, modes, wind, tension-only cables, determinism (short runs)."""
+
+import functools
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from planners import fast
+from planners import fast_plan as fplan
+from sims import fast as fast_sim
+from sims import runner
+from sims.fast_physics import CableLoads, ControllerOptions, FastController, FastPhysics, tangent_stiffness
+from sims.scenarios import RunOptions
+
+#: The measured lowest cabin-cable mode (REFERENCE.md: Universe 10:450, 2024).
+MEASURED_LOWEST_MODE_HZ = (0.12, 0.2)
+
+
+def hold_plan(azimuth_deg: float, elevation_deg: float, duration: float) -> fplan.FastPlan:
+    """A feed held still at the focal point of one direction (a one-segment plan)."""
+    s = fast.source_direction(math.radians(azimuth_deg), math.radians(elevation_deg))
+    return fplan.FastPlan([fplan.observation_segment(np.array([0.0, duration]), np.stack([s, s]),
+                                                     name="observation (held)")])
+
+
+@functools.cache
+def observation_run(wind: float, stewart: bool, duration: float = 60.0, seed: int = 0):
+    plan = fast_sim.observation_plan(duration)
+    setup = fast_sim.build(plan, RunOptions(wind=wind, seed=seed), ControllerOptions(stewart=stewart))
+    return runner.run("fast-observation", setup), setup
+
+
+def check(result, name):
+    return next(c for c in result.checks if c.name == name)
+
+
+@pytest.mark.parametrize("elevation_deg", [90.0, 50.0])
+def test_static_tensions_equal_the_planner(elevation_deg):
+    """At rest at the zenith and at zenith angle 40 deg (the planner's tilt split), MuJoCo's
+    cable tensions equal the planner's static distribution within 1 %."""
+    plan = hold_plan(30.0, elevation_deg, 10.0)
+    setup = fast_sim.build(plan, RunOptions(wind=0.0))
+    result = runner.run("hold", setup)
+    planned = setup.controller.state.tension[-1]
+    measured = -result.log.actuator_force[-1, setup.physics.cable_ids]
+    np.testing.assert_allclose(measured, planned, rtol=0.01)
+    assert np.abs(measured / planned - 1).max() < 0.002  # in fact within 0.2 %
+    if elevation_deg == 50.0:  # the tilt split's point: tensions far from uniform
+        assert np.degrees(setup.controller.state.cabin_tilt[-1]) > 10
+        assert planned.max() / planned.min() > 1.5
+    assert check(result, "feed_error_max").value < 2.0  # mm: the feed holds still
+
+
+def test_lowest_cabin_modes():
+    """MuJoCo's linearization at the zenith (mjd_transitionFD): six cabin-cable modes.
+
+    The lowest is the heave mode, checked against the hand value sqrt(k_z / m)/(2 pi) with
+    k_z = sum of the cables' tangent stiffness sin^2(beta) plus their geometric stiffness
+    T cos^2(beta) / L, and m the cabin with the cables' lumped third. It lies at 0.30 Hz,
+    above the measured 0.12-0.2 Hz: E A = 1.5e8 N is a generic rope value (FAST's own is not
+    public), the model lumps a third of each cable's mass at its anchor but leaves out the
+    cables' transverse (sag) dynamics and the towers' compliance, all of which lower the real
+    modes. Its damping is at least the measured 0.4 %.
+    """
+    physics = FastPhysics.load()
+    model, data = physics.model.ptr, physics.data.ptr
+    loads = CableLoads(0.0)
+    loads.reset(physics, np.arange(3) * 0.01, np.random.default_rng(0))
+    nx = 2 * model.nv + model.na
+    a = np.zeros((nx, nx))
+    mujoco.mjd_transitionFD(model, data, 1e-6, True, a, None, None, None)
+    eig, vec = np.linalg.eig(a)
+    s = np.log(eig.astype(complex)) / model.opt.timestep
+    up = (s.imag > 1e-6) & (s.imag / (2 * np.pi) < 1.0)
+    freq = s.imag[up] / (2 * np.pi)
+    zeta = -s.real[up] / np.abs(s[up])
+    assert up.sum() == 6  # the cabin's six rigid-body modes on its cables, all below 1 Hz
+    order = np.argsort(freq)
+    freq, zeta, shapes = freq[order], zeta[order], vec[:, up][:, order]
+    assert 0.25 < freq[0] < 0.35 and freq[-1] < 0.8
+    assert zeta.min() >= 0.004
+    # The lowest is the heave: its shape is the cabin's z (qpos index 2).
+    heave = np.abs(shapes[:model.nv, 0])
+    assert np.argmax(heave[:6]) == 2
+    # Hand value.
+    origin, rotation = physics.cabin_pose()
+    vectors = fast.FAST.cabin_anchors + origin - fast.FAST.tower_anchors
+    length = np.linalg.norm(vectors, axis=1)
+    sin_beta = -vectors[:, 2] / length
+    span = np.hypot(vectors[:, 0], vectors[:, 1])
+    tension = physics.cable_tensions()
+    k = tangent_stiffness(tension, span, data.ctrl[physics.cable_ids])
+    k_z = np.sum(k * sin_beta**2 + tension * (1 - sin_beta**2) / length)
+    mass = fast.FAST.cabin_mass + sum(model.body(f"anchor_mass{i}").mass[0] for i in range(1, 4))
+    assert freq[0] == pytest.approx(math.sqrt(k_z / mass) / (2 * math.pi), rel=0.03)
+    assert freq[0] > MEASURED_LOWEST_MODE_HZ[1]  # documented above: stiffer than measured
+
+
+def test_feed_error_grows_with_wind_without_the_stabilizer():
+    rms = [check(observation_run(w, False)[0], "feed_error_rms").value for w in (0.0, 4.0, 8.0)]
+    assert rms[0] < rms[1] < rms[2]
+    assert rms[2] > 2 * rms[1]  # drag grows with the square of the speed
+
+
+def test_stabilizer_holds_10_mm_rms_at_4_m_s():
+    on, _ = observation_run(4.0, True)
+    off, _ = observation_run(4.0, False)
+    feed_on, feed_off = check(on, "feed_error_rms"), check(off, "feed_error_rms")
+    assert feed_on.passed and feed_on.value <= 10.0
+    assert feed_on.value < feed_off.value
+    # With the stabilizer on the feed is steadier than the cabin that carries it.
+    assert feed_on.value < check(on, "cabin_error_rms").value
+    assert on.passed
+    # At 8 m/s (the stress case) the stabilizer still removes most of the error.
+    assert check(observation_run(8.0, True)[0], "feed_error_rms").value < \
+        0.6 * check(observation_run(8.0, False)[0], "feed_error_rms").value
+
+
+def test_wind_load_matches_the_drag_formula():
+    result, setup = observation_run(8.0, False)
+    loads = setup.disturbance
+    n = result.log.t.size - 1
+    force = np.linalg.norm(loads.force[:n], axis=1)
+    # Cabin alone: 1/2 rho Cd D H u^2 at the mean; cables add their normal drag.
+    cabin = 0.5 * 1.2 * 0.8 * 13.0 * 7.6 * loads.speed[:n] ** 2
+    assert np.all(force >= 0.9 * cabin)
+    assert np.all(force <= 2.0 * cabin)
+
+
+class PayOutCable(FastController):
+    """Pays out cable 1 by 12 m over 10 s from t = 5 s: the winch runs the wrong way."""
+
+    def __call__(self, tick, physics):
+        super().__call__(tick, physics)
+        extra = 12.0 * np.clip((tick * self.dt - 5.0) / 10.0, 0.0, 1.0)
+        physics.data.ctrl[physics.cable_ids[0]] += extra
+
+
+def test_a_slack_cable_fails_and_no_cable_ever_pushes():
+    plan = fast_sim.observation_plan(30.0)
+    setup = fast_sim.build(plan, RunOptions(wind=0.0))
+    setup.controller = PayOutCable(plan, ControllerOptions(stewart=False))
+    setup.evaluate.controller = setup.controller
+    result = runner.run("slack", setup)
+    low = check(result, "cable_tension_min")
+    assert not low.passed and low.value < fast.FAST_LIMITS.tension_min / 1e3
+    assert "cable1" in low.note
+    assert result.log.actuator_force[:, setup.physics.cable_ids].max() <= 0.0  # pull only
+    # The nominal runs never come near slack.
+    assert check(observation_run(8.0, False)[0], "cable_tension_min").passed
+
+
+def test_same_seed_same_run_other_seed_other_wind():
+    a, _ = observation_run(4.0, True, duration=10.0, seed=3)
+    plan = fast_sim.observation_plan(10.0)
+    b = runner.run("again", fast_sim.build(plan, RunOptions(wind=4.0, seed=3), ControllerOptions()))
+    np.testing.assert_array_equal(a.log.qpos, b.log.qpos)
+    np.testing.assert_array_equal(a.log.actuator_force, b.log.actuator_force)
+    c, _ = observation_run(4.0, True, duration=10.0, seed=4)
+    assert not np.array_equal(a.log.qpos, c.log.qpos)
+
+
+def test_winch_feedforward_alone_holds_the_cabin():
+    """No feedback, no wind: the stretch-and-sag feed-forward alone keeps the cabin within a
+    few mm while tracking (the plan's statics and the model agree)."""
+    plan = fast_sim.observation_plan(30.0)
+    setup = fast_sim.build(plan, RunOptions(wind=0.0), ControllerOptions(stewart=False, kp=0, kd=0, ki=0))
+    result = runner.run("ff", setup)
+    assert check(result, "cabin_error_rms").value < 3.0
