@@ -268,7 +268,8 @@ class FastEvaluation:
             "ab_actual": log.qpos[:, p.ab_qpos],
             "stewart_leg": legs,
             "stewart_command": c.stewart_command[:n],
-            "stewart_force_demanded": demanded_force(kp, kv, ctrl[:, p.leg_ids], legs, log.qvel[:, p.leg_dofs]),
+            "stewart_setpoint": log.act[:, p.leg_act],
+            "stewart_force_demanded": demanded_force(kp, kv, log.act[:, p.leg_act], legs, log.qvel[:, p.leg_dofs]),
             "observing": observing_mask(self.plan, state.segment[:n]),
         }
 

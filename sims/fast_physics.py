@@ -212,6 +212,11 @@ class FastPhysics(dm_mujoco.Physics):
         return np.array([self.model.ptr.joint(n).dofadr[0] for n in LEG_ACTUATORS])
 
     @functools.cached_property
+    def leg_act(self) -> np.ndarray:
+        """act index of each leg drive (its set-point)."""
+        return self.model.ptr.actuator_actadr[self.leg_ids].copy()
+
+    @functools.cached_property
     def multifeed_qpos(self) -> int:
         return self._qpos_adr("multifeed")
 
@@ -227,7 +232,8 @@ class FastPhysics(dm_mujoco.Physics):
 
     # ---- drive constants
     def drive_gains(self, ids) -> tuple[np.ndarray, np.ndarray]:
-        """(kp, kv) of position actuators ``ids``."""
+        """(kp, kv) of the servo drives ``ids`` (position actuators and the legs' integrator
+        servos: force = kp (set-point - q) - kv qdot)."""
         model = self.model.ptr
         return model.actuator_gainprm[ids, 0].copy(), -model.actuator_biasprm[ids, 2].copy()
 
@@ -601,7 +607,8 @@ class FastController:
         self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (self._leg_target - data.qpos[p.leg_qpos]),
                                     -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
         self._leg_target = legs
-        data.ctrl[p.leg_ids] = legs + self.leg_integral
+        setpoint = legs + self.leg_integral
+        data.ctrl[p.leg_ids] = (setpoint - data.act[p.leg_act]) / self.dt  # ramp over the tick
 
     def _stewart_legs(self, tick: int, nxt: int) -> np.ndarray:
         """Leg length changes (6,) that put the feed platform at its planned pose for the end of
