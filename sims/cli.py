@@ -201,7 +201,8 @@ def cmd_demo(args) -> int:
         setup = scenario.build(scenarios.RunOptions())
         result = runner.run(scenario.name, setup, quiet=args.quiet)
         outputs.write_run(result, setup, out, video=out / f"{scenario.name}.mp4",
-                          camera=scenario.camera, quiet=args.quiet)
+                          camera=scenario.camera, quiet=args.quiet,
+                          more_videos=[(f"{scenario.name}-{c}.mp4", c) for c in scenario.demo_cameras])
         rows += [(scenario.name, c) for c in result.checks]
         verdict = "passed" if result.passed else "failed"
         expected = "as expected" if result.passed == scenario.expect_pass else "UNEXPECTEDLY"

@@ -162,3 +162,84 @@ def antenna_environment(sea_state: bool = True, duration: float = 60.0,
     task.prepare(setup.physics, control_dt, duration)
     n_sub = int(round(control_dt / setup.physics.model.opt.timestep))
     return control.Environment(setup.physics, task, time_limit=duration, n_sub_steps=n_sub)
+
+
+class FastTask(TrajectoryTrackingTask):
+    """Keep FAST's feed on its plan: the feed support for a user's controller.
+
+    The action is every actuator's ctrl: the six winches' unstretched lengths (m), the A-B
+    set-points (rad), the six Stewart legs' set-point rates (m/s) and the multi-beam angle
+    (rad). The plant's per-tick physics (the cables' catenary law, their weight and the wind,
+    ``sims.fast_physics.CableLoads``) runs before every step. Observations: the cabin pose
+    (position, quaternion), the feed position, the cable tensions and lengths, the A-B angles,
+    the leg encoders, the planned feed and the plan's static tensions and unstretched-length
+    feed-forward at the current time. The reward is exp(-feed error / scale).
+    """
+
+    def __init__(self, setup, error_scale: float = 0.01):
+        super().__init__(setup.trajectory, [], error_scale)
+        self._setup = setup
+
+    def prepare(self, physics, control_dt: float, duration: float):
+        from planners.trajectory import control_ticks
+
+        self._times = control_ticks(duration, control_dt)
+        self._dt = control_dt
+        self._initial = physics.get_state().copy()
+        self._setup.controller.reset(physics, self._setup.trajectory.sample(self._times), control_dt)
+        self._initial_ctrl = physics.data.ctrl.copy()
+
+    def initialize_episode(self, physics):
+        physics.set_state(self._initial)
+        physics.data.ctrl[:] = self._initial_ctrl
+        physics.forward()
+        self._setup.disturbance.reset(physics, self._times, np.random.default_rng(self._setup.seed))
+
+    def tick(self, physics) -> int:
+        return min(int(round(physics.data.time / self._dt)), self._times.size - 1)
+
+    def before_step(self, action, physics):
+        physics.data.ctrl[:] = action
+        self._setup.disturbance(self.tick(physics), physics)
+
+    def action_spec(self, physics):
+        from dm_env import specs
+
+        lo, hi = physics.model.actuator_ctrlrange.T
+        return specs.BoundedArray((physics.model.nu,), float, lo, hi, name="ctrl")
+
+    def get_observation(self, physics):
+        state = self._setup.controller.state
+        k = self.tick(physics)
+        origin, rotation = physics.cabin_pose()
+        obs = collections.OrderedDict()
+        obs["cabin_position"] = origin
+        obs["cabin_quat"] = physics.data.xquat[physics.cabin_body].copy()
+        obs["feed_position"] = physics.feed_position()
+        obs["cable_tensions"] = physics.cable_tensions()
+        obs["cable_lengths"] = physics.cable_lengths()
+        obs["ab_angles"] = physics.ab_angles()
+        obs["stewart_legs"] = physics.stewart_legs()
+        obs["reference_feed"] = state.feed[k]
+        obs["reference_tensions"] = state.tension[k]
+        obs["reference_unstretched_lengths"] = self._setup.controller.l0_ff[k]
+        return obs
+
+    def get_reward(self, physics):
+        error = np.linalg.norm(physics.feed_position() - self._setup.controller.state.feed[self.tick(physics)])
+        return float(np.exp(-error / self._scale))
+
+
+def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0) -> control.Environment:
+    """FAST's feed support as a dm_control Environment: ``duration`` s of tracking 3C 286 (no
+    switch: the episode starts on the source at rest), in ``wind`` m/s."""
+    from sims import fast
+    from sims.fast_physics import CONTROL_DT
+    from sims.scenarios import RunOptions
+
+    setup = fast.build(fast.observation_plan(duration), RunOptions(wind=wind, seed=seed))
+    task = FastTask(setup)
+    total = setup.trajectory.duration
+    task.prepare(setup.physics, CONTROL_DT, total)
+    n_sub = int(round(CONTROL_DT / setup.physics.model.opt.timestep))
+    return control.Environment(setup.physics, task, time_limit=total, n_sub_steps=n_sub)

@@ -90,12 +90,13 @@ def atomic_dir(out_dir: Path):
 
 
 def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: str = "overview",
-              quiet: bool = True) -> dict:
+              quiet: bool = True, more_videos: tuple = ()) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
 
     The video goes into the same temporary directory when it lies inside ``out_dir``, else
     into a temporary file beside it; both are renamed into place only when everything is
-    written. Returns the summary.
+    written. ``more_videos``: (file name, camera) pairs of further videos inside ``out_dir``
+    (the demo's close-ups). Returns the summary.
     """
     from sims.render import render_video
 
@@ -128,6 +129,11 @@ def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: s
                 summary["video"] = {"path": str(video), "frames": frames, "camera": camera}
                 if setup.video_note:
                     summary["video"]["shows"] = setup.video_note
+            for name, extra_camera in more_videos:
+                frames = render_video(setup.physics.model.ptr, log, tmp / name, camera=extra_camera,
+                                      speed=setup.video_speed, quiet=quiet, frame_qpos=setup.video_qpos)
+                summary.setdefault("more_videos", []).append(
+                    {"path": str(out_dir / name), "frames": frames, "camera": extra_camera})
             (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         if video_tmp is not None:
             _usual_mode(video_tmp, 0o666)

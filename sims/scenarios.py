@@ -52,6 +52,7 @@ class Scenario:
       kinds: () -> "slide" or "hinge" per planned channel (units of plots).
       plan_extras: optional (plan, out_dir) -> None, more files for ``planbench plan`` (the
         antenna's comparison of the paper's methods, FAST's figures).
+      demo_cameras: cameras of further videos that ``planbench demo`` renders (NAME-CAMERA.mp4).
     """
 
     name: str
@@ -63,6 +64,7 @@ class Scenario:
     camera: str = "overview"
     kinds: Callable = lambda: ()
     plan_extras: Callable | None = None
+    demo_cameras: tuple = ()
 
 
 SCENARIOS: dict[str, Scenario] = {
@@ -124,6 +126,7 @@ SCENARIOS: dict[str, Scenario] = {
             options=frozenset({"wind", "stewart"}),
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
+            demo_cameras=("closeup",),
         ),
         Scenario(
             "fast-ra-scan",

@@ -240,3 +240,37 @@ def test_fast_plans(tmp_path, name):
 
 def test_fast_dec_scan_is_a_plan_only(tmp_path):
     assert_one_line_error(planbench("run", "fast-dec-scan", "--out", tmp_path / "x"), "unknown scenario")
+
+
+def test_fast_run_outputs_and_stewart_option(tmp_path):
+    out = tmp_path / "fast"
+    proc = planbench("run", "fast-tracking", "--duration", "3", "--stewart", "off", "--wind", "6",
+                     "--out", out, "--video", out / "closeup.mp4", "--camera", "closeup", "--quiet")
+    assert proc.returncode in (0, 1), proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["metrics"]["stewart"] == "off" and summary["metrics"]["wind_mean_m_s"] == 6.0
+    names = {c["name"] for c in summary["checks"]}
+    assert {"feed_error_rms", "feed_error_max", "cabin_error_rms", "cable_tension_min", "cable_tension_max",
+            "stewart_stroke", "stewart_force"} <= names
+    # 3 s lie in the switch: no observing segment, so the feed checks cover the whole run.
+    assert "no observing segment" in next(c for c in summary["checks"] if c["name"] == "feed_error_rms")["note"]
+    ts = np.load(out / "timeseries.npz")
+    n = ts["t"].size
+    assert n == 301
+    for key in ("feed_pos_planned", "feed_pos_actual", "cabin_pos_actual"):
+        assert ts[key].shape == (n, 3)
+    assert ts["cable_tension"].shape == (n, 6) and ts["cable_tension"].min() > 100e3  # N
+    assert np.abs(ts["stewart_leg"]).max() < 1e-3  # off: the legs hold nominal
+    reader = imageio_ffmpeg.read_frames(str(out / "closeup.mp4"))
+    assert tuple(next(reader)["size"]) == (640, 480)
+    frames = [np.frombuffer(f, np.uint8).reshape(480, 640, 3) for f in reader]
+    assert len(frames) >= 85 and frames[-1].std() > 10
+
+
+def test_fast_bad_stewart_option(tmp_path):
+    assert_one_line_error(planbench("run", "fast-tracking", "--stewart", "maybe", "--out", tmp_path / "x"),
+                          "invalid choice")
+    assert_one_line_error(planbench("run", "loader-supply", "--stewart", "on", "--out", tmp_path / "x"),
+                          "no Stewart stabilizer")
+    assert_one_line_error(planbench("run", "fast-ra-scan", "--wind", "-1", "--out", tmp_path / "x"), "wind")
+    assert not (tmp_path / "x").exists()
