@@ -218,6 +218,10 @@ FEED_MAX_LIMIT_MM = 30.0
 #: The cable robot's own accuracy: no public figure found; assumed 50 mm RMS, a fifth of the
 #: Stewart's +/-0.25 m stroke, so that the stabilizer corrects the cabin well inside its range.
 CABIN_RMS_LIMIT_MM = 50.0
+#: Runs longer than this write every OUTPUT_STRIDE-th tick to timeseries.npz (10 Hz; a 20-min
+#: run at 100 Hz would be 190 MB); the checks use every tick.
+LONG_RUN_S = 120.0
+OUTPUT_STRIDE = 10
 #: Segments during which the feed must hold its accuracy (names of planners.fast_plan).
 OBSERVING_PREFIXES = ("observation", "leg", "transition")
 
@@ -385,7 +389,8 @@ def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | No
     duration = plan.duration if options.duration is None else options.duration
     return Setup(physics=physics, trajectory=plan, controller=controller, control_dt=CONTROL_DT,
                  duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
-                 report=evaluation.report, disturbance=loads, video_speed=1.0, seed=options.seed)
+                 report=evaluation.report, disturbance=loads, video_speed=1.0, seed=options.seed,
+                 output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1)
 
 
 def build_tracking(options) -> Setup:

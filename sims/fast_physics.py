@@ -200,10 +200,6 @@ class FastPhysics(dm_mujoco.Physics):
         return np.array([self._qpos_adr(n) for n in AB_ACTUATORS])
 
     @functools.cached_property
-    def ab_dofs(self) -> np.ndarray:
-        return np.array([self.model.ptr.joint(n).dofadr[0] for n in AB_ACTUATORS])
-
-    @functools.cached_property
     def leg_qpos(self) -> np.ndarray:
         return np.array([self._qpos_adr(n) for n in LEG_ACTUATORS])
 
@@ -462,6 +458,22 @@ class ControllerOptions:
     derivative_filter_s: float = 0.05
     ab_integral_s: float = 1.0
     leg_integral_s: float = 0.2
+
+    def __post_init__(self):
+        positive = ("pose_rate_hz", "stewart_bandwidth_hz", "ab_integral_s", "leg_integral_s")
+        for name in positive:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"controller option {name} = {value!r} must be finite and > 0")
+        for name in ("pose_latency_s", "pose_noise_m", "pose_noise_rad", "stewart_latency_s", "stewart_noise_m",
+                     "stewart_noise_rad", "kp", "kd", "ki", "derivative_filter_s"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"controller option {name} = {value!r} must be finite and >= 0")
+        if self.pose_rate_hz > 1.0 / CONTROL_DT or self.stewart_bandwidth_hz >= 0.5 / CONTROL_DT:
+            raise ValueError(f"pose_rate_hz = {self.pose_rate_hz} must be <= {1.0 / CONTROL_DT:g} Hz and "
+                             f"stewart_bandwidth_hz = {self.stewart_bandwidth_hz} < {0.5 / CONTROL_DT:g} Hz "
+                             f"(the {1.0 / CONTROL_DT:g} Hz control tick)")
 
 
 def ab_gravity_torque(state, geometry: fast.FastGeometry = fast.FAST) -> np.ndarray:

@@ -110,6 +110,11 @@ def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: s
                       "act": log.act, "actuator_force": log.actuator_force,
                       "sensordata": log.sensordata}
             arrays.update(setup.timeseries(log))
+            if setup.output_stride > 1:  # every stride-th tick of the per-tick arrays
+                n = log.t.size
+                arrays = {k: v[::setup.output_stride] if np.ndim(v) and np.shape(v)[0] == n else v
+                          for k, v in arrays.items()}
+                summary["timeseries_every_s"] = float(log.t[setup.output_stride] - log.t[0]) if n > setup.output_stride else None
             np.savez_compressed(tmp / "timeseries.npz", **arrays)
             setup.report(log, result.checks, tmp / "report.png")
             if video is not None:

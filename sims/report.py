@@ -266,6 +266,7 @@ def fast_report(ts: dict, t: np.ndarray, checks, path, tension_min: float) -> No
         line, = ax.plot(t, ts["cable_tension"][:, j] / 1e3, lw=0.7, label=str(name))
         ax.plot(t, ts["cable_tension_planned"][:, j] / 1e3, "--", color=line.get_color(), lw=0.6)
     ax.axhline(tension_min / 1e3, color="r", lw=0.8)
+    ax.set_ylim(bottom=0.0)
     ax.set(title="cable tensions (dashed: planned statics), T_min in red", xlabel="t [s]", ylabel="kN")
     ax.legend(fontsize=8, ncol=3)
     ax = axes[1, 0]
@@ -282,4 +283,4 @@ def fast_report(ts: dict, t: np.ndarray, checks, path, tension_min: float) -> No
         twin.legend(fontsize=8, loc="upper right")
         ax.legend(fontsize=8, loc="upper left")
     ax.set(title="wind", xlabel="t [s]", ylabel="m/s")
-    _finish(fig, axes, ax, checks, path, top=False)
+    _finish(fig, axes, axes[0, 1], checks, path, top=False)  # below the tensions, above 0

@@ -67,6 +67,8 @@ class Setup:
       video_qpos: optional (log, ticks) -> qpos rows to render at those ticks, for a video
         that shows something other than the logged state (the hexapod's magnified motion).
       video_note: what the video shows, written to summary.json (e.g. the magnification).
+      output_stride: timeseries.npz keeps every this-many-th tick (the checks use them all):
+        long runs at a high control rate would otherwise write hundreds of MB.
     """
 
     physics: object
@@ -82,6 +84,7 @@ class Setup:
     seed: int = 0
     video_qpos: Callable | None = None
     video_note: str = ""
+    output_stride: int = 1
 
 
 @dataclass

@@ -199,3 +199,37 @@ def test_dm_control_environment_with_the_winch_feedforward():
     assert abs(held.size - env.task._setup.trajectory.duration / 0.01) <= 1  # 10 ms steps
     assert held.min() > math.exp(-1.0)  # feed error below 10 mm throughout
     assert run(1.0).min() < 0.05  # 1 m of cable paid out: the feed drops by metres
+
+
+@pytest.mark.parametrize("option, value, words", [
+    ("pose_rate_hz", 0.0, "pose_rate_hz = 0.0 must be finite and > 0"),
+    ("pose_rate_hz", 400.0, "must be <= 100 Hz"),
+    ("pose_latency_s", -0.1, "pose_latency_s = -0.1 must be finite and >= 0"),
+    ("stewart_noise_m", float("nan"), "stewart_noise_m = nan"),
+    ("stewart_bandwidth_hz", 60.0, "< 50 Hz"),
+])
+def test_bad_controller_options_are_named(option, value, words):
+    with pytest.raises(ValueError, match=words):
+        ControllerOptions(**{option: value})
+    with pytest.raises(ValueError, match="mean wind speed -2"):
+        CableLoads(-2.0)
+
+
+def test_long_runs_write_every_tenth_tick(tmp_path):
+    import json
+
+    from sims import outputs
+
+    plan = fast_sim.observation_plan(200.0)
+    assert fast_sim.build(plan, RunOptions()).output_stride == fast_sim.OUTPUT_STRIDE  # 204 s > 120 s
+    setup = fast_sim.build(plan, RunOptions(duration=3.0))
+    assert setup.output_stride == 1
+    setup.output_stride = 10
+    result = runner.run("stride", setup)
+    outputs.write_run(result, setup, tmp_path / "out")
+    ts = np.load(tmp_path / "out" / "timeseries.npz")
+    assert ts["t"].size == 31 and ts["qpos"].shape[0] == 31 and ts["cable_tension"].shape == (31, 6)
+    np.testing.assert_array_equal(ts["t"], result.log.t[::10])
+    assert ts["cable_names"].shape == (6,)
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["timeseries_every_s"] == pytest.approx(0.1)
