@@ -3,7 +3,7 @@
   planbench list
   planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--elevation DEG]
                 [--hs M] [--tp S] [--heading DEG] [--imu-rate HZ] [--imu-latency S]
-                [--no-prediction] [--stewart on|off] [--duration S]
+                [--no-prediction] [--wind-direction DEG] [--stewart on|off] [--duration S]
                 [--video FILE] [--camera overview|closeup] [--quiet]
   planbench plan NAME --out DIR
   planbench bench
@@ -83,6 +83,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="antenna IMU latency, s (a multiple of 5 ms)")
     run.add_argument("--no-prediction", action="store_true",
                      help="antenna controller: use each IMU sample as it is, no gyro prediction")
+    run.add_argument("--wind-direction", type=_finite("wind direction"),
+                     help="azimuth the wind blows toward, deg from east toward north (FAST scenarios; default 0)")
     run.add_argument("--stewart", choices=("on", "off"),
                      help="FAST's Stewart stabilizer: on (default) or off (FAST scenarios)")
     run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
@@ -113,13 +115,16 @@ def _options(scenario, args):
     if imu_given and "imu" not in scenario.options:
         raise BadInput(f"scenario {scenario.name} has no IMU; --imu-rate, --imu-latency and "
                        "--no-prediction are not accepted")
+    if args.wind_direction is not None and "wind_direction" not in scenario.options:
+        raise BadInput(f"scenario {scenario.name} has no wind direction; --wind-direction is not accepted")
     if args.stewart is not None and "stewart" not in scenario.options:
         raise BadInput(f"scenario {scenario.name} has no Stewart stabilizer; --stewart is not accepted")
     return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
                       elevation=args.elevation, hs=args.hs, tp=args.tp, heading=args.heading,
                       imu_rate=args.imu_rate, imu_latency=args.imu_latency,
                       predict=not args.no_prediction,
-                      stewart=None if args.stewart is None else args.stewart == "on")
+                      stewart=None if args.stewart is None else args.stewart == "on",
+                      wind_direction=args.wind_direction)
 
 
 def cmd_list(args) -> int:

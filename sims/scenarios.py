@@ -22,6 +22,8 @@ class RunOptions:
       imu_rate, imu_latency: the antenna IMU's sample rate (Hz) and latency (s), None for the
         defaults; predict: False to switch the antenna controller's prediction off.
       stewart: FAST's Stewart stabilizer on (True) or off (False), None for the default (on).
+      wind_direction: the azimuth the wind blows toward, deg from east (+x) toward north, None
+        for the default (FAST scenarios).
     """
 
     seed: int = 0
@@ -35,6 +37,7 @@ class RunOptions:
     imu_latency: float | None = None
     predict: bool = True
     stewart: bool | None = None
+    wind_direction: float | None = None
 
 
 @dataclass(frozen=True)
@@ -120,29 +123,29 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "fast-tracking",
-            "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --stewart on|off)",
+            "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --wind-direction, --stewart on|off)",
             fast.build_tracking,
             fast.tracking_plan,
-            options=frozenset({"wind", "stewart"}),
+            options=frozenset({"wind", "wind_direction", "stewart"}),
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
             demo_cameras=("closeup",),
         ),
         Scenario(
             "fast-ra-scan",
-            "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --stewart on|off)",
+            "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --wind-direction, --stewart on|off)",
             fast.build_ra_scan,
             fast.ra_scan_plan,
-            options=frozenset({"wind", "stewart"}),
+            options=frozenset({"wind", "wind_direction", "stewart"}),
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
         ),
         Scenario(
             "fast-source-switch",
-            "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --stewart on|off)",
+            "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --wind-direction, --stewart on|off)",
             fast.build_source_switch,
             fast.source_switch_plan,
-            options=frozenset({"wind", "stewart"}),
+            options=frozenset({"wind", "wind_direction", "stewart"}),
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
         ),

@@ -245,10 +245,12 @@ def test_fast_dec_scan_is_a_plan_only(tmp_path):
 def test_fast_run_outputs_and_stewart_option(tmp_path):
     out = tmp_path / "fast"
     proc = planbench("run", "fast-tracking", "--duration", "3", "--stewart", "off", "--wind", "6",
+                     "--wind-direction", "90",
                      "--out", out, "--video", out / "closeup.mp4", "--camera", "closeup", "--quiet")
     assert proc.returncode in (0, 1), proc.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["metrics"]["stewart"] == "off" and summary["metrics"]["wind_mean_m_s"] == 6.0
+    assert summary["metrics"]["wind_toward_deg"] == pytest.approx(90.0)
     names = {c["name"] for c in summary["checks"]}
     assert {"feed_error_rms", "feed_error_max", "cabin_error_rms", "cable_tension_min", "cable_tension_max",
             "stewart_stroke", "stewart_force"} <= names
@@ -273,4 +275,8 @@ def test_fast_bad_stewart_option(tmp_path):
     assert_one_line_error(planbench("run", "loader-supply", "--stewart", "on", "--out", tmp_path / "x"),
                           "no Stewart stabilizer")
     assert_one_line_error(planbench("run", "fast-ra-scan", "--wind", "-1", "--out", tmp_path / "x"), "wind")
+    assert_one_line_error(planbench("run", "fast-ra-scan", "--wind-direction", "inf", "--out", tmp_path / "x"),
+                          "wind direction inf is not finite")
+    assert_one_line_error(planbench("run", "hexapod-sync-move", "--wind-direction", "30", "--out", tmp_path / "x"),
+                          "no wind direction")
     assert not (tmp_path / "x").exists()

@@ -127,6 +127,9 @@ def test_wind_load_matches_the_drag_formula():
     cabin = 0.5 * 1.2 * 0.8 * 13.0 * 7.6 * loads.speed[:n] ** 2
     assert np.all(force >= 0.9 * cabin)
     assert np.all(force <= 2.0 * cabin)
+    # Along the wind (toward +x by default); the inclined cables add a little lift.
+    mean = loads.force[:n].mean(axis=0)
+    assert mean[0] > 0.95 * np.linalg.norm(mean) and abs(mean[1]) < 0.05 * mean[0]
 
 
 class PayOutCable(FastController):
