@@ -3,7 +3,8 @@
   planbench list
   planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--elevation DEG]
                 [--hs M] [--tp S] [--heading DEG] [--imu-rate HZ] [--imu-latency S]
-                [--no-prediction] [--wind-direction DEG] [--stewart on|off] [--duration S]
+                [--no-prediction] [--wind-direction DEG] [--stewart on|off]
+                [--cable-segments N] [--duration S]
                 [--video FILE] [--camera overview|closeup] [--quiet]
   planbench plan NAME --out DIR
   planbench bench
@@ -60,6 +61,16 @@ def _seed(text: str) -> int:
     return value
 
 
+def _cable_segments(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"cable segments {text!r} is not an integer") from None
+    if not 2 <= value <= 50:
+        raise argparse.ArgumentTypeError(f"cable segments {value} must be in [2, 50]")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="planbench", description="MuJoCo testbed for motion planners.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -85,6 +96,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="antenna controller: use each IMU sample as it is, no gyro prediction")
     run.add_argument("--wind-direction", type=_finite("wind direction"),
                      help="azimuth the wind blows toward, deg from east toward north (FAST scenarios; default 0)")
+    run.add_argument("--cable-segments", type=_cable_segments,
+                     help="FAST: each cable as a chain of N elastic segments (2-50; default: straight "
+                          "cables with the lumped catenary law)")
     run.add_argument("--stewart", choices=("on", "off"),
                      help="FAST's Stewart stabilizer: on (default) or off (FAST scenarios)")
     run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
@@ -117,6 +131,8 @@ def _options(scenario, args):
                        "--no-prediction are not accepted")
     if args.wind_direction is not None and "wind_direction" not in scenario.options:
         raise BadInput(f"scenario {scenario.name} has no wind direction; --wind-direction is not accepted")
+    if args.cable_segments is not None and "cables" not in scenario.options:
+        raise BadInput(f"scenario {scenario.name} has no cables; --cable-segments is not accepted")
     if args.stewart is not None and "stewart" not in scenario.options:
         raise BadInput(f"scenario {scenario.name} has no Stewart stabilizer; --stewart is not accepted")
     return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
@@ -124,7 +140,7 @@ def _options(scenario, args):
                       imu_rate=args.imu_rate, imu_latency=args.imu_latency,
                       predict=not args.no_prediction,
                       stewart=None if args.stewart is None else args.stewart == "on",
-                      wind_direction=args.wind_direction)
+                      wind_direction=args.wind_direction, cable_segments=args.cable_segments)
 
 
 def cmd_list(args) -> int:

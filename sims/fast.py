@@ -35,7 +35,8 @@ from planners import fast_plan as fp
 from planners import fast_sky as sky
 from sims.checks import Check
 from sims.controllers import demanded_force
-from sims.fast_physics import CONTROL_DT, CableLoads, ControllerOptions, FastController, FastPhysics
+from sims.fast_physics import (CONTROL_DT, CableLoads, ChainCableLoads, ControllerOptions, FastController,
+                               FastPhysics)
 from sims.runner import RunLog, Setup
 
 #: Calibrators (J2000, NED): 3C 286 13h31m08.29s +30d30m33.0s; 3C 295 14h11m20.5s +52d12m21s.
@@ -319,6 +320,8 @@ class FastEvaluation:
         ab_error = np.degrees(np.abs(s["ab_actual"] - s["ab_planned"]).max(axis=0)) * 3600.0
         metrics = {
             "stewart": stewart,
+            "cables": (f"{p.cable_segments} segments each" if p.cable_segments
+                       else "straight, lumped catenary law"),
             "wind_mean_m_s": self.loads.mean_speed,
             "wind_toward_deg": float(np.degrees(np.arctan2(self.loads.direction[1], self.loads.direction[0]))),
             "feed_error_rms_all_mm": _rms(feed_mm),
@@ -373,11 +376,16 @@ class FastEvaluation:
         fast_report(self.timeseries(log), log.t, checks, path, fast.FAST_LIMITS.tension_min)
 
 
-def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | None = None) -> Setup:
+def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | None = None,
+          cable_segments: int | None = None) -> Setup:
     """A run of ``plan``: the physics at the plan's first pose (at rest, in equilibrium), the
     cables and wind (``options.wind``, default DEFAULT_WIND_M_S), and the controller
-    (``options.stewart``: None or True for the stabilizer on)."""
-    physics = FastPhysics.load()
+    (``options.stewart``: None or True for the stabilizer on). ``cable_segments`` >= 2: the
+    discretized cables (sims.fast_physics.discretized_spec) instead of the lumped ones; None:
+    ``options.cable_segments``."""
+    if cable_segments is None:
+        cable_segments = getattr(options, "cable_segments", None) or 0
+    physics = FastPhysics.load(cable_segments)
     s0 = plan.state(np.array([0.0]))
     physics.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
                               s0.multifeed[0])
@@ -387,7 +395,8 @@ def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | No
     controller = FastController(plan, controller_options, seed=options.seed)
     wind = DEFAULT_WIND_M_S if options.wind is None else options.wind
     direction = getattr(options, "wind_direction", None)
-    loads = CableLoads(wind, WIND_AZIMUTH_DEG if direction is None else direction)
+    loads = (ChainCableLoads if cable_segments else CableLoads)(
+        wind, WIND_AZIMUTH_DEG if direction is None else direction)
     evaluation = FastEvaluation(physics, plan, controller, loads)
     duration = plan.duration if options.duration is None else options.duration
     return Setup(physics=physics, trajectory=plan, controller=controller, control_dt=CONTROL_DT,

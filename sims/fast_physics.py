@@ -38,6 +38,7 @@ from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import fast
+from planners.errors import LimitError
 from planners.legs import leg_lengths, structure_matrix
 from planners.rotations import rot_y, rot_z
 from planners.trajectory import TrajectorySample
@@ -128,25 +129,106 @@ def _skew(w: np.ndarray) -> np.ndarray:
     return np.array([[1.0, -w[2], w[1]], [w[2], 1.0, -w[0]], [-w[1], w[0], 1.0]])
 
 
+def cable_drag_force(wind: np.ndarray, vectors: np.ndarray, lengths) -> np.ndarray:
+    """(n, 3) drag of the wind (3,) m/s on cable pieces along ``vectors`` (n, 3) of ``lengths``
+    (n,) m: 1/2 rho Cd d |u_n| u_n per metre, u_n the wind's component normal to the piece, N."""
+    units = vectors / np.sqrt(np.einsum("ij,ij->i", vectors, vectors))[:, None]
+    normal = wind - (units @ wind)[:, None] * units
+    speed = np.sqrt(np.einsum("ij,ij->i", normal, normal))
+    return (0.5 * AIR_DENSITY * CABLE_DRAG_COEFFICIENT * CABLE_DIAMETER * np.asarray(lengths) * speed)[:, None] * normal
+
+
 def _wxyz_from_matrix(rotation: np.ndarray) -> np.ndarray:
     quat = np.empty(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rotation, dtype=float).ravel())
     return quat
 
 
-@functools.lru_cache(maxsize=1)
-def _compiled() -> mujoco.MjModel:
-    return models.load("fast")
+#: The discretized cables' nodes: the home unstretched length (keyframe home) split evenly.
+HOME_UNSTRETCHED = 320.13646  # m (models/fast/fast.xml, keyframe home)
+#: Damping of the discretized cables' nodes, as the ratio it gives their first string modes
+#: (~0.2 Hz): 0.5 %, the lower bound measured for the cable-cabin system (REFERENCE.md); the
+#: cables' internal friction and the still air's drag are not known better.
+NODE_DAMPING_RATIO = 0.005
+STRING_MODE_HZ = 0.2
+
+
+@functools.lru_cache(maxsize=4)
+def _compiled(cable_segments: int = 0) -> mujoco.MjModel:
+    """The model; with ``cable_segments`` >= 2 each cable is a chain of point masses instead
+    of a straight tendon with a lumped law (``discretized_spec``)."""
+    if cable_segments == 0:
+        return models.load("fast")
+    return discretized_spec(cable_segments).compile()
+
+
+def discretized_spec(segments: int) -> mujoco.MjSpec:
+    """models/fast with each cable discretized into ``segments`` elastic segments.
+
+    Cable i becomes ``segments`` spatial tendons ``cable{i}_seg{k}`` joining the tower top,
+    ``segments - 1`` point masses ``cable{i}_node{k}`` (three slide joints each, damped by
+    ``NODE_DAMPING_RATIO`` at ``STRING_MODE_HZ``) and the cabin anchor. The segments share the cable's unstretched length
+    L0 evenly (the winch pays out at the tower and the rope runs through): the winch actuator
+    ``cable{i}`` drives the first (ctrl = L0), the others are springs EA / (L0 / n) of rest
+    length L0 / n with stiffness-proportional damping; ``ChainCableLoads`` writes both every
+    tick, and gives the nodes the mass mu L0 / n of the run's first L0. Written here for the
+    home pose. The chord tendons ``cable{i}`` stay, to measure. Gravity loads the nodes
+    directly, so the lumped anchor masses are emptied. Sag, its stiffness and the cables' own
+    vibration come out of the chain instead of the catenary law.
+    """
+    if segments < 2:
+        raise ValueError(f"cable segments {segments} must be >= 2 (0 for the lumped cables)")
+    spec = mujoco.MjSpec.from_file(str(models.scene_path("fast")))
+    rest = HOME_UNSTRETCHED / segments
+    mass = fast.FAST.cable_mass_per_length * rest
+    stiffness = CABLE_EA / rest
+    for i in range(1, 4):
+        body = spec.body(f"anchor_mass{i}")
+        body.mass, body.inertia = 1e-6, [1e-6, 1e-6, 1e-6]
+    home = mujoco.MjModel.from_xml_path(str(models.scene_path("fast")))
+    home_data = mujoco.MjData(home)
+    mujoco.mj_kinematics(home, home_data)
+    for i in range(1, 7):
+        top = home_data.site_xpos[home.site(f"tower{i}_top").id]
+        anchor = home_data.site_xpos[home.site(f"anchor{i}").id]
+        sites = [f"tower{i}_top"]
+        for k in range(1, segments):
+            node = spec.worldbody.add_body(name=f"cable{i}_node{k}", pos=top + (anchor - top) * k / segments)
+            for axis, label in zip(np.eye(3), "xyz"):
+                node.add_joint(name=f"cable{i}_node{k}_{label}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=axis,
+                               damping=2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)
+            node.add_geom(name=f"cable{i}_node{k}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.3, 0, 0],
+                          mass=mass, contype=0, conaffinity=0, group=2, rgba=[0.12, 0.12, 0.14, 1])
+            node.add_site(name=f"cable{i}_node{k}")
+            sites.append(f"cable{i}_node{k}")
+        sites.append(f"anchor{i}")
+        for k in range(1, segments + 1):
+            tendon = spec.add_tendon(name=f"cable{i}_seg{k}", width=0.35, rgba=[0.12, 0.12, 0.14, 1])
+            tendon.wrap_site(sites[k - 1])
+            tendon.wrap_site(sites[k])
+            if k > 1:
+                tendon.stiffness, tendon.springlength = [stiffness, 0.0, 0.0], [rest, rest]
+                tendon.damping = [CABLE_DAMPING_S * stiffness, 0.0, 0.0]
+        spec.tendon(f"cable{i}").rgba = [0, 0, 0, 0]  # the chord measures, the segments show
+        spec.actuator(f"cable{i}").target = f"cable{i}_seg1"
+    key = spec.key("home")
+    model = spec.compile()
+    key.qpos = np.concatenate([model.qpos0])  # nodes on the chords; set_configuration sags them
+    return spec
 
 
 class FastPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/fast/scene.xml with FAST's accessors."""
 
     @classmethod
-    def load(cls) -> "FastPhysics":
-        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(_compiled())))
+    def load(cls, cable_segments: int = 0) -> "FastPhysics":
+        """The model at keyframe home; ``cable_segments`` >= 2 for the discretized cables."""
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(_compiled(cable_segments))))
+        physics.cable_segments = cable_segments
         physics.reset(keyframe_id=0)
         return physics
+
+    cable_segments = 0
 
     # ---- indices (from the compiled model)
     def _ids(self, kind, names) -> np.ndarray:
@@ -293,7 +375,60 @@ class FastPhysics(dm_mujoco.Physics):
         data.qpos[self.multifeed_qpos] = multifeed
         data.qvel[:] = 0.0
         data.act[:] = 0.0
+        if self.cable_segments:
+            self._sag_nodes(origin, rotation, r_ab)
         mujoco.mj_forward(model, data)
+
+    def _sag_nodes(self, origin, rotation, r_ab) -> None:
+        """Put the discretized cables' nodes on the parabola of the planner's static tension T:
+        the sag below the chord at the horizontal distance x is w_h x (l_h - x) / (2 H), H the
+        tension's horizontal part, w_h the weight per horizontal metre. Along it the nodes
+        divide the arc in the ratio of the segments' unstretched lengths: the winch segment
+        holds what the unstretched length for T (``unstretched_length``) leaves to it."""
+        model, data = self.model.ptr, self.data.ptr
+        g = fast.FAST
+        tension = fast.cable_tensions(origin, rotation, g, ab_rotation=r_ab)
+        anchors = origin + g.cabin_anchors @ rotation.T
+        n = self.cable_segments
+        x = np.linspace(0.0, 1.0, 2001)
+        for i in range(6):
+            top, chord = g.tower_anchors[i], anchors[i] - g.tower_anchors[i]
+            length, span = np.linalg.norm(chord), np.hypot(chord[0], chord[1])
+            horizontal = tension[i] * span / length
+            curve = top + x[:, None] * chord
+            curve[:, 2] -= CABLE_WEIGHT * length / span * (x * span) * ((1 - x) * span) / (2 * horizontal)
+            arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(curve, axis=0), axis=1))])
+            for k, share in enumerate(np.arange(1, n) / n, start=1):
+                point = np.array([np.interp(share * arc[-1], arc, curve[:, j]) for j in range(3)])
+                body = model.body(f"cable{i + 1}_node{k}")
+                adr = model.jnt_qposadr[body.jntadr[0]]
+                data.qpos[adr:adr + 3] = point - model.body_pos[body.id]
+
+    @functools.cached_property
+    def node_bodies(self) -> np.ndarray:
+        """(6, segments - 1) body ids of the discretized cables' nodes, tower to anchor."""
+        return np.array([[self.model.ptr.body(f"cable{i}_node{k}").id for k in range(1, self.cable_segments)]
+                         for i in range(1, 7)])
+
+    @functools.cached_property
+    def segment_tendons(self) -> np.ndarray:
+        """(6, segments) tendon ids of the discretized cables' segments, tower to anchor."""
+        return np.array([[self.model.ptr.tendon(f"cable{i}_seg{k}").id for k in range(1, self.cable_segments + 1)]
+                         for i in range(1, 7)])
+
+    def anchor_forces(self) -> np.ndarray:
+        """(6, 3) force of each cable on the cabin at its anchor, N (world)."""
+        data = self.data.ptr
+        anchors = data.site_xpos[self.anchor_sites]
+        if not self.cable_segments:
+            units = (self.tower_tops - anchors) / self.cable_lengths()[:, None]
+            return self.cable_tensions()[:, None] * units
+        last = self.segment_tendons[:, -1]
+        model = self.model.ptr
+        tension = model.tendon_stiffness[last] * (data.ten_length[last] - model.tendon_lengthspring[last, 0])
+        before = data.xpos[self.node_bodies[:, -1]]
+        units = (before - anchors) / np.linalg.norm(before - anchors, axis=1)[:, None]
+        return tension[:, None] * units
 
     def loop_closure_error(self) -> float:
         """Largest violation of the Stewart's six ball constraints, m."""
@@ -385,28 +520,100 @@ class CableLoads:
         u = 0.0 if tick is None else float(self.speed[tick])
         force, torque = np.zeros(3), np.zeros(3)
         if u != 0.0:
-            wind = u * self.direction
-            half_rho = 0.5 * AIR_DENSITY
             # Cables: the normal component of the wind on each chord, half the drag at the anchor.
-            units = vectors / chord[:, None]
-            normal = wind - (units @ wind)[:, None] * units
-            speed_n = np.sqrt(np.einsum("ij,ij->i", normal, normal))
-            cable_drag = (half_rho * CABLE_DRAG_COEFFICIENT * CABLE_DIAMETER * 0.5 * chord * speed_n)[:, None] * normal
-            # Cabin: a cylinder of the cabin's size along its z axis.
-            rotation = data.xmat[self._cabin].reshape(3, 3)
-            cos_t = min(abs(float(rotation[:, 2] @ self.direction)), 1.0)
-            area = CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + \
-                math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
-            cabin_drag = half_rho * CABIN_DRAG_COEFFICIENT * area * abs(u) * wind
-            centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE - com
-            self.force[tick] = cable_drag.sum(axis=0) + cabin_drag
+            cable_drag = cable_drag_force(u * self.direction, vectors, 0.5 * chord)
+            force, torque = self._cabin_drag(u)
+            self.force[tick] = cable_drag.sum(axis=0) + force
             anchor_force += cable_drag
-            force, torque = cabin_drag, _moment(centre[None], cabin_drag[None])
         self._xfrc[:3] = anchor_force.sum(axis=0) + force
         self._xfrc[3:] = _moment(arms, anchor_force) + torque
 
+    def _cabin_drag(self, u: float):
+        """(force (3,), torque (3,) about the cabin body's centre of mass) of the wind speed
+        ``u`` on the cabin: a cylinder of its size along its z axis, drag at the shell's centre."""
+        data = self._data
+        rotation = data.xmat[self._cabin].reshape(3, 3)
+        cos_t = min(abs(float(rotation[:, 2] @ self.direction)), 1.0)
+        area = CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + \
+            math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
+        drag = 0.5 * AIR_DENSITY * CABIN_DRAG_COEFFICIENT * area * abs(u) * u * self.direction
+        centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE - data.xipos[self._cabin]
+        return drag, _moment(centre[None], drag[None])
+
     def __call__(self, tick: int, physics) -> None:
         self.apply(physics, tick)
+
+
+class ChainCableLoads(CableLoads):
+    """The plant's loads with the discretized cables (``FastPhysics.load(cable_segments=n)``).
+
+    The chain carries sag, cable weight and cable inertia itself; per tick this shares the
+    winch command L0 (``ctrl``) among the segments: rest length l = L0 / n, stiffness EA / l
+    and damping beta EA / l for the springs, and the winch segment's law force =
+    (EA / l) (L0 / n - L1) - beta (EA / l) L1'; puts the half segment that ends at the cabin
+    anchor (its weight) on the cabin; and applies the wind: on the cabin, and on every node half
+    of each neighbouring segment's normal drag (half the last segment on the cabin).
+    """
+
+    def reset(self, physics: FastPhysics, times: np.ndarray, rng: np.random.Generator) -> None:
+        n = physics.cable_segments
+        self._n = n
+        self._nodes = physics.node_bodies
+        self._segments = physics.segment_tendons
+        self._node_xfrc = physics.data.ptr.xfrc_applied[self._nodes.ravel()]
+        model, data = physics.model.ptr, physics.data.ptr
+        rest = data.ctrl[physics.cable_ids] / n
+        # A segment's axial mode, 2 sqrt(EA / mu) / l rad/s, must stay slow for the timestep
+        # (the springs are explicit): omega dt <= 0.7 (20 segments at 1.0 diverge).
+        wave = 2.0 * math.sqrt(CABLE_EA / fast.FAST.cable_mass_per_length)  # omega l, m/s
+        omega = wave / rest.min()
+        if omega * model.opt.timestep > 0.7:
+            raise LimitError(f"cable segments {n}: the shortest segment ({rest.min():.1f} m) vibrates at "
+                             f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
+                             f"timestep's limit omega dt <= 0.7; use at most "
+                             f"{int(0.7 * rest.min() * n / (wave * model.opt.timestep))} segments")
+        mass = np.broadcast_to((fast.FAST.cable_mass_per_length * rest)[:, None], self._nodes.shape)
+        model.body_mass[self._nodes] = mass
+        dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)
+        model.dof_damping[dofs] = (2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[..., None]
+        super().reset(physics, times, rng)
+
+    def apply(self, physics, tick: int | None = None) -> None:
+        model, data = self._model, self._data
+        ids = self._cables
+        self._rest = rest = data.ctrl[ids] / self._n  # (6,) every segment's unstretched length
+        k = CABLE_EA / np.maximum(rest, 1e-3)
+        model.actuator_gainprm[ids, 0] = k / self._n
+        model.actuator_biasprm[ids, 0] = 0.0
+        model.actuator_biasprm[ids, 1] = -k
+        model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
+        passive = self._segments[:, 1:]
+        model.tendon_stiffness[passive] = k[:, None]
+        model.tendon_damping[passive] = CABLE_DAMPING_S * k[:, None]
+        model.tendon_lengthspring[passive] = rest[:, None, None]
+        self.tension = np.maximum(k * (data.ten_length[self._segments[:, 0]] - rest), 0.0)
+        if tick is not None:
+            self.tension_log[tick] = self.tension
+        anchors = data.site_xpos[self._sites]
+        anchor_force = np.zeros((6, 3))
+        anchor_force[:, 2] = -0.5 * CABLE_WEIGHT * self._rest
+        u = 0.0 if tick is None else float(self.speed[tick])
+        force, torque = np.zeros(3), np.zeros(3)
+        if u != 0.0:
+            wind = u * self.direction
+            nodes = data.xpos[self._nodes]  # (6, n - 1, 3)
+            points = np.concatenate([self._towers[:, None], nodes, anchors[:, None]], axis=1)
+            pieces = np.diff(points, axis=1)  # (6, n, 3) segment vectors
+            drag = cable_drag_force(wind, pieces.reshape(-1, 3), np.repeat(self._rest, self._n)).reshape(6, self._n, 3)
+            node_drag = 0.5 * (drag[:, :-1] + drag[:, 1:])  # half of each neighbouring segment
+            self._node_xfrc[:, :3] = node_drag.reshape(-1, 3)
+            data.xfrc_applied[self._nodes.ravel()] = self._node_xfrc
+            anchor_force += 0.5 * drag[:, -1]
+            force, torque = self._cabin_drag(u)
+            self.force[tick] = drag.sum(axis=(0, 1)) - 0.5 * drag[:, 0].sum(axis=0) + force
+        com = data.xipos[self._cabin]
+        self._xfrc[:3] = anchor_force.sum(axis=0) + force
+        self._xfrc[3:] = _moment(anchors - com, anchor_force) + torque
 
 
 # ----------------------------------------------------------------------------- control

@@ -24,6 +24,8 @@ class RunOptions:
       stewart: FAST's Stewart stabilizer on (True) or off (False), None for the default (on).
       wind_direction: the azimuth the wind blows toward, deg from east (+x) toward north, None
         for the default (FAST scenarios).
+      cable_segments: FAST's cables as chains of this many elastic segments (>= 2), None or 0
+        for the default straight cables with the lumped catenary law.
     """
 
     seed: int = 0
@@ -38,6 +40,7 @@ class RunOptions:
     predict: bool = True
     stewart: bool | None = None
     wind_direction: float | None = None
+    cable_segments: int | None = None
 
 
 @dataclass(frozen=True)
@@ -126,7 +129,7 @@ SCENARIOS: dict[str, Scenario] = {
             "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --wind-direction, --stewart on|off)",
             fast.build_tracking,
             fast.tracking_plan,
-            options=frozenset({"wind", "wind_direction", "stewart"}),
+            options=frozenset({"wind", "wind_direction", "stewart", "cables"}),
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
             demo_cameras=("closeup",),
@@ -136,7 +139,7 @@ SCENARIOS: dict[str, Scenario] = {
             "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --wind-direction, --stewart on|off)",
             fast.build_ra_scan,
             fast.ra_scan_plan,
-            options=frozenset({"wind", "wind_direction", "stewart"}),
+            options=frozenset({"wind", "wind_direction", "stewart", "cables"}),
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
         ),
@@ -145,7 +148,7 @@ SCENARIOS: dict[str, Scenario] = {
             "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --wind-direction, --stewart on|off)",
             fast.build_source_switch,
             fast.source_switch_plan,
-            options=frozenset({"wind", "wind_direction", "stewart"}),
+            options=frozenset({"wind", "wind_direction", "stewart", "cables"}),
             kinds=fast.plan_kinds,
             plan_extras=fast.write_figures,
         ),

@@ -279,4 +279,10 @@ def test_fast_bad_stewart_option(tmp_path):
                           "wind direction inf is not finite")
     assert_one_line_error(planbench("run", "hexapod-sync-move", "--wind-direction", "30", "--out", tmp_path / "x"),
                           "no wind direction")
+    assert_one_line_error(planbench("run", "fast-tracking", "--cable-segments", "1", "--out", tmp_path / "x"),
+                          "cable segments 1 must be in [2, 50]")
+    assert_one_line_error(planbench("run", "fast-tracking", "--cable-segments", "20", "--out", tmp_path / "x"),
+                          "cable segments 20", "use at most 14 segments")
+    assert_one_line_error(planbench("run", "loader-supply", "--cable-segments", "4", "--out", tmp_path / "x"),
+                          "no cables")
     assert not (tmp_path / "x").exists()
