@@ -7,12 +7,15 @@ per control tick (100 Hz), MuJoCo takes the physics steps between them:
   gets it too): each cable's tension from the elastic catenary (parabolic sag) at the current
   chord length and the winch's unstretched length, linearized into the cable actuator's gain
   and bias for the tick; half of each cable's weight at its cabin anchor; wind drag on the
-  cabin and on the cables (half of each cable's drag at its anchor).
+  cabin and on the cables (half of each cable's drag at its anchor). ``ChainCableLoads`` does
+  the same for the discretized cables (``discretized_spec``), whose chains carry sag and
+  weight themselves.
 * ``FastController``: winch commands (planned cable lengths less the elastic stretch and the
-  sag under the planned tensions, plus PID feedback on the cabin pose measured at 10 Hz with
-  150 ms latency and noise), the A-B rotator servo (with integral action), the multi-beam
-  rotation, and the Stewart stabilizer (at 100 Hz: inverse kinematics from the measured pose of
-  its base to the planned feed pose).
+  sag under the planned tensions, plus feedback on the cabin pose measured at 10 Hz with
+  150 ms latency and noise: integral only by default), the A-B rotator servo (gravity
+  feed-forward and integral action), the multi-beam rotation, and the Stewart stabilizer (at
+  100 Hz: an alpha-beta estimate of the cabin pose, led by its latency and the legs' lag, and
+  the inverse kinematics from the base to the planned feed pose).
 
 Elastic catenary (Irvine, "Cable Structures", 1981; parabolic sag, small sag-to-span): a cable
 of unstretched length L0, axial stiffness EA and weight w per length, with horizontal span
@@ -51,8 +54,9 @@ CONTROL_DT = 0.01  # s: the runner's tick, the Stewart stabilizer's 100 Hz
 CABLE_EA = 1.5e8  # N
 CABLE_WEIGHT = fast.FAST.cable_mass_per_length * fast.GRAVITY  # N/m
 CABLE_DIAMETER = 0.046  # m
-#: Stiffness-proportional damping of the cables, s: beta = 2 zeta / omega gives zeta = 0.5 % at
-#: 0.2 Hz, the measured lowest cabin mode with its >= 0.4 % damping (REFERENCE.md).
+#: Stiffness-proportional damping of the cables, s: beta = 2 zeta / omega with zeta = 0.7 % at
+#: 0.2 Hz; the model's cabin modes (0.30-0.65 Hz) then have 0.41-1.7 %, at least the measured
+#: >= 0.4 % of the lowest cabin mode (REFERENCE.md).
 CABLE_DAMPING_S = 2 * 0.007 / (2 * math.pi * 0.2)
 #: Below this tension the catenary law is not solved further (a cable this slack is a failed
 #: check long before), N.
