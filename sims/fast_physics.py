@@ -148,8 +148,6 @@ def _wxyz_from_matrix(rotation: np.ndarray) -> np.ndarray:
     return quat
 
 
-#: The discretized cables' nodes: the home unstretched length (keyframe home) split evenly.
-HOME_UNSTRETCHED = 320.13646  # m (models/fast/fast.xml, keyframe home)
 #: Damping of the discretized cables' nodes, as the ratio it gives their first string modes
 #: (~0.2 Hz): 0.5 %, the lower bound measured for the cable-cabin system (REFERENCE.md); the
 #: cables' internal friction and the still air's drag are not known better.
@@ -183,13 +181,13 @@ def discretized_spec(segments: int) -> mujoco.MjSpec:
     if segments < 2:
         raise ValueError(f"cable segments {segments} must be >= 2 (0 for the lumped cables)")
     spec = mujoco.MjSpec.from_file(str(models.scene_path("fast")))
-    rest = HOME_UNSTRETCHED / segments
+    home = mujoco.MjModel.from_xml_path(str(models.scene_path("fast")))
+    rest = home.key("home").ctrl[0] / segments  # the winches' unstretched length at home
     mass = fast.FAST.cable_mass_per_length * rest
     stiffness = CABLE_EA / rest
     for i in range(1, 4):
         body = spec.body(f"anchor_mass{i}")
         body.mass, body.inertia = 1e-6, [1e-6, 1e-6, 1e-6]
-    home = mujoco.MjModel.from_xml_path(str(models.scene_path("fast")))
     home_data = mujoco.MjData(home)
     mujoco.mj_kinematics(home, home_data)
     for i in range(1, 7):

@@ -73,6 +73,10 @@ class Scenario:
     demo_cameras: tuple = ()
 
 
+#: What the FAST runs share: options, plan plots and the paper's figures.
+FAST_RUN = dict(options=frozenset({"wind", "wind_direction", "stewart", "cables"}), kinds=fast.plan_kinds,
+                plan_extras=fast.write_figures)
+
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
     for s in (
@@ -126,31 +130,25 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "fast-tracking",
-            "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --wind-direction, --stewart on|off)",
+            "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
             fast.build_tracking,
             fast.tracking_plan,
-            options=frozenset({"wind", "wind_direction", "stewart", "cables"}),
-            kinds=fast.plan_kinds,
-            plan_extras=fast.write_figures,
+            **FAST_RUN,
             demo_cameras=("closeup",),
         ),
         Scenario(
             "fast-ra-scan",
-            "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --wind-direction, --stewart on|off)",
+            "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
             fast.build_ra_scan,
             fast.ra_scan_plan,
-            options=frozenset({"wind", "wind_direction", "stewart", "cables"}),
-            kinds=fast.plan_kinds,
-            plan_extras=fast.write_figures,
+            **FAST_RUN,
         ),
         Scenario(
             "fast-source-switch",
-            "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --wind-direction, --stewart on|off)",
+            "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
             fast.build_source_switch,
             fast.source_switch_plan,
-            options=frozenset({"wind", "wind_direction", "stewart", "cables"}),
-            kinds=fast.plan_kinds,
-            plan_extras=fast.write_figures,
+            **FAST_RUN,
         ),
     )
 }
