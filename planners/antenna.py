@@ -47,7 +47,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from planners.errors import LimitError, PlanningError
-from planners.rotations import rot_x, rot_y, rot_z
+from planners.rotations import rot_x, rot_y, rot_z, vee
 from planners.trajectory import TrajectorySample
 
 JOINT_LABELS = ("azimuth", "elevation", "cross_elevation", "polarization")
@@ -71,22 +71,6 @@ class SingularityError(PlanningError):
 
 # --------------------------------------------------------------------------------------
 # Rotations
-
-
-def skew(v) -> np.ndarray:
-    """[v]x, (..., 3, 3), such that [v]x u = v x u."""
-    v = np.asarray(v, dtype=float)
-    z = np.zeros(v.shape[:-1])
-    x, y, w = v[..., 0], v[..., 1], v[..., 2]
-    return np.stack([np.stack([z, -w, y], -1), np.stack([w, z, -x], -1),
-                     np.stack([-y, x, z], -1)], -2)
-
-
-def vee(m) -> np.ndarray:
-    """The vector of the antisymmetric part of m: vee((M - M^T) / 2), (..., 3)."""
-    m = np.asarray(m, dtype=float)
-    return 0.5 * np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0],
-                           m[..., 1, 0] - m[..., 0, 1]], -1)
 
 
 def rotation_log(r) -> np.ndarray:

@@ -234,6 +234,14 @@ def observing_mask(plan: fp.FastPlan, segment_index: np.ndarray) -> np.ndarray:
     return observing[segment_index]
 
 
+def _hold_last(per_tick: np.ndarray, n: int) -> np.ndarray:
+    """The first n rows of a per-tick log of the plant's loads, the last one held: the runner
+    applies no loads after its last tick."""
+    out = per_tick[:n].copy()
+    out[n - 1] = out[max(n - 2, 0)]
+    return out
+
+
 def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(x)))) if x.size else float("nan")
 
@@ -243,19 +251,21 @@ class FastEvaluation:
 
     def __init__(self, physics: FastPhysics, plan: fp.FastPlan, controller: FastController, loads: CableLoads):
         self.physics, self.plan, self.controller, self.loads = physics, plan, controller, loads
+        self._series = (None, None)  # (log, its series): checks, timeseries and report share it
 
     def series(self, log: RunLog) -> dict:
-        """The quantities of the checks, SI, one row per logged tick."""
+        """The quantities of the checks, SI, one row per logged tick (computed once per log)."""
+        if self._series[0] is not log:
+            self._series = (log, self._compute_series(log))
+        return self._series[1]
+
+    def _compute_series(self, log: RunLog) -> dict:
         p, c = self.physics, self.controller
         n = log.t.size
         state = c.state
         feed = log.sensordata[:, p.sensor_block("feed_pos")]
         cabin = log.sensordata[:, p.sensor_block("cabin_pos")]
-        tension_law = self.loads.tension_log[:n].copy()
-        tension_law[n - 1] = tension_law[max(n - 2, 0)]  # the last tick has no physics after it
         legs = log.qpos[:, p.leg_qpos]
-        ctrl = log.ctrl.copy()
-        ctrl[n - 1] = ctrl[max(n - 2, 0)]  # the runner logs the ctrl of ticks with physics after them
         kp, kv = p.drive_gains(p.leg_ids)
         return {
             "feed_planned": log.reference.position[:, :3],
@@ -265,10 +275,10 @@ class FastEvaluation:
             "cabin_actual": cabin,
             "cabin_error": np.linalg.norm(cabin - state.cabin_origin[:n], axis=1),
             "cable_tension": -log.actuator_force[:, p.cable_ids],
-            "cable_tension_law": tension_law,
+            "cable_tension_law": _hold_last(self.loads.tension_log, n),
             "cable_tension_planned": state.tension[:n],
             "cable_length": log.sensordata[:, p.sensor_columns([f"cable{i}_length" for i in range(1, 7)])],
-            "cable_unstretched": ctrl[:, p.cable_ids],
+            "cable_unstretched": log.ctrl[:, p.cable_ids],
             "cable_length_feedback": c.cable_length_correction[:n],
             "ab_planned": c.ab_reference[:n],
             "ab_actual": log.qpos[:, p.ab_qpos],
@@ -365,9 +375,7 @@ class FastEvaluation:
         }
         if self.loads.mean_speed > 0:
             out["wind_speed"] = self.loads.speed[:n]
-            force = self.loads.force[:n].copy()
-            force[n - 1] = force[max(n - 2, 0)]  # the last tick has no physics after it
-            out["wind_force"] = force
+            out["wind_force"] = _hold_last(self.loads.force, n)
         return out
 
     def report(self, log: RunLog, checks, path) -> None:

@@ -43,7 +43,7 @@ import models
 from planners import fast
 from planners.errors import LimitError
 from planners.legs import leg_lengths, structure_matrix
-from planners.rotations import rot_y, rot_z
+from planners.rotations import rot_y, rot_z, skew, vee, wxyz
 from planners.trajectory import TrajectorySample
 from sims.wind import AIR_DENSITY, wind_speed_series
 
@@ -128,11 +128,6 @@ def _moment(arms: np.ndarray, forces: np.ndarray) -> np.ndarray:
     return np.einsum("ijk,nj,nk->i", _LEVI_CIVITA, arms, forces)
 
 
-def _skew(w: np.ndarray) -> np.ndarray:
-    """I + [w]x: a small rotation w (rad) to first order."""
-    return np.array([[1.0, -w[2], w[1]], [w[2], 1.0, -w[0]], [-w[1], w[0], 1.0]])
-
-
 def cable_drag_force(wind: np.ndarray, vectors: np.ndarray, lengths) -> np.ndarray:
     """(n, 3) drag of the wind (3,) m/s on cable pieces along ``vectors`` (n, 3) of ``lengths``
     (n,) m: 1/2 rho Cd d |u_n| u_n per metre, u_n the wind's component normal to the piece, N."""
@@ -140,12 +135,6 @@ def cable_drag_force(wind: np.ndarray, vectors: np.ndarray, lengths) -> np.ndarr
     normal = wind - (units @ wind)[:, None] * units
     speed = np.sqrt(np.einsum("ij,ij->i", normal, normal))
     return (0.5 * AIR_DENSITY * CABLE_DRAG_COEFFICIENT * CABLE_DIAMETER * np.asarray(lengths) * speed)[:, None] * normal
-
-
-def _wxyz_from_matrix(rotation: np.ndarray) -> np.ndarray:
-    quat = np.empty(4)
-    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rotation, dtype=float).ravel())
-    return quat
 
 
 #: Damping of the discretized cables' nodes, as the ratio it gives their first string modes
@@ -169,8 +158,8 @@ def discretized_spec(segments: int) -> mujoco.MjSpec:
 
     Cable i becomes ``segments`` spatial tendons ``cable{i}_seg{k}`` joining the tower top,
     ``segments - 1`` point masses ``cable{i}_node{k}`` (three slide joints each, damped by
-    ``NODE_DAMPING_RATIO`` at ``STRING_MODE_HZ``) and the cabin anchor. The segments share the cable's unstretched length
-    L0 evenly (the winch pays out at the tower and the rope runs through): the winch actuator
+    ``NODE_DAMPING_RATIO`` at ``STRING_MODE_HZ``) and the cabin anchor. The segments share the
+    cable's unstretched length L0 evenly (the winch pays out at the tower and the rope runs through): the winch actuator
     ``cable{i}`` drives the first (ctrl = L0), the others are springs EA / (L0 / n) of rest
     length L0 / n with stiffness-proportional damping; ``ChainCableLoads`` writes both every
     tick, and gives the nodes the mass mu L0 / n of the run's first L0. Written here for the
@@ -181,7 +170,7 @@ def discretized_spec(segments: int) -> mujoco.MjSpec:
     if segments < 2:
         raise ValueError(f"cable segments {segments} must be >= 2 (0 for the lumped cables)")
     spec = mujoco.MjSpec.from_file(str(models.scene_path("fast")))
-    home = mujoco.MjModel.from_xml_path(str(models.scene_path("fast")))
+    home = spec.compile()  # the lumped model: its home keyframe and sites
     rest = home.key("home").ctrl[0] / segments  # the winches' unstretched length at home
     mass = fast.FAST.cable_mass_per_length * rest
     stiffness = CABLE_EA / rest
@@ -213,9 +202,7 @@ def discretized_spec(segments: int) -> mujoco.MjSpec:
                 tendon.damping = [CABLE_DAMPING_S * stiffness, 0.0, 0.0]
         spec.tendon(f"cable{i}").rgba = [0, 0, 0, 0]  # the chord measures, the segments show
         spec.actuator(f"cable{i}").target = f"cable{i}_seg1"
-    key = spec.key("home")
-    model = spec.compile()
-    key.qpos = np.concatenate([model.qpos0])  # nodes on the chords; set_configuration sags them
+    # Keyframe home keeps qpos0: the nodes on the chords (set_configuration sags them).
     return spec
 
 
@@ -367,13 +354,13 @@ class FastPhysics(dm_mujoco.Physics):
         data.qpos[:] = model.qpos0
         cabin = self._qpos_adr("cabin")
         data.qpos[cabin:cabin + 3] = origin
-        data.qpos[cabin + 3:cabin + 7] = _wxyz_from_matrix(rotation)
+        data.qpos[cabin + 3:cabin + 7] = wxyz(rotation)
         data.qpos[self.ab_qpos] = theta_a, theta_b
         g = fast.FAST
         r_ab = fast.ab_rotation(theta_a, theta_b, g.alpha)
         plat = self._qpos_adr("feed_platform")
         data.qpos[plat:plat + 3] = origin + rotation @ (g.ab_center + r_ab @ g.r_ab_s)
-        data.qpos[plat + 3:plat + 7] = _wxyz_from_matrix(rotation @ r_ab)
+        data.qpos[plat + 3:plat + 7] = wxyz(rotation @ r_ab)
         data.qpos[self.multifeed_qpos] = multifeed
         data.qvel[:] = 0.0
         data.act[:] = 0.0
@@ -384,9 +371,8 @@ class FastPhysics(dm_mujoco.Physics):
     def _sag_nodes(self, origin, rotation, r_ab) -> None:
         """Put the discretized cables' nodes on the parabola of the planner's static tension T:
         the sag below the chord at the horizontal distance x is w_h x (l_h - x) / (2 H), H the
-        tension's horizontal part, w_h the weight per horizontal metre. Along it the nodes
-        divide the arc in the ratio of the segments' unstretched lengths: the winch segment
-        holds what the unstretched length for T (``unstretched_length``) leaves to it."""
+        tension's horizontal part, w_h the weight per horizontal metre; the nodes divide its
+        arc length evenly, as the segments share the unstretched length."""
         model, data = self.model.ptr, self.data.ptr
         g = fast.FAST
         tension = fast.cable_tensions(origin, rotation, g, ab_rotation=r_ab)
@@ -704,12 +690,6 @@ def ab_gravity_torque(state, geometry: fast.FastGeometry = fast.FAST) -> np.ndar
     return np.column_stack([np.einsum("ni,ni->n", axis_a, moment), np.einsum("ni,ni->n", axis_b, moment)])
 
 
-def _small_rotation(r_target: np.ndarray, r_actual: np.ndarray) -> np.ndarray:
-    """Rotation vector (3,) that turns r_actual toward r_target (small angles), rad."""
-    m = r_target @ r_actual.T
-    return 0.5 * np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
-
-
 class FastController:
     """Winches, A-B rotator, multi-beam rotation and Stewart stabilizer (see the module doc).
 
@@ -751,10 +731,11 @@ class FastController:
         self.stewart_lag = int(round(o.stewart_latency_s / control_dt))
         self.true_pos = np.empty((n, 3))
         self.true_rot = np.empty((n, 3, 3))
-        self.pose_noise = np.hstack([rng.normal(0.0, o.pose_noise_m, (n, 3)),
-                                     rng.normal(0.0, o.pose_noise_rad, (n, 3))])
-        self.stewart_noise = np.hstack([rng.normal(0.0, o.stewart_noise_m, (n, 3)),
-                                        rng.normal(0.0, o.stewart_noise_rad, (n, 3))])
+        # Noise of each measurement: position (n, 3) and a small rotation I + [w]x (n, 3, 3).
+        self.pose_noise = (rng.normal(0.0, o.pose_noise_m, (n, 3)),
+                           np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
+        self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
+                              np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
         self.correction = np.zeros(6)  # commanded pose correction, m and rad
         self.length_correction = np.zeros(6)  # its cable lengths, m
         self.integral = np.zeros(6)
@@ -785,14 +766,17 @@ class FastController:
         data.ctrl[physics.leg_ids] = 0.0
         data.ctrl[physics.multifeed_id] = state.multifeed[0]
 
-    def _measured(self, tick: int, lag: int, noise: np.ndarray):
+    def _measured(self, tick: int, lag: int, noise):
+        """(tick measured, position, rotation) of the cabin as a sensor ``lag`` ticks late
+        reports it, with its ``noise`` (position, rotation) of that tick."""
         j = max(0, tick - lag)
-        return j, self.true_pos[j] + noise[j, :3], _skew(noise[j, 3:]) @ self.true_rot[j]
+        return j, self.true_pos[j] + noise[0][j], noise[1][j] @ self.true_rot[j]
 
     def _cable_feedback(self, tick: int) -> None:
         o, s = self.options, self.state
         j, pos, rot = self._measured(tick, self.pose_lag, self.pose_noise)
-        error = np.concatenate([s.cabin_origin[j] - pos, _small_rotation(s.cabin_rotation[j], rot)])
+        # Rotation error: the small rotation that turns the measured attitude to the planned one.
+        error = np.concatenate([s.cabin_origin[j] - pos, vee(s.cabin_rotation[j] @ rot.T)])
         dt = self.pose_every * self.dt
         if self.last_error is not None:
             alpha = dt / (o.derivative_filter_s + dt)
@@ -836,7 +820,7 @@ class FastController:
         the tick, from the estimated cabin pose and the A-B encoders (inverse kinematics)."""
         data, p, s = self._data, self.physics, self.state
         j, pos, rot = self._measured(tick, self.stewart_lag, self.stewart_noise)
-        deviation = np.concatenate([pos - s.cabin_origin[j], _small_rotation(rot, s.cabin_rotation[j])])
+        deviation = np.concatenate([pos - s.cabin_origin[j], vee(rot @ s.cabin_rotation[j].T)])
         alpha, beta = self._tracker_gains
         predicted = self.stewart_deviation + self.stewart_rate * self.dt
         residual = deviation - predicted
@@ -845,7 +829,7 @@ class FastController:
         # Where the cabin will be when the legs get there: lead by latency + servo lag.
         ahead = self.stewart_deviation + self.stewart_lead * self.stewart_rate
         pos = s.cabin_origin[nxt] + ahead[:3]
-        rot = _skew(ahead[3:]) @ s.cabin_rotation[nxt]
+        rot = (np.eye(3) + skew(ahead[3:])) @ s.cabin_rotation[nxt]
         # R_AB from the encoders: the B frame relative to the cabin, as the model's kinematics
         # has it (the encoders are exact here).
         r_ab = data.xmat[p.cabin_body].reshape(3, 3).T @ data.xmat[p.ab_b_body].reshape(3, 3)

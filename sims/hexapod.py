@@ -25,6 +25,7 @@ import models
 from planners import hexapod as hexapod_planner
 from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
+from planners.rotations import wxyz
 from planners.trajectory import TrajectorySample
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
@@ -86,18 +87,13 @@ def check_elevation(elevation_deg: float) -> float:
     return float(elevation_deg)
 
 
-def _wxyz(rotation: np.ndarray) -> np.ndarray:
-    x, y, z, w = Rotation.from_matrix(rotation).as_quat()
-    return np.array([w, x, y, z])
-
-
 @functools.lru_cache(maxsize=16)
 def _compiled(elevation_deg: float) -> mujoco.MjModel:
     spec = mujoco.MjSpec.from_file(str(models.scene_path("hexapod")))
     top_end = spec.body("top_end")
     rotation = top_end_rotation(elevation_deg)
     origin = np.array(top_end.pos)
-    quat = _wxyz(rotation)
+    quat = wxyz(rotation)
     top_end.quat = quat
     platform_pos = origin + rotation @ RUBIN_CAMERA.rotation_pivot
     platform = spec.body("platform")
@@ -218,7 +214,7 @@ class HexapodPhysics(dm_mujoco.Physics):
         origin, rotation = self.top_end_frame
         position, r_pose = hexapod_planner.platform_frame(pose)
         data.qpos[self._free_qpos:self._free_qpos + 3] = origin + rotation @ position
-        data.qpos[self._free_qpos + 3:self._free_qpos + 7] = _wxyz(rotation @ r_pose)
+        data.qpos[self._free_qpos + 3:self._free_qpos + 7] = wxyz(rotation @ r_pose)
         pivots = hexapod_planner.pivot_positions(pose)
         for i, name in enumerate(STRUT_LABELS):
             housing = model.body(f"{name}_housing")

@@ -93,9 +93,10 @@ class RunLog:
 
     Arrays: t (n,), qpos, qvel, act, ctrl, actuator_force, sensordata (n, size), mocap_pos
     and mocap_quat (n, nmocap, 3|4) when the model has mocap bodies. ``reference`` is the
-    planned motion sampled at ``t``. ``contacts`` lists (tick, geom1, geom2, distance) of
-    every contact seen at a tick's end. ``n`` may be shorter than planned when the run
-    diverged.
+    planned motion sampled at ``t``. ``ctrl`` row i holds the controls applied from ``t[i]``;
+    the last row, after which no physics runs, the controls still held there. ``contacts``
+    lists (tick, geom1, geom2, distance) of every contact seen at a tick's end. ``n`` may be
+    shorter than planned when the run diverged.
     """
 
     t: np.ndarray
@@ -242,6 +243,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
             bar.update(update_every)
     log.loop_wall_s = time.perf_counter() - start
     bar.close()
+    ctrl[last] = data.ctrl  # held at the end (no controller call there)
     log.physics_steps = last * k
     if last < n - 1:
         for name in ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata",

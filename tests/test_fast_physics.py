@@ -311,7 +311,8 @@ def test_discretized_cables_bring_a_cabin_mode_into_the_measured_band():
     mujoco.mj_fullM(model, data, mass)
     velocity = vec[model.nv:2 * model.nv]
     energy = np.einsum("ik,ij,jk->k", velocity.conj(), mass, velocity).real
-    cabin = np.arange(int(physics.node_bodies.min()) and model.body_dofadr[physics.node_bodies.min()])
+    # The feed support's dofs: every dof before the first cable node's (the nodes come last).
+    cabin = np.arange(model.body_dofadr[physics.node_bodies.min()])
     cabin_energy = np.einsum("ik,ij,jk->k", velocity[cabin].conj(), mass[np.ix_(cabin, cabin)], velocity[cabin]).real
     coupled = (freq > 1e-3) & (freq < 1.0) & (cabin_energy > 0.2 * energy)
     lowest = freq[coupled].min()
