@@ -16,8 +16,12 @@ Exit codes: 0 every check passed, 1 a check failed, 2 bad input (one line on std
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
+import signal
 import sys
+import threading
 from pathlib import Path
 
 import sims  # noqa: F401  (chooses the OpenGL back end before mujoco is imported)
@@ -77,7 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser("list", help="list the scenarios")
     run = sub.add_parser("run", help="simulate a scenario and check it")
     run.add_argument("name")
-    run.add_argument("--out", type=Path, help="output directory (default results/NAME)")
+    run.add_argument("--out", help="output directory (default results/NAME); replaced only if "
+                     "planbench wrote it")
     run.add_argument("--seed", type=_seed, default=0)
     run.add_argument("--wind", type=_finite("wind speed", 0.0), help="mean wind, m/s")
     run.add_argument("--elevation", type=_finite("elevation"),
@@ -102,15 +107,16 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--stewart", choices=("on", "off"),
                      help="FAST's Stewart stabilizer: on (default) or off (FAST scenarios)")
     run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
-    run.add_argument("--video", type=Path, help="write an H.264 video of the run here")
+    run.add_argument("--video", help="write an H.264 video of the run here (.mp4, .m4v, .mov, .mkv)")
     run.add_argument("--camera", default=None, help="video camera: overview or closeup")
     run.add_argument("--quiet", action="store_true", help="no progress bars")
     plan = sub.add_parser("plan", help="write a scenario's planned motion, no physics")
     plan.add_argument("name")
-    plan.add_argument("--out", type=Path, required=True)
+    plan.add_argument("--out", required=True, help="output directory; replaced only if planbench wrote it")
     sub.add_parser("bench", help="benchmark table: realtime factors and loop/bare-mj_step ratios")
     demo = sub.add_parser("demo", help="run every scenario with a video; one table of checks")
-    demo.add_argument("--out", type=Path, default=Path("results"))
+    demo.add_argument("--out", default="results",
+                      help="directory of the scenarios' output directories (default results)")
     demo.add_argument("--quiet", action="store_true")
     return parser
 
@@ -164,6 +170,13 @@ def format_checks(rows) -> str:
     return "\n".join(lines)
 
 
+def _camera(scenario, requested: str | None) -> str:
+    camera = scenario.camera if requested is None else requested
+    if camera not in ("overview", "closeup"):
+        raise BadInput(f"camera {camera!r} is not one of overview, closeup")
+    return camera
+
+
 def cmd_run(args) -> int:
     from sims import outputs, runner, scenarios
 
@@ -171,16 +184,17 @@ def cmd_run(args) -> int:
         scenario = scenarios.get(args.name)
     except ValueError as e:
         raise BadInput(str(e)) from None
-    out = args.out if args.out is not None else Path("results") / scenario.name
-    outputs.check_writable(out, "output dir")
-    if args.video is not None:
-        outputs.check_writable(args.video, "video")
-    camera = args.camera or scenario.camera
-    if camera not in ("overview", "closeup"):
-        raise BadInput(f"camera {camera!r} is not one of overview, closeup")
-    setup = scenario.build(_options(scenario, args))
-    result = runner.run(scenario.name, setup, quiet=args.quiet)
-    outputs.write_run(result, setup, out, video=args.video, camera=camera, quiet=args.quiet)
+    options = _options(scenario, args)
+    camera = _camera(scenario, args.camera)
+    out = outputs.OutputDir(Path("results") / scenario.name if args.out is None else args.out)
+    video = None if args.video is None else outputs.VideoFile(args.video, out)
+    with contextlib.ExitStack() as reserved:  # lock before simulating: a second run is refused
+        reserved.enter_context(out.reserved())
+        if video is not None:
+            reserved.enter_context(video.reserved())
+        setup = scenario.build(options)
+        result = runner.run(scenario.name, setup, quiet=args.quiet)
+        outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
     print(format_checks([(scenario.name, c) for c in result.checks]))
     print(f"{'PASSED' if result.passed else 'FAILED'}: {scenario.name}, "
           f"{result.sim_time_s:.2f} s simulated in {result.wall_time_s:.2f} s; outputs in {out}")
@@ -194,9 +208,10 @@ def cmd_plan(args) -> int:
         scenario = scenarios.get_plan(args.name)
     except ValueError as e:
         raise BadInput(str(e)) from None
-    outputs.check_writable(args.out, "output dir")
-    plans.write_plan(scenario, args.out)
-    print(f"plan of {scenario.name} written to {args.out}")
+    out = outputs.OutputDir(args.out, kind="plan")
+    with out.reserved():
+        plans.write_plan(scenario, out)
+    print(f"plan of {scenario.name} written to {out}")
     return EXIT_OK
 
 
@@ -213,24 +228,43 @@ def cmd_bench(args) -> int:
     return EXIT_OK
 
 
+def _demo_root(raw: str) -> Path:
+    """The demo's directory: created if missing, never replaced itself (only the scenarios'
+    directories inside it are)."""
+    from sims.outputs import OutputError
+
+    if raw.strip() == "":
+        raise BadInput("demo --out '' is empty; give it a directory")
+    root = Path(raw)
+    if os.path.lexists(root) and not root.is_dir():
+        raise OutputError(f"demo --out {root} exists and is not a directory")
+    return root
+
+
 def cmd_demo(args) -> int:
     from sims import outputs, runner, scenarios
 
+    root = _demo_root(args.out)
+    targets = {name: outputs.OutputDir(root / name, option="demo --out")
+               for name in scenarios.SCENARIOS}  # every one validated before the first run
     rows, unexpected = [], []
-    for scenario in scenarios.SCENARIOS.values():
-        out = args.out / scenario.name
-        setup = scenario.build(scenarios.RunOptions())
-        result = runner.run(scenario.name, setup, quiet=args.quiet)
-        outputs.write_run(result, setup, out, video=out / f"{scenario.name}.mp4",
-                          camera=scenario.camera, quiet=args.quiet,
-                          more_videos=[(f"{scenario.name}-{c}.mp4", c) for c in scenario.demo_cameras])
-        rows += [(scenario.name, c) for c in result.checks]
-        verdict = "passed" if result.passed else "failed"
-        expected = "as expected" if result.passed == scenario.expect_pass else "UNEXPECTEDLY"
-        if result.passed != scenario.expect_pass:
-            unexpected.append(scenario.name)
-        print(f"{scenario.name}: {verdict} {expected} ({result.sim_time_s:.1f} s simulated in "
-              f"{result.wall_time_s:.1f} s) -> {out}", flush=True)
+    with contextlib.ExitStack() as reserved:
+        for target in targets.values():
+            reserved.enter_context(target.reserved())
+        for scenario in scenarios.SCENARIOS.values():
+            out = targets[scenario.name]
+            setup = scenario.build(scenarios.RunOptions())
+            result = runner.run(scenario.name, setup, quiet=args.quiet)
+            outputs.write_run(result, setup, out, video=outputs.VideoFile(out.path / f"{scenario.name}.mp4", out),
+                              camera=scenario.camera, quiet=args.quiet,
+                              more_videos=[(f"{scenario.name}-{c}.mp4", c) for c in scenario.demo_cameras])
+            rows += [(scenario.name, c) for c in result.checks]
+            verdict = "passed" if result.passed else "failed"
+            expected = "as expected" if result.passed == scenario.expect_pass else "UNEXPECTEDLY"
+            if result.passed != scenario.expect_pass:
+                unexpected.append(scenario.name)
+            print(f"{scenario.name}: {verdict} {expected} ({result.sim_time_s:.1f} s simulated in "
+                  f"{result.wall_time_s:.1f} s) -> {out}", flush=True)
     print()
     print(format_checks(rows))
     if unexpected:
@@ -244,19 +278,53 @@ def cmd_demo(args) -> int:
 COMMANDS = {"list": cmd_list, "run": cmd_run, "plan": cmd_plan, "bench": cmd_bench, "demo": cmd_demo}
 
 
+class _Interrupt:
+    """SIGINT, SIGTERM and SIGHUP become one KeyboardInterrupt (the first only: a second
+    Ctrl-C must not break the clean-up of the first); ``signum`` remembers which came."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+    def __init__(self):
+        self.signum = None
+        self._old = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self._old = {s: signal.signal(s, self._handle) for s in self.SIGNALS}
+        return self
+
+    def __exit__(self, *exc):
+        for s, handler in self._old.items():
+            signal.signal(s, handler)
+        return False
+
+    def _handle(self, signum, frame):
+        if self.signum is None:
+            self.signum = signum
+            raise KeyboardInterrupt
+
+
 def main(argv=None) -> int:
+    """Run the CLI; returns the exit code (0, 1, 2, or 130 / 128 + signal on an interrupt)."""
     from planners.errors import PlanningError
     from sims.outputs import OutputError
 
-    try:
-        args = build_parser().parse_args(argv)
-        return COMMANDS[args.command](args)
-    except (BadInput, PlanningError, OutputError) as e:
-        print(f"planbench: error: {e}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        print("planbench: interrupted", file=sys.stderr)
-        return 130
+    with _Interrupt() as interrupt:
+        try:
+            args = build_parser().parse_args(argv)
+            return COMMANDS[args.command](args)
+        except BaseException as e:
+            # An interrupt also kills ffmpeg (the terminal signals the whole process group),
+            # so whatever was raised after it is its consequence: one line, no traceback.
+            if interrupt.signum is not None or isinstance(e, KeyboardInterrupt):
+                signum = interrupt.signum or signal.SIGINT
+                print(f"planbench: interrupted by {signal.Signals(signum).name}; nothing "
+                      "half-written was left", file=sys.stderr)
+                return 128 + int(signum)
+            if isinstance(e, (BadInput, PlanningError, OutputError)):
+                print(f"planbench: error: {e}", file=sys.stderr)
+                return EXIT_BAD_INPUT
+            raise
 
 
 if __name__ == "__main__":

@@ -1,42 +1,558 @@
-"""Outputs of a run, written atomically: a temporary directory beside the target, renamed.
+"""Outputs of a run or a plan: validated up front, staged, swapped into place whole.
 
-A failed or interrupted write leaves no half-written directory or video behind.
+The contract (README, "Outputs and interrupts"):
+
+- planbench replaces an output directory only if planbench wrote it: the directory holds
+  ``planbench-manifest.json`` and nothing that the manifest does not list. An empty directory
+  may be filled. Everything else is refused before any work starts, as are ``.``, ``..`` and
+  every other directory that holds the current one, ``/``, the home directory, the empty
+  string, an existing file or symbolic link, places where nothing can be created (``/proc``,
+  read-only or immutable directories) and names or paths longer than the file system allows.
+- A video outside the output directory may replace only a video that planbench wrote (its
+  container's ``comment`` tag says so); its suffix must be one of VIDEO_SUFFIXES.
+- Writing happens in a staging directory ``.planbench-tmp-*`` beside the target, which is
+  swapped with the old directory by one ``renameat2(RENAME_EXCHANGE)``: a reader of
+  ``out/summary.json`` finds either the old file or the new one at every instant. Where the
+  file system cannot exchange, each file is moved in by ``os.replace`` instead (still never
+  missing), and the old files the old manifest lists are removed after.
+- One run at a time per target: a lock file ``.planbench-lock-*`` beside it (``flock``, freed
+  by the kernel when its process dies) refuses a second writer with exit 2.
+- Leftovers of a killed run (SIGKILL mid-write) are staging directories that name their
+  target in a marker or in a planbench manifest; the next run into that target, holding its
+  lock, removes them. Anything else is left alone.
+- A failure or an interrupt removes the staging directory, the lock file and any parent
+  directory created for the output, and leaves the old output as it was.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import errno
+import fcntl
+import hashlib
 import json
 import os
+import re
 import shutil
+import signal
+import subprocess
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
 
+MANIFEST = "planbench-manifest.json"
+STAGING_PREFIX = ".planbench-tmp-"
+STAGING_MARKER = ".planbench-staging.json"
+LOCK_PREFIX = ".planbench-lock-"
+PROBE_PREFIX = ".planbench-probe-"
+#: Containers that carry H.264 and that the ffmpeg of imageio-ffmpeg writes (tested).
+VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv")
+#: The ``comment`` tag of every video planbench writes: the proof that it may replace it.
+VIDEO_TAG = "written by planbench"
+#: Files of a run directory, and of a plan directory (more may follow, e.g. videos).
+RUN_FILES = ("summary.json", "timeseries.npz", "report.png", MANIFEST)
+PLAN_FILES = ("plan.npz", "plan.png", MANIFEST)
+#: Longest name planbench writes inside an output directory besides a video's.
+_LONGEST_INNER = max(len(n) for n in (*RUN_FILES, *PLAN_FILES, "segments.json", "figures.png",
+                                      "methods.png", "methods.npz", STAGING_MARKER))
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
 
 class OutputError(ValueError):
-    """The output location cannot be written."""
+    """The output location cannot or may not be written (bad input: exit 2)."""
 
 
-def check_writable(path: Path, what: str) -> None:
-    """Fail early, before simulating, if ``path`` (a file or directory) cannot be created.
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
 
-    Its nearest existing ancestor must be a writable directory and ``path`` itself must not
-    be an existing entry of the wrong kind.
-    """
-    path = Path(path)
+    try:
+        return version("planbench")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+@contextlib.contextmanager
+def signals_deferred():
+    """Hold back SIGINT, SIGTERM and SIGHUP: a step in here (a swap, a clean-up) completes,
+    and a signal that came meanwhile is delivered right after."""
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _usual_mode(path: Path, mode: int) -> None:
+    """mkdtemp/mkstemp make private entries (0700/0600); give ``path`` ``mode`` less the umask."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(path, mode & ~umask)
+
+
+def _nearest_existing(path: Path) -> Path:
     parent = path.parent
-    while not parent.exists():
+    while not os.path.lexists(parent):
         parent = parent.parent
-    if not parent.is_dir():
-        raise OutputError(f"{what} {path}: {parent} is not a directory")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f"{what} {path}: directory {parent} is not writable")
-    if what == "output dir" and path.exists() and not path.is_dir():
-        raise OutputError(f"{what} {path} exists and is not a directory")
-    if what == "video" and path.is_dir():
-        raise OutputError(f"{what} {path} is a directory")
+    return parent
+
+
+def _check_lengths(what: str, path: Path, deepest_inner: int) -> None:
+    """Every component within NAME_MAX and the deepest file within PATH_MAX (bytes)."""
+    anchor = _nearest_existing(path)
+    try:
+        name_max = os.pathconf(anchor, "PC_NAME_MAX")
+        path_max = os.pathconf(anchor, "PC_PATH_MAX")
+    except OSError:
+        name_max, path_max = 255, 4096
+    for part in path.parts[1:]:
+        n = len(os.fsencode(part))
+        if n > name_max:
+            shown = part if len(part) <= 40 else part[:37] + "..."
+            raise OutputError(f"{what} {shown!r}: a name of {n} bytes, longer than the file "
+                              f"system's limit of {name_max}")
+    staging = len(STAGING_PREFIX) + 8
+    n = len(os.fsencode(str(path.parent))) + 1 + max(len(os.fsencode(path.name)), staging) + 1 + deepest_inner
+    if n >= path_max:
+        raise OutputError(f"{what} {str(path)[:40]}...: its files' paths would be {n} bytes, "
+                          f"longer than the file system's limit of {path_max - 1}")
+
+
+def _probe(what: str, path: Path) -> None:
+    """Create (and remove) a directory and a file where ``path`` will be created."""
+    anchor = _nearest_existing(path)
+    if not anchor.is_dir():
+        raise OutputError(f"{what} {path}: {anchor} is not a directory")
+    try:
+        probe = tempfile.mkdtemp(prefix=PROBE_PREFIX, dir=anchor)
+    except OSError as e:
+        raise OutputError(f"{what} {path}: nothing can be created in {anchor} "
+                          f"({e.strerror or e})") from None
+    try:
+        with open(os.path.join(probe, "probe"), "wb") as f:
+            f.write(b"planbench")
+    except OSError as e:
+        raise OutputError(f"{what} {path}: files cannot be written in {anchor} "
+                          f"({e.strerror or e})") from None
+    finally:
+        shutil.rmtree(probe, ignore_errors=True)
+
+
+def _absolute(raw, what: str, option: str) -> Path:
+    if raw is None or str(raw).strip() == "":
+        raise OutputError(f"{what} {str(raw or '')!r} is empty; give {option} a path")
+    if "\0" in str(raw):
+        raise OutputError(f"{what} {str(raw)!r} contains a NUL byte")
+    return Path(os.path.abspath(os.path.expanduser(str(raw))))
+
+
+def read_manifest(directory: Path) -> dict | None:
+    """The manifest of a directory planbench wrote, or None if there is none or it is not one."""
+    try:
+        manifest = json.loads((Path(directory) / MANIFEST).read_text())
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    if not isinstance(manifest, dict) or manifest.get("written_by") != "planbench" \
+            or not isinstance(manifest.get("files"), list):
+        return None
+    return manifest
+
+
+def _entries(directory: Path) -> tuple[list[str], list[str]]:
+    """(files, directories) below ``directory`` as relative POSIX paths."""
+    files, dirs = [], []
+    for root, dirnames, filenames in os.walk(directory):
+        rel = Path(root).relative_to(directory)
+        dirs += [(rel / d).as_posix() for d in dirnames]
+        files += [(rel / f).as_posix() for f in filenames]
+        # symbolic links to directories are listed (os.walk does not follow them)
+    return files, dirs
+
+
+class _Target:
+    """What the output directory and an outside video share: the parents created for them,
+    and their lock."""
+
+    what = "output"
+
+    def __init__(self, raw, option: str):
+        self.option = option
+        self.path = _absolute(raw, self.what, option)
+        self._lock_fd: int | None = None
+        self._created: list[Path] = []
+
+    def __str__(self) -> str:
+        return str(self.path)
+
+    @property
+    def is_reserved(self) -> bool:
+        return self._lock_fd is not None
+
+    @contextlib.contextmanager
+    def reserved(self):
+        """Create missing parents, lock the target, remove provable leftovers. On an
+        exception the parents created here are removed again (if still empty)."""
+        ok = False
+        try:
+            self._make_parents()
+            self._lock_fd = _acquire_lock(self.path, self.what, self.option)
+            remove_leftovers(self.path)
+            yield self
+            ok = True
+        finally:
+            with signals_deferred():
+                if self._lock_fd is not None:
+                    _release_lock(self.path, self._lock_fd)
+                    self._lock_fd = None
+                if not ok:
+                    for d in reversed(self._created):
+                        with contextlib.suppress(OSError):
+                            d.rmdir()
+                self._created = []
+
+    def _make_parents(self) -> None:
+        missing = []
+        parent = self.path.parent
+        while not os.path.lexists(parent):
+            missing.append(parent)
+            parent = parent.parent
+        for d in reversed(missing):
+            try:
+                d.mkdir()
+            except FileExistsError:
+                continue
+            except OSError as e:
+                raise OutputError(f"{self.what} {self.path}: cannot create {d} "
+                                  f"({e.strerror or e})") from None
+            self._created.append(d)
+
+
+class OutputDir(_Target):
+    """A directory that planbench writes whole (``--out`` of ``run`` and ``plan``, and each
+    scenario's directory of ``demo``).
+
+    ``OutputDir(raw)`` validates without writing anything (raises OutputError);
+    ``with target.reserved():`` creates missing parents, takes the lock and removes
+    provable leftovers; ``with target.staging() as tmp:`` yields the staging directory and
+    swaps it in when the block ends without an exception.
+    """
+
+    what = "output dir"
+
+    def __init__(self, raw, option: str = "--out", kind: str = "run"):
+        super().__init__(raw, option)
+        self.kind = kind
+        path, what = self.path, self.what
+        real = Path(os.path.realpath(path))
+        cwd = Path(os.path.realpath(os.getcwd()))
+        if real == Path(real.anchor):
+            raise OutputError(f"{what} {path} is the file system's root; choose a new directory")
+        if real == cwd:
+            raise OutputError(f"{what} {path} is the current directory; choose a new directory")
+        if cwd.is_relative_to(real):
+            raise OutputError(f"{what} {path} holds the current directory; choose a new directory")
+        if real == Path(os.path.realpath(Path.home())):
+            raise OutputError(f"{what} {path} is the home directory; choose a new directory")
+        _check_lengths(what, path, _LONGEST_INNER)
+        if os.path.islink(path):
+            raise OutputError(f"{what} {path} is a symbolic link; give the directory itself")
+        if os.path.lexists(path):
+            if not path.is_dir():
+                raise OutputError(f"{what} {path} exists and is not a directory")
+            self._check_replaceable()
+            if not os.access(path, os.W_OK | os.X_OK):
+                raise OutputError(f"{what} {path} cannot be replaced: it is not writable "
+                                  "(read-only or immutable)")
+        _probe(what, path)
+
+    def _check_replaceable(self) -> None:
+        files, dirs = _entries(self.path)
+        if not files and not dirs:
+            return  # an empty directory: nothing to lose
+        manifest = read_manifest(self.path)
+        if manifest is None:
+            raise OutputError(
+                f"{self.what} {self.path} is not empty and planbench did not write it (no "
+                f"{MANIFEST}); choose another {self.option} or empty it yourself")
+        listed = set(manifest["files"]) | {MANIFEST}
+        parents = {p.as_posix() for f in listed for p in Path(f).parents}
+        foreign = [f for f in files if f not in listed] + [d for d in dirs if d not in parents]
+        if foreign:
+            shown = ", ".join(sorted(foreign)[:3]) + (", ..." if len(foreign) > 3 else "")
+            raise OutputError(
+                f"{self.what} {self.path} holds files planbench did not write ({shown}); "
+                f"choose another {self.option} or move them away")
+
+    @contextlib.contextmanager
+    def staging(self, info: dict | None = None):
+        """Yield a new staging directory; on success write the manifest and swap it in.
+        Reserves the target first unless the caller already did."""
+        if not self.is_reserved:
+            with self.reserved(), self.staging(info) as tmp:
+                yield tmp
+            return
+        tmp = _new_staging(self.path.parent, self.path.name)
+        try:
+            yield tmp
+            with signals_deferred():
+                files = [f for f in _entries(tmp)[0] if f != STAGING_MARKER]
+                manifest = {"written_by": "planbench", "version": _version(), "kind": self.kind,
+                            "target": self.path.name, "files": sorted(files + [MANIFEST]),
+                            "written_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                            **(info or {})}
+                (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+                (tmp / STAGING_MARKER).unlink()
+                _usual_mode(tmp, 0o777)
+                swap_in(tmp, self.path)
+        except BaseException:
+            with signals_deferred():
+                shutil.rmtree(tmp, ignore_errors=True)
+            raise
+
+
+def _new_staging(parent: Path, target_name: str) -> Path:
+    """A staging directory in ``parent`` whose marker names ``target_name`` (and this process)."""
+    with signals_deferred():
+        tmp = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=parent))
+        marker = json.dumps({"written_by": "planbench", "target": target_name, "pid": os.getpid()})
+        fd = os.open(tmp / STAGING_MARKER, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        try:
+            os.write(fd, marker.encode())
+        finally:
+            os.close(fd)
+    return tmp
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two directory entries atomically (Linux renameat2 RENAME_EXCHANGE); False where the
+    C library or the file system cannot."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    renameat2 = getattr(libc, "renameat2", None)
+    if renameat2 is None:
+        return False
+    if renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP, errno.EOPNOTSUPP):
+        return False
+    raise OSError(code, os.strerror(code), str(b))
+
+
+#: Tests set this to False to exercise the per-file fallback.
+USE_EXCHANGE = True
+
+
+def swap_in(tmp: Path, target: Path) -> None:
+    """Make the staging directory ``tmp`` the directory ``target``.
+
+    A reader of any file of the new output finds, at every instant, the old file or the new
+    one. The old directory (if any) is removed after.
+    """
+    if not os.path.lexists(target):
+        os.rename(tmp, target)
+        return
+    if not any(target.iterdir()):
+        os.rename(tmp, target)  # rename replaces an empty directory atomically
+        return
+    if USE_EXCHANGE and _exchange(tmp, target):
+        shutil.rmtree(tmp)  # now the old output
+        return
+    # Per file: move each new file over the old one, then drop the old ones not rewritten.
+    old = read_manifest(target) or {"files": []}
+    new_files, new_dirs = _entries(tmp)
+    for d in sorted(new_dirs):
+        (target / d).mkdir(exist_ok=True)
+    for f in sorted(new_files, key=lambda f: f == MANIFEST):  # the manifest last
+        os.replace(tmp / f, target / f)
+    for f in old["files"]:
+        if f not in new_files:
+            with contextlib.suppress(OSError):
+                (target / f).unlink()
+    shutil.rmtree(tmp)
+
+
+def _owned_leftover(entry: Path, target_name: str) -> bool:
+    """Whether ``entry`` (a staging or probe directory) provably belongs to planbench's run
+    into ``target_name``: its marker or its manifest names it (a probe: it holds at most the
+    probe file)."""
+    if entry.name.startswith(PROBE_PREFIX):
+        with contextlib.suppress(OSError):
+            return {p.name for p in entry.iterdir()} <= {"probe"}
+        return False
+    for marker in (STAGING_MARKER, MANIFEST):
+        try:
+            content = json.loads((entry / marker).read_text())
+        except (OSError, ValueError, UnicodeDecodeError):
+            continue
+        if isinstance(content, dict) and content.get("written_by") == "planbench" \
+                and content.get("target") == target_name:
+            return True
+    return False
+
+
+#: An empty staging directory this old (s) is a killed run's, not one being set up now.
+EMPTY_LEFTOVER_AGE_S = 60.0
+
+
+def remove_leftovers(target: Path) -> list[Path]:
+    """Remove what a killed run into ``target`` left beside it: staging directories whose
+    marker or manifest names ``target``, probes, and staging directories left empty for
+    over EMPTY_LEFTOVER_AGE_S. Call with the target's lock held, so that no live run owns
+    them. Anything else is left alone. Returns what was removed."""
+    removed = []
+    with contextlib.suppress(OSError):
+        for entry in target.parent.iterdir():
+            if not entry.name.startswith((STAGING_PREFIX, PROBE_PREFIX)) or entry.is_symlink() \
+                    or not entry.is_dir():
+                continue
+            if _owned_leftover(entry, target.name):
+                shutil.rmtree(entry, ignore_errors=True)
+                removed.append(entry)
+            elif not any(entry.iterdir()) and time.time() - entry.stat().st_mtime > EMPTY_LEFTOVER_AGE_S:
+                with contextlib.suppress(OSError):
+                    entry.rmdir()
+                    removed.append(entry)
+    return removed
+
+
+def _lock_path(target: Path) -> Path:
+    digest = hashlib.sha256(os.fsencode(target.name)).hexdigest()[:16]
+    return target.parent / f"{LOCK_PREFIX}{digest}"
+
+
+def _acquire_lock(target: Path, what: str, option: str) -> int:
+    """flock a lock file beside ``target``; a second planbench writer is refused."""
+    path = _lock_path(target)
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as e:
+            raise OutputError(f"{what} {target}: cannot create its lock file ({e.strerror or e})") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 64, 0).decode(errors="replace").strip() or "?"
+            os.close(fd)
+            raise OutputError(f"{what} {target} is being written by another planbench run "
+                              f"(pid {holder}); wait for it or choose another {option}") from None
+        # The file may have been unlinked by the previous holder between open and flock.
+        try:
+            same = os.stat(path).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, str(os.getpid()).encode(), 0)
+            return fd
+        os.close(fd)
+
+
+def _release_lock(target: Path, fd: int) -> None:
+    with contextlib.suppress(OSError):
+        os.unlink(_lock_path(target))
+    os.close(fd)
+
+
+class VideoFile(_Target):
+    """A video written outside an output directory (``--video``), or inside one.
+
+    Inside ``out_dir`` it is rendered into the output's staging directory and ``relative``
+    is its path there; outside, it gets a staging directory and a lock of its own, and may
+    replace only a video that planbench wrote.
+    """
+
+    what = "video"
+
+    def __init__(self, raw, out_dir: OutputDir | None = None, reserved_names=RUN_FILES,
+                 option: str = "--video"):
+        super().__init__(raw, option)
+        self.relative: Path | None = None
+        self._staged: Path | None = None
+        path = self.path
+        if path.suffix.lower() not in VIDEO_SUFFIXES:
+            raise OutputError(f"video {path}: suffix {path.suffix or '(none)'!r} is not one of "
+                              f"{', '.join(VIDEO_SUFFIXES)} (H.264 containers ffmpeg writes)")
+        if out_dir is not None and path.is_relative_to(out_dir.path):
+            if path == out_dir.path:
+                raise OutputError(f"video {path} is the output directory itself")
+            relative = path.relative_to(out_dir.path)
+            if relative.parts[0] in reserved_names or relative.parts[0] == MANIFEST:
+                raise OutputError(f"video {path} would overwrite the run's own "
+                                  f"{relative.parts[0]}; choose another name")
+            _check_lengths(self.what, out_dir.path, len(os.fsencode(str(relative))))
+            self.relative = relative
+            return
+        _check_lengths(self.what, path, len(STAGING_MARKER))
+        if os.path.islink(path):
+            raise OutputError(f"video {path} is a symbolic link; give the file itself")
+        if path.is_dir():
+            raise OutputError(f"video {path} is a directory")
+        if os.path.lexists(path):
+            if not path.is_file():
+                raise OutputError(f"video {path} exists and is not a regular file")
+            if not is_planbench_video(path):
+                raise OutputError(f"video {path} exists and planbench did not write it; "
+                                  f"choose another {option} or remove it yourself")
+        _probe(self.what, path)
+
+    @property
+    def is_reserved(self) -> bool:
+        return self.relative is not None or self._lock_fd is not None
+
+    @contextlib.contextmanager
+    def reserved(self):
+        """As ``_Target.reserved``; a video inside the output directory is covered by the
+        directory's own reservation."""
+        if self.relative is not None:
+            yield self
+            return
+        with super().reserved():
+            yield self
+
+    @contextlib.contextmanager
+    def staging(self):
+        """Yield the path to render to; ``commit`` moves it to ``self.path`` afterwards."""
+        tmp = _new_staging(self.path.parent, self.path.name)
+        try:
+            yield tmp / ("video" + self.path.suffix)
+        except BaseException:
+            with signals_deferred():
+                shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        self._staged = tmp
+
+    def commit(self) -> None:
+        if self._staged is None:
+            return
+        with signals_deferred():
+            rendered = self._staged / ("video" + self.path.suffix)
+            _usual_mode(rendered, 0o666)
+            os.replace(rendered, self.path)
+            shutil.rmtree(self._staged, ignore_errors=True)
+            self._staged = None
+
+    def discard(self) -> None:
+        if self._staged is not None:
+            with signals_deferred():
+                shutil.rmtree(self._staged, ignore_errors=True)
+            self._staged = None
+
+
+def is_planbench_video(path: Path) -> bool:
+    """Whether ``path`` is a video whose container carries planbench's ``comment`` tag."""
+    import imageio_ffmpeg
+
+    try:
+        proc = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-nostdin",
+                               "-i", str(path)], capture_output=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    text = proc.stderr.decode(errors="replace")
+    return re.search(r"^\s*comment\s*:\s*" + re.escape(VIDEO_TAG), text, re.MULTILINE | re.IGNORECASE) is not None
 
 
 def summary_dict(result) -> dict:
@@ -52,99 +568,67 @@ def summary_dict(result) -> dict:
     }
 
 
-def _usual_mode(path: Path, mode: int) -> None:
-    """mkdtemp/mkstemp make private entries (0700/0600); give ``path`` ``mode`` less the umask."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(path, mode & ~umask)
+def _as_output_dir(out_dir, kind: str) -> OutputDir:
+    return out_dir if isinstance(out_dir, OutputDir) else OutputDir(out_dir, kind=kind)
 
 
-def replace_dir(tmp: Path, target: Path) -> None:
-    """Rename ``tmp`` to ``target``, replacing an existing ``target`` directory."""
-    _usual_mode(tmp, 0o777)
-    if target.exists():
-        old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
-        os.rename(target, old / target.name)
-        os.rename(tmp, target)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.rename(tmp, target)
-
-
-@contextlib.contextmanager
-def atomic_dir(out_dir: Path):
-    """Yield a temporary directory beside ``out_dir`` that replaces it on success.
-
-    On any exception (or interrupt) the temporary directory is removed and ``out_dir`` is
-    left as it was.
-    """
-    out_dir = Path(out_dir).absolute()
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
-    try:
-        yield tmp
-        replace_dir(tmp, out_dir)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-
-
-def write_run(result, setup, out_dir: Path, video: Path | None = None, camera: str = "overview",
+def write_run(result, setup, out_dir, video=None, camera: str = "overview",
               quiet: bool = True, more_videos: tuple = ()) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
 
-    The video goes into the same temporary directory when it lies inside ``out_dir``, else
-    into a temporary file beside it; both are renamed into place only when everything is
-    written. ``more_videos``: (file name, camera) pairs of further videos inside ``out_dir``
-    (the demo's close-ups). Returns the summary.
+    ``out_dir``: an OutputDir (validated and reserved by the caller before simulating, as
+    the CLI does) or a path, validated here. ``video``: a VideoFile or a path. A video inside
+    ``out_dir`` is rendered into its staging directory; one outside into a staging directory
+    of its own; both are moved into place only when everything is written.
+    ``more_videos``: (file name, camera) pairs of further videos inside ``out_dir`` (the
+    demo's close-ups). Returns the summary.
     """
     from sims.render import render_video
 
-    out_dir = Path(out_dir).absolute()
-    video_tmp = None
-    try:
-        with atomic_dir(out_dir) as tmp:
-            summary = summary_dict(result)
-            log = result.log
-            arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl,
-                      "act": log.act, "actuator_force": log.actuator_force,
-                      "sensordata": log.sensordata}
-            arrays.update(setup.timeseries(log))
-            if setup.output_stride > 1:  # every stride-th tick of the per-tick arrays
-                n = log.t.size
-                arrays = {k: v[::setup.output_stride] if np.ndim(v) and np.shape(v)[0] == n else v
-                          for k, v in arrays.items()}
-                summary["timeseries_every_s"] = float(log.t[setup.output_stride] - log.t[0]) if n > setup.output_stride else None
-            np.savez_compressed(tmp / "timeseries.npz", **arrays)
-            setup.report(log, result.checks, tmp / "report.png")
+    target = _as_output_dir(out_dir, "run")
+    if video is not None and not isinstance(video, VideoFile):
+        video = VideoFile(video, target)
+    with contextlib.ExitStack() as stack:
+        if not target.is_reserved:
+            stack.enter_context(target.reserved())
+        if video is not None and not video.is_reserved:
+            stack.enter_context(video.reserved())
+        try:
+            with target.staging({"scenario": result.scenario}) as tmp:
+                summary = summary_dict(result)
+                log = result.log
+                arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl,
+                          "act": log.act, "actuator_force": log.actuator_force,
+                          "sensordata": log.sensordata}
+                arrays.update(setup.timeseries(log))
+                if setup.output_stride > 1:  # every stride-th tick of the per-tick arrays
+                    n = log.t.size
+                    arrays = {k: v[::setup.output_stride] if np.ndim(v) and np.shape(v)[0] == n else v
+                              for k, v in arrays.items()}
+                    summary["timeseries_every_s"] = float(log.t[setup.output_stride] - log.t[0]) if n > setup.output_stride else None
+                np.savez_compressed(tmp / "timeseries.npz", **arrays)
+                setup.report(log, result.checks, tmp / "report.png")
+                render = dict(speed=setup.video_speed, quiet=quiet, frame_qpos=setup.video_qpos)
+                if video is not None:
+                    if video.relative is not None:
+                        path = tmp / video.relative
+                        path.parent.mkdir(parents=True, exist_ok=True)
+                        frames = render_video(setup.physics.model.ptr, log, path, camera=camera, **render)
+                    else:
+                        with video.staging() as path:
+                            frames = render_video(setup.physics.model.ptr, log, path, camera=camera, **render)
+                    summary["video"] = {"path": str(video.path), "frames": frames, "camera": camera}
+                    if setup.video_note:
+                        summary["video"]["shows"] = setup.video_note
+                for name, extra_camera in more_videos:
+                    frames = render_video(setup.physics.model.ptr, log, tmp / name, camera=extra_camera, **render)
+                    summary.setdefault("more_videos", []).append(
+                        {"path": str(target.path / name), "frames": frames, "camera": extra_camera})
+                (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        except BaseException:
             if video is not None:
-                video = Path(video).absolute()
-                if video.is_relative_to(out_dir):
-                    target = tmp / video.relative_to(out_dir)
-                    target.parent.mkdir(parents=True, exist_ok=True)
-                else:
-                    video.parent.mkdir(parents=True, exist_ok=True)
-                    fd, name = tempfile.mkstemp(prefix=f".{video.stem}.tmp-", suffix=video.suffix,
-                                                dir=video.parent)
-                    os.close(fd)
-                    video_tmp = target = Path(name)
-                frames = render_video(setup.physics.model.ptr, log, target, camera=camera,
-                                      speed=setup.video_speed, quiet=quiet,
-                                      frame_qpos=setup.video_qpos)
-                summary["video"] = {"path": str(video), "frames": frames, "camera": camera}
-                if setup.video_note:
-                    summary["video"]["shows"] = setup.video_note
-            for name, extra_camera in more_videos:
-                frames = render_video(setup.physics.model.ptr, log, tmp / name, camera=extra_camera,
-                                      speed=setup.video_speed, quiet=quiet, frame_qpos=setup.video_qpos)
-                summary.setdefault("more_videos", []).append(
-                    {"path": str(out_dir / name), "frames": frames, "camera": extra_camera})
-            (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-        if video_tmp is not None:
-            _usual_mode(video_tmp, 0o666)
-            os.replace(video_tmp, video)
-        return summary
-    except BaseException:
-        if video_tmp is not None and video_tmp.exists():
-            video_tmp.unlink()
-        raise
+                video.discard()
+            raise
+        if video is not None:
+            video.commit()
+    return summary

@@ -7,21 +7,22 @@ from pathlib import Path
 import numpy as np
 
 from planners.trajectory import control_ticks
-from sims.outputs import atomic_dir
+from sims.outputs import OutputDir
 from sims.report import plan_plot
 
 PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
 MAX_PLAN_SAMPLES = 60_000  # longer plans are sampled coarser (a 300 s plan at 5 ms)
 
 
-def write_plan(scenario, out_dir: Path) -> Path:
+def write_plan(scenario, out_dir) -> Path:
     """Write plan.npz (t, position, velocity, acceleration, labels, key points), plan.png and
-    the scenario's extra files."""
+    the scenario's extra files into ``out_dir`` (an OutputDir, or a path validated here)."""
+    target = out_dir if isinstance(out_dir, OutputDir) else OutputDir(out_dir, kind="plan")
     trajectory = scenario.plan()
     dt = max(PLAN_DT, trajectory.duration / MAX_PLAN_SAMPLES)
     sample = trajectory.sample(control_ticks(trajectory.duration, dt))
     kinds = scenario.kinds()
-    with atomic_dir(out_dir) as tmp:
+    with target.staging({"scenario": scenario.name}) as tmp:
         arrays = dict(t=sample.t, position=sample.position, velocity=sample.velocity,
                       acceleration=sample.acceleration, labels=np.array(trajectory.labels),
                       kinds=np.array(kinds))
@@ -34,4 +35,4 @@ def write_plan(scenario, out_dir: Path) -> Path:
                   title=f"{scenario.name}: planned motion", key_times=key_times, key_points=key_points)
         if scenario.plan_extras is not None:
             scenario.plan_extras(trajectory, tmp)
-    return Path(out_dir)
+    return target.path

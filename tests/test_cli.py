@@ -100,15 +100,6 @@ def test_other_bad_options_exit_2(tmp_path):
     assert_one_line_error(planbench("frobnicate"), "invalid choice")
 
 
-def test_existing_output_is_replaced_whole(tmp_path):
-    out = tmp_path / "run"
-    out.mkdir()
-    (out / "stale.txt").write_text("old")
-    proc = planbench("run", "loader-supply", "--out", out, "--quiet", "--duration", "0.5")
-    assert proc.returncode == 0, proc.stderr
-    assert not (out / "stale.txt").exists() and (out / "summary.json").exists()
-
-
 def test_plan_writes_npz_and_plot(tmp_path):
     proc = planbench("plan", "loader-supply", "--out", tmp_path / "p")
     assert proc.returncode == 0, proc.stderr
@@ -119,20 +110,6 @@ def test_plan_writes_npz_and_plot(tmp_path):
     np.testing.assert_allclose(plan["position"][::500], plan["key_points"], atol=1e-12)
     assert (tmp_path / "p" / "plan.png").stat().st_size > 10_000
     assert_one_line_error(planbench("plan", "nope", "--out", tmp_path / "q"), "nope")
-
-
-def test_failed_write_leaves_old_output_and_no_temp_dir(tmp_path):
-    from sims.outputs import atomic_dir
-
-    out = tmp_path / "run"
-    out.mkdir()
-    (out / "summary.json").write_text("old")
-    with pytest.raises(RuntimeError):
-        with atomic_dir(out) as tmp:
-            (tmp / "summary.json").write_text("half")
-            raise RuntimeError("renderer died")
-    assert (out / "summary.json").read_text() == "old"
-    assert [p.name for p in tmp_path.iterdir()] == ["run"]
 
 
 def test_hexapod_run_with_elevation_and_wind(tmp_path):
