@@ -48,7 +48,7 @@ from scipy.interpolate import CubicSpline
 
 from planners.errors import LimitError, PlanningError
 from planners.rotations import rot_x, rot_y, rot_z, vee
-from planners.trajectory import TrajectorySample
+from planners.trajectory import TrajectorySample, sample_times
 
 JOINT_LABELS = ("azimuth", "elevation", "cross_elevation", "polarization")
 #: The paper's weights, eq. (7): motion of axis 1 costs most, axis 4 least.
@@ -511,7 +511,7 @@ class JointPathTrajectory:
         return float(self.path.t[-1] - self.path.t[0])
 
     def sample(self, t) -> TrajectorySample:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        t = sample_times(t)  # a number or 1-D array of finite times
         s = self._spline
         return TrajectorySample(t, s(t), s(t, 1), s(t, 2))
 

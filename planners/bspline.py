@@ -19,6 +19,39 @@ eq. (6) only holds for uniform knots, so non-uniform key times are rejected with
 
 With zero end velocities this is the clamped interpolating cubic spline (REFERENCE.md); the
 tests check it against ``scipy.interpolate.CubicSpline(bc_type="clamped")``.
+
+Joint limits and round-off
+--------------------------
+Key points are checked against the limits exactly: they are the caller's numbers, so one on a
+limit is accepted and one beyond it by any amount is refused. Between key points the spline is
+checked at its extrema, and there its values are the planner's own arithmetic: the control
+points come from a linear solve, the power-basis coefficients from them, the values from
+Horner's rule. A spline that touches a limit in exact arithmetic (a key point on the limit, the
+spline at rest there) evaluates to the limit give or take a few ulps of the control points, so
+a strict comparison refused, e.g., the move 1 -> 0 in [0, 1] for a value of -2.2e-16. The
+check therefore allows, per joint,
+
+    tolerance = 64 (eps max_k |P_k| + eta)    (eps = 2.2e-16, P the joint's control points,
+                                               eta = 4.9e-324 the smallest subnormal)
+
+(``limit_tolerance``), an a priori bound of the evaluation's error. The banded solve is
+backward stable and its matrix well conditioned: its error in the values is a few eps max |P|
+(at most 3 measured). Each coefficient a_r = sum_q B_rq P_q is four rounded products and
+sums, error <= 4 eps sum_q |B_rq| max |P|; summed over the rows (sum |B| = 32/6) that is
+<= 22 eps max |P| at u in [0, 1]. Horner's rule adds at most 6 eps sum_r |a_r| <=
+32 eps max |P|. Together < 64 eps max |P|; measured against exact rational arithmetic the
+error never exceeded 3 eps max |P|. Each operation may also underflow by up to eta (the
+standard error model's absolute term), which matters only for values near 1e-308 (a key
+point of 5e-324 on a limit of 0 evaluated to -5e-324). The tolerance scales with the magnitude of the values,
+not with the limits' range: the round-off of a joint near 1000 rad is that of 1000, whatever
+its range. A real overshoot, larger than this, is still refused, and the sampled trajectory
+stays within the limits up to the same tolerance (both tested in
+``tests/test_api_bad_input.py``).
+
+Inputs are checked before anything is solved: key times, key points and limits must be finite
+and within +/-``planners.trajectory.MAX_MAGNITUDE``, the limits ordered, and the key step long
+enough that the spline's accelerations stay within that magnitude too (a step of 1e-200 s
+would give infinite accelerations).
 """
 
 from __future__ import annotations
@@ -29,7 +62,8 @@ import numpy as np
 from scipy import linalg
 
 from planners.errors import LimitError, PlanningError
-from planners.trajectory import TrajectorySample
+from planners.trajectory import (MAX_MAGNITUDE, TrajectorySample, check_values, fmt_number,
+                                 sample_times)
 
 # Eq. (10): power-basis coefficients of the uniform cubic B-spline, rows for u^3, u^2, u, 1.
 BASIS = np.array(
@@ -42,6 +76,9 @@ BASIS = np.array(
 ) / 6.0
 
 _UNIFORM_RTOL = 1e-9
+# Round-off allowed between key points, in units of eps * max |control point| of the joint
+# (module docstring, "Joint limits and round-off").
+LIMIT_TOLERANCE_ULPS = 64
 
 
 def solve_control_points(key_points: np.ndarray) -> np.ndarray:
@@ -78,6 +115,12 @@ def solve_control_points(key_points: np.ndarray) -> np.ndarray:
     return linalg.solve_banded((2, 2), ab, rhs)
 
 
+def _distinct(value: float, limit: float) -> tuple[str, str]:
+    """A value and its limit as 6 significant digits, or in full where those look equal."""
+    a, b = f"{value:.6g}", f"{limit:.6g}"
+    return (a, b) if a != b else (fmt_number(value), fmt_number(limit))
+
+
 class CubicBSplineTrajectory:
     """Joint trajectory through key points at uniform times (loader paper, eq. 1-10).
 
@@ -85,8 +128,9 @@ class CubicBSplineTrajectory:
       times: (n+1,) key times in s, strictly increasing and uniformly spaced.
       key_points: (n+1, m) joint values at those times, SI units (m or rad).
       labels: m joint names, used in error messages and outputs.
-      lower, upper: optional (m,) joint limits. Key points outside them are rejected, and so
-        is a spline that overshoots them between key points.
+      lower, upper: optional (m,) joint limits, finite, lower <= upper. Key points outside
+        them are rejected, and so is a spline that overshoots them between key points by more
+        than its round-off (``limit_tolerance``; module docstring).
 
     Before ``times[0]`` and after ``times[-1]`` the trajectory holds its end points at rest.
     """
@@ -99,12 +143,17 @@ class CubicBSplineTrajectory:
         lower: Sequence[float] | None = None,
         upper: Sequence[float] | None = None,
     ):
-        times = np.asarray(times, dtype=float)
-        key_points = np.asarray(key_points, dtype=float)
+        try:
+            times = np.asarray(times, dtype=float)
+            key_points = np.asarray(key_points, dtype=float)
+        except (TypeError, ValueError):
+            raise PlanningError(f"key times {times!r} and key points {key_points!r} must be "
+                                "numbers") from None
         if key_points.ndim == 1:
             key_points = key_points[:, None]
         if times.ndim != 1:
             raise PlanningError(f"key times must be a 1-D array, got shape {times.shape}")
+        check_values(times, lambda i: f"key time t[{i[0]}]", "s")
         if times.size < 2:
             raise PlanningError(f"need at least 2 key points, got {times.size}")
         if key_points.ndim != 2 or key_points.shape[0] != times.size:
@@ -116,12 +165,7 @@ class CubicBSplineTrajectory:
         labels = list(labels) if labels is not None else [f"q{j + 1}" for j in range(m)]
         if len(labels) != m:
             raise PlanningError(f"{len(labels)} joint labels for {m} joint columns")
-        if not np.all(np.isfinite(times)):
-            raise PlanningError(f"key times contain NaN or inf: {times.tolist()}")
-        bad = np.argwhere(~np.isfinite(key_points))
-        if bad.size:
-            k, j = bad[0]
-            raise PlanningError(f"key point {k} of joint {labels[j]} is {key_points[k, j]}")
+        check_values(key_points, lambda i: f"key point {i[0]} of joint {labels[i[1]]}")
         steps = np.diff(times)
         if np.any(steps <= 0):
             k = int(np.argmax(steps <= 0))
@@ -136,11 +180,29 @@ class CubicBSplineTrajectory:
                 f"key times must be uniformly spaced (the paper's uniform B-spline, eq. 6): "
                 f"step {worst} is {steps[worst]} s, the mean step is {h} s"
             )
-        self._lower = None if lower is None else np.asarray(lower, dtype=float)
-        self._upper = None if upper is None else np.asarray(upper, dtype=float)
-        for name, lim in (("lower", self._lower), ("upper", self._upper)):
-            if lim is not None and lim.shape != (m,):
-                raise PlanningError(f"{name} limits have shape {lim.shape}, expected ({m},)")
+        limits = {}
+        for name, lim in (("lower", lower), ("upper", upper)):
+            if lim is None:
+                limits[name] = None
+                continue
+            try:
+                arr = np.asarray(lim, dtype=float)
+            except (TypeError, ValueError):
+                raise PlanningError(f"{name} limits {lim!r} are not numbers") from None
+            if arr.shape != (m,):
+                raise PlanningError(f"{name} limits have shape {arr.shape}, expected ({m},)")
+            limits[name] = check_values(
+                arr, lambda i, name=name: f"{name} limit of joint {labels[i[0]]}"
+            )
+        self._lower, self._upper = limits["lower"], limits["upper"]
+        if self._lower is not None and self._upper is not None:
+            crossed = np.flatnonzero(self._lower > self._upper)
+            if crossed.size:
+                j = int(crossed[0])
+                raise PlanningError(
+                    f"joint {labels[j]}: lower limit {self._lower[j]:.6g} is above its upper "
+                    f"limit {self._upper[j]:.6g}"
+                )
         self._check_limits(key_points, labels, times, what="key point")
 
         self._t0 = float(times[0])
@@ -153,6 +215,10 @@ class CubicBSplineTrajectory:
         # (segments, 4, m), rows for u^3, u^2, u, 1 (eq. 10 expanded once).
         windows = np.stack([self.control_points[i : i + 4] for i in range(times.size - 1)])
         self._coef_u = np.einsum("rc,scm->srm", BASIS, windows)
+        self._check_key_step()
+        finfo = np.finfo(float)
+        self._tolerance = LIMIT_TOLERANCE_ULPS * (
+            finfo.eps * np.max(np.abs(self.control_points), axis=0) + finfo.smallest_subnormal)
         self._check_overshoot()
 
     # -- the Trajectory contract -------------------------------------------------------------
@@ -172,9 +238,19 @@ class CubicBSplineTrajectory:
     def key_points(self) -> np.ndarray:
         return self._key_points.copy()
 
+    @property
+    def limit_tolerance(self) -> np.ndarray:
+        """(m,) round-off allowed beyond a limit between key points: 64 (eps max |P| + eta)
+        per joint (module docstring, "Joint limits and round-off"); in the joints' units."""
+        return self._tolerance.copy()
+
     def sample(self, t: np.ndarray | float) -> TrajectorySample:
-        """Positions, velocities and accelerations at times ``t`` (s), vectorized (eq. 10)."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        """Positions, velocities and accelerations at times ``t`` (s), vectorized (eq. 10).
+
+        ``t``: a number or a 1-D array of finite times (``planners.trajectory.sample_times``;
+        a PlanningError names a NaN or infinite time).
+        """
+        t = sample_times(t)
         s = (np.clip(t, self._t0, self._times[-1]) - self._t0) / self._h
         seg = np.minimum(np.floor(s).astype(int), self._coef_u.shape[0] - 1)
         u = (s - seg)[:, None]
@@ -198,6 +274,24 @@ class CubicBSplineTrajectory:
         return self._coef_u * scale[None, :, None]
 
     # -- validation ---------------------------------------------------------------------------
+    def _check_key_step(self):
+        """Refuse a key step so short that the spline's accelerations leave +/-MAX_MAGNITUDE.
+
+        The acceleration in a segment is (6 a3 u + 2 a2) / h^2, at most 8 max |a| / h^2.
+        """
+        peak = float(np.max(np.abs(self._coef_u[:, :2]))) if self._coef_u.size else 0.0
+        if peak == 0.0:
+            return
+        with np.errstate(over="ignore", divide="ignore"):
+            accel = 8.0 * peak / np.float64(self._h) ** 2
+        if not accel <= MAX_MAGNITUDE:
+            shortest = np.sqrt(8.0 * peak / MAX_MAGNITUDE)
+            raise PlanningError(
+                f"key step {self._h:.6g} s is too short for these key points: the spline's "
+                f"accelerations (up to {accel:.3g} per s^2) would exceed +/-{MAX_MAGNITUDE:g}; "
+                f"the key step must be >= {shortest:.3g} s"
+            )
+
     def _check_limits(self, values, labels, times, what):
         for name, lim, breaks in (
             ("lower", self._lower, lambda v, l: v < l),
@@ -208,15 +302,20 @@ class CubicBSplineTrajectory:
             bad = np.argwhere(breaks(values, lim[None, :]))
             if bad.size:
                 k, j = bad[0]
+                value, limit = _distinct(values[k, j], lim[j])
                 raise LimitError(
-                    f"{what} at t = {times[k]:.4g} s: joint {labels[j]} = {values[k, j]:.6g} "
-                    f"is beyond its {name} limit {lim[j]:.6g}"
+                    f"{what} at t = {times[k]:.4g} s: joint {labels[j]} = {value} "
+                    f"is beyond its {name} limit {limit}"
                 )
 
     def _check_overshoot(self):
         """Reject a spline that leaves the joint limits between key points.
 
-        Each segment is a cubic in u; its extrema are the roots of the derivative quadratic.
+        Each segment is a cubic in u; its extrema are the roots of the derivative quadratic
+        qa u^2 + qb u + qc, found without cancellation: q = -(qb + sign(qb) sqrt(disc)) / 2,
+        roots q / qa and qc / q. (The textbook (-qb + sqrt(disc)) / (2 qa) with a cutoff
+        |qa| < 1e-14 for "linear" lost the root of a segment whose a3 was round-off of 4e-14:
+        the spline 360, 128.5, 128.5, 360 dips to 70.6 and passed a lower limit of 75.)
         """
         if self._lower is None and self._upper is None:
             return
@@ -226,9 +325,9 @@ class CubicBSplineTrajectory:
         disc = qb**2 - 4.0 * qa * qc
         with np.errstate(divide="ignore", invalid="ignore"):
             root = np.sqrt(np.where(disc >= 0, disc, np.nan))
-            linear = np.abs(qa) < 1e-14
-            r1 = np.where(linear, -qc / qb, (-qb + root) / (2.0 * qa))
-            r2 = np.where(linear, np.nan, (-qb - root) / (2.0 * qa))
+            q = -0.5 * (qb + np.where(qb >= 0, 1.0, -1.0) * root)
+            r1 = np.where(q != 0, q / qa, np.nan)  # inf/nan where qa == 0: no second root
+            r2 = np.where(q != 0, qc / q, np.nan)  # q == 0: qb == qa qc == 0, roots at 0 only
         for r in (r1, r2):
             candidates.append(np.where(np.isfinite(r) & (r > 0) & (r < 1), r, 0.0))
         for u in candidates:
@@ -237,11 +336,14 @@ class CubicBSplineTrajectory:
             for name, lim, sign in (("lower", self._lower, -1.0), ("upper", self._upper, 1.0)):
                 if lim is None:
                     continue
-                bad = np.argwhere(sign * (values - lim[None, :]) > 0)
+                excess = sign * (values - lim[None, :])
+                bad = np.argwhere(excess > self._tolerance[None, :])
                 if bad.size:
                     k, j = bad[0]
+                    value, limit = _distinct(values[k, j], lim[j])
                     raise LimitError(
                         f"spline between key points at t = {times[k, j]:.4g} s: joint "
-                        f"{self._labels[j]} = {values[k, j]:.6g} overshoots its {name} limit "
-                        f"{lim[j]:.6g}"
+                        f"{self._labels[j]} = {value} overshoots its {name} limit "
+                        f"{limit} by {excess[k, j]:.3g} (round-off tolerance "
+                        f"{self._tolerance[j]:.3g})"
                     )

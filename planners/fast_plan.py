@@ -26,7 +26,7 @@ from scipy.interpolate import CubicHermiteSpline, CubicSpline
 from planners import fast
 from planners import profiles as prof
 from planners.errors import LimitError, PlanningError
-from planners.trajectory import TrajectorySample
+from planners.trajectory import TrajectorySample, check_values, sample_times
 
 R_FOCAL = fast.FOCAL_SURFACE_RADIUS
 MIN_LENGTH = 1e-6  # m: shorter lines and arcs are left out of a switch
@@ -155,6 +155,14 @@ def tangential_limit(a_max: float, v_max: float, radius: float = R_FOCAL) -> flo
     return math.sqrt(a_max * a_max - centripetal * centripetal)
 
 
+def _point(name: str, value, unit: str = "m") -> np.ndarray:
+    """A (3,) vector, finite and within +/-MAX_MAGNITUDE (a PlanningError names the entry)."""
+    v = check_values(value, lambda i: f"{name} {'xyz'[i[0]] if len(i) == 1 else list(i)}", unit)
+    if v.shape != (3,):
+        raise PlanningError(f"{name} must be a 3-vector, got shape {v.shape}")
+    return v
+
+
 def _arc_between(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
     """(unit tangent at a toward b, arc length on the focal sphere)."""
     ua, ub = a / np.linalg.norm(a), b / np.linalg.norm(b)
@@ -202,7 +210,9 @@ def switch_times(p0, p1, multifeed0: float = 0.0, multifeed1: float = 0.0,
     time T_AB (its larger angle change P0 -> P1) less T_focal; the same for the multi-feed
     rotation.
     """
-    p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
+    p0, p1 = _point("P0", p0), _point("P1", p1)
+    multifeed0 = float(check_values(multifeed0, "multifeed0", "rad"))
+    multifeed1 = float(check_values(multifeed1, "multifeed1", "rad"))
     ph = fast.closest_focal_point(p0)
     _, arc = _arc_between(ph, p1)
     a_arc = tangential_limit(fast.A_S_MAX, fast.V_S_MAX)
@@ -301,8 +311,11 @@ def observation_segment(times, directions, t0: float = 0.0, name: str = "observa
     """The feed following a sky path: P_feed = -r s(t) through a cubic spline in time;
     ``angles`` (rad, at the same times): the multi-feed rotation along it (e.g. the
     parallactic angle, so the 19 beams keep their pattern on the sky)."""
-    times = np.asarray(times, dtype=float)
-    points = fast.feed_position(np.asarray(directions, dtype=float))
+    times = check_values(times, lambda i: f"observation time t[{i[0]}]", "s")
+    directions = check_values(directions, lambda i: f"observation direction[{', '.join(map(str, i))}]")
+    if angles is not None:
+        angles = check_values(angles, lambda i: f"observation angle[{i[0]}]", "rad")
+    points = fast.feed_position(directions)
     spline = CubicSpline(times - times[0], points, axis=0)
     angle_spline = None
     if angles is not None:
@@ -339,6 +352,11 @@ def hermite_peak_acceleration(p0, v0, p1, v1, duration: float) -> float:
 
 def transition_time(p0, v0, p1, v1, a_limit: float = fast.A_T_MAX) -> float:
     """The shortest transition time whose Hermite curve keeps |a| <= a_limit (bisection)."""
+    p0, p1 = _point("transition P0", p0), _point("transition P1", p1)
+    v0, v1 = _point("transition V0", v0, "m/s"), _point("transition V1", v1, "m/s")
+    a_limit = float(check_values(a_limit, "a_limit", "m/s^2"))
+    if a_limit <= 0:
+        raise PlanningError(f"a_limit = {a_limit!r} m/s^2 must be > 0")
     lo, hi = 1e-3, 1.0
     while hermite_peak_acceleration(p0, v0, p1, v1, hi) > a_limit:
         hi *= 2.0
@@ -513,7 +531,7 @@ class FastPlan:
 
     def feed(self, t):
         """(index, position, velocity, acceleration) of the feed at times t (s)."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        t = sample_times(t)  # a number or 1-D array of finite times
         index = np.clip(np.searchsorted(self._breaks, t, side="right") - 1, 0, len(self.segments) - 1)
         pos, vel, acc = np.empty((t.size, 3)), np.empty((t.size, 3)), np.empty((t.size, 3))
         for k in np.unique(index):
@@ -536,7 +554,7 @@ class FastPlan:
         return out
 
     def state(self, t) -> FastPlanSample:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        t = sample_times(t)  # a number or 1-D array of finite times
         index, pos, vel, acc = self.feed(t)
         axis = -pos / np.linalg.norm(pos, axis=1, keepdims=True)
         tilt = fast.tilt_law(self.geometry, self.limits)(axis)
@@ -553,7 +571,7 @@ class FastPlan:
         return np.column_stack([s.feed, s.cabin_tilt, s.theta_a, s.theta_b, s.multifeed, s.cable_length])
 
     def sample(self, t) -> TrajectorySample:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        t = sample_times(t)  # a number or 1-D array of finite times
         h = RATE_STEP
         mid, plus, minus = self._channels(t), self._channels(t + h), self._channels(t - h)
         velocity = (plus - minus) / (2 * h)

@@ -47,11 +47,14 @@ import numpy as np
 
 from planners.errors import LimitError, PlanningError
 from planners.legs import leg_forces, leg_lengths, leg_vectors, structure_matrix
-from planners.trajectory import TrajectorySample
+from planners.trajectory import TrajectorySample, check_values, sample_times
 
 POSE_LABELS = ("x", "y", "z", "rx", "ry", "rz")
 STRUT_LABELS = tuple(f"strut{i}" for i in range(1, 7))
 CONTROL_DT = 0.005  # s: the paper's 200 Hz
+# The most ticks one move may take: 5.8 days at 200 Hz. ``commanded_acceleration`` holds
+# (ticks, 6) doubles, 4.8 GB at this count; a tick of, e.g., 1e-300 s would overflow the count.
+MAX_TICKS = 1e8
 
 _UM = 1e-6
 
@@ -73,7 +76,7 @@ class HexapodGeometry:
 
     def __post_init__(self):
         for name in ("base_pivots", "platform_pivots", "rotation_pivot"):
-            value = np.array(getattr(self, name), dtype=float)
+            value = np.array(check_values(getattr(self, name), name, "m"), dtype=float)
             value.setflags(write=False)
             object.__setattr__(self, name, value)
         if self.base_pivots.shape != (6, 3) or self.platform_pivots.shape != (6, 3):
@@ -117,12 +120,28 @@ class HexapodLimits:
     def __post_init__(self):
         for name in ("pose_lower", "pose_upper"):
             value = np.array(getattr(self, name), dtype=float)
+            if value.shape != (6,):
+                raise PlanningError(f"{name} must have 6 components (x, y, z, rx, ry, rz), got "
+                                    f"shape {value.shape}")
+            check_values(value, lambda i, name=name: f"{name} {POSE_LABELS[i[0]]}",
+                         lambda i: _pose_unit(i[-1]))
             value.setflags(write=False)
             object.__setattr__(self, name, value)
+        crossed = np.flatnonzero(self.pose_lower > self.pose_upper)
+        if crossed.size:
+            axis = int(crossed[0])
+            raise PlanningError(f"pose_lower {POSE_LABELS[axis]} = {self.pose_lower[axis]:.6g} "
+                                f"{_pose_unit(axis)} is above pose_upper "
+                                f"{POSE_LABELS[axis]} = {self.pose_upper[axis]:.6g}")
         for name in ("stroke", "strut_speed", "strut_accel", "linear_speed", "angular_speed"):
             value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
+            try:
+                ok = bool(np.isfinite(value) and value > 0)
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
                 raise PlanningError(f"limit {name} = {value!r} must be finite and > 0")
+            check_values(value, f"limit {name}")
 
     @property
     def threshold_distance(self) -> float:
@@ -190,14 +209,36 @@ def rotation_matrix(angles) -> np.ndarray:
     return r
 
 
+def _pose_unit(axis: int) -> str:
+    return "m" if axis < 3 else "rad"
+
+
 def _as_poses(pose, what: str = "pose") -> np.ndarray:
-    pose = np.asarray(pose, dtype=float)
+    """Poses (..., 6) as floats; PlanningError naming the row, axis and value of a NaN, inf or
+    |value| > MAX_MAGNITUDE entry (``planners.trajectory.check_values``)."""
+    try:
+        pose = np.asarray(pose, dtype=float)
+    except (TypeError, ValueError):
+        raise PlanningError(f"{what} {pose!r} must be numbers") from None
     if pose.shape[-1:] != (6,):
         raise PlanningError(f"{what} must have 6 components (x, y, z, rx, ry, rz), got shape "
                             f"{pose.shape}")
-    if not np.all(np.isfinite(pose)):
-        raise PlanningError(f"{what} contains a non-finite value: {pose}")
+    flat = pose.reshape(-1, 6)
+    check_values(flat, lambda i: f"{what} {POSE_LABELS[i[1]]}"
+                 + (f" of row {i[0]}" if pose.ndim > 1 else ""),
+                 lambda i: _pose_unit(i[1]))
     return pose
+
+
+def _um(value: float) -> str:
+    """A length in um as the limit messages write it (fixed point unless it is huge)."""
+    um = value * 1e6
+    return f"{um:.1f}" if abs(um) < 1e9 else f"{um:.6g}"
+
+
+def _deg(value: float) -> str:
+    deg = np.degrees(value)
+    return f"{deg:.4f}" if abs(deg) < 1e9 else f"{deg:.6g}"
 
 
 def platform_frame(pose, geometry: HexapodGeometry = RUBIN_CAMERA):
@@ -314,9 +355,9 @@ def check_pose_limits(pose, limits: HexapodLimits = RUBIN_LIMITS, what: str = "t
         limit = limits.pose_lower[axis] if low[row, axis] else limits.pose_upper[axis]
         name = POSE_LABELS[axis]
         if axis < 3:
-            text = f"{value * 1e6:.1f} um is beyond its limit {limit * 1e6:.1f} um"
+            text = f"{_um(value)} um is beyond its limit {_um(limit)} um"
         else:
-            text = f"{np.degrees(value):.4f} deg is beyond its limit {np.degrees(limit):.4f} deg"
+            text = f"{_deg(value)} deg is beyond its limit {_deg(limit)} deg"
         where = f" (move {row})" if flat.shape[0] > 1 else ""
         raise LimitError(f"{what} {name} = {text}{where}")
 
@@ -592,7 +633,9 @@ class StrutMove:
         return position, velocity
 
     def sample(self, t) -> TrajectorySample:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        """Strut positions, velocities, accelerations at the times t (a number or a 1-D
+        array of finite times, ``planners.trajectory.sample_times``)."""
+        t = sample_times(t)
         tau = np.maximum(t, 0.0)[:, None]  # at rest on the start before t = 0
         a = self.accel
         t1 = self.n_accel * self.dt
@@ -674,10 +717,14 @@ def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = 
             raise PlanningError(f"pose displacement {pose_displacement.shape} must be "
                                 f"{start.shape}, one per move")
     for name, value in (("start", start), ("target", target)):
-        if not np.all(np.isfinite(value)):
-            raise PlanningError(f"{name} strut positions contain a non-finite value")
+        check_values(value, lambda i, name=name: f"{name} {STRUT_LABELS[i[1]]} position"
+                     + (f" of row {i[0]}" if value.shape[0] > 1 else ""), "m")
         check_stroke(value, limits, what=name)
-    if not (np.isfinite(dt) and dt > 0):
+    try:
+        dt_ok = bool(np.isfinite(dt) and dt > 0)
+    except (TypeError, ValueError):
+        dt_ok = False
+    if not dt_ok:
         raise PlanningError(f"tick {dt!r} s must be finite and > 0")
     distance = np.abs(target - start)
     half = distance / 2.0
@@ -688,6 +735,11 @@ def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = 
     half_time = np.maximum(t_strut, t_hex[:, None])  # T_i,max
     if synchronous:
         half_time = np.broadcast_to(half_time.max(axis=-1, keepdims=True), half.shape)
+    longest = 2.0 * float(np.max(half_time, initial=0.0))
+    if longest / dt > MAX_TICKS:
+        raise PlanningError(f"tick {dt!r} s is too short: the longest move ({longest:.6g} s) "
+                            f"would take {longest / dt:.3g} ticks, more than the {MAX_TICKS:g} "
+                            f"a plan holds")
     profiles = solve_profiles(half, half_time, limits, method=method)
     n_ticks, n_accel, accel = realize_on_ticks(distance, 2.0 * np.asarray(half_time),
                                                synchronous, limits, dt)

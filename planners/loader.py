@@ -14,6 +14,8 @@ from scipy.spatial.transform import Rotation
 
 from models import SerialChainSpec, loader_spec
 from planners.bspline import CubicBSplineTrajectory
+from planners.errors import PlanningError
+from planners.trajectory import check_values
 
 #: Table 1 as printed: rows P2, M1, M2, M3, M4, P3; columns theta1 (mm), theta2..theta6 (deg).
 TABLE1 = np.array(
@@ -82,15 +84,22 @@ def forward_kinematics(q: np.ndarray, sites: list[str] | None = None, spec: Seri
       {site name: (..., 3) world position, m}.
     """
     spec = spec or loader_spec()
-    q = np.asarray(q, dtype=float)
+    try:
+        q = np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise PlanningError(f"q must be numbers, got {q!r}") from None
+    if q.ndim == 0:
+        raise PlanningError(f"q must be (..., {len(spec.joints)}) joint values, got a number")
     batch = q.shape[:-1]
     q = q.reshape(-1, q.shape[-1])
     if q.shape[1] != len(spec.joints):
-        raise ValueError(f"q has {q.shape[1]} joints, the chain has {len(spec.joints)}")
+        raise PlanningError(f"q has {q.shape[1]} joints, the chain has {len(spec.joints)}")
+    # Name the joint (and the row of a batch) of a NaN, inf or huge value.
+    check_values(q, lambda i: f"q of joint {spec.names[i[1]]}" + (f" in row {i[0]}" if batch else ""))
     wanted = list(spec.sites) if sites is None else list(sites)
     for name in wanted:
         if name not in spec.sites:
-            raise ValueError(f"unknown site {name!r}; chain sites: {', '.join(spec.sites)}")
+            raise PlanningError(f"unknown site {name!r}; chain sites: {', '.join(spec.sites)}")
     n = q.shape[0]
     rot = Rotation.concatenate([_scipy_quat(spec.base_quat)] * n)
     pos = np.broadcast_to(spec.base_pos, (n, 3)).copy()

@@ -86,6 +86,9 @@ planned on the limit. A pulse shorter than the resolution of the absolute break 
 (h < 8 eps T) is widened to that length with a lower peak and the same speed change.
 ``move_in_time``'s duration is exact to the last bit where the sum of the pieces allows it (the
 round-off of the sum is moved into the longest piece).
+Every number given (distances, speeds, limits, durations, accelerations, sample times) must be
+finite and within +/-``planners.trajectory.MAX_MAGNITUDE``, and so must a profile's break
+times, positions, velocities and jerks (a ``PlanningError`` names the value and the limit).
 """
 
 from __future__ import annotations
@@ -96,7 +99,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.errors import LimitError, PlanningError
-from planners.trajectory import TrajectorySample
+from planners.trajectory import TrajectorySample, check_values, fmt_number, sample_times
 
 __all__ = [
     "Profile",
@@ -158,9 +161,8 @@ class Profile:
         if accel.size != dt.size + 1:
             raise PlanningError(f"a profile of {dt.size} pieces needs {dt.size + 1} "
                                 f"accelerations, got {accel.size}")
-        if not (np.all(np.isfinite(dt)) and np.all(np.isfinite(accel))):
-            raise PlanningError(f"profile durations {dt} s / accelerations {accel} m/s^2 "
-                                f"contain a non-finite value")
+        check_values(dt, "profile durations", "s")
+        check_values(accel, "profile accel", "m/s^2")
         if np.any(dt <= 0):
             i = int(np.argmax(dt <= 0))
             raise PlanningError(f"profile piece durations must be > 0: durations[{i}] = "
@@ -172,6 +174,10 @@ class Profile:
         positions = p0 + np.concatenate(([0.0], np.cumsum(dp)))
         jerk = np.diff(accel) / dt
         breaks = np.concatenate(([0.0], np.cumsum(dt)))
+        # Derived values: within the same magnitude, so sampling (t * v ...) stays finite.
+        for name, value, unit in (("break time", breaks, "s"), ("position", positions, "m"),
+                                  ("velocity", velocities, "m/s"), ("jerk", jerk, "m/s^3")):
+            check_values(value, lambda i, name=name: f"profile {name} at break {i[0]}", unit)
         for name, value in (("durations", dt), ("accel", accel), ("breaks", breaks),
                             ("positions", positions), ("velocities", velocities),
                             ("jerk", jerk)):
@@ -258,10 +264,7 @@ class Profile:
         """
         if side not in ("left", "right"):
             raise PlanningError(f"side {side!r} is not 'left' or 'right'")
-        t = np.asarray(t, dtype=float)
-        if not np.all(np.isfinite(t)):
-            bad = t[~np.isfinite(t)].ravel()[0]
-            raise PlanningError(f"sample time {_fmt(bad)} s must be finite")
+        t = check_values(t, "sample time", "s")
         k = self.breaks.size - 1
         idx = np.searchsorted(self.breaks, t, side=side) - 1
         idx = np.clip(idx, 0, k)
@@ -282,10 +285,11 @@ class Profile:
         )
 
     def sample(self, t) -> TrajectorySample:
-        """The Trajectory protocol: t (n,) s -> (n, 1) position, velocity, acceleration."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        if t.ndim != 1:
-            raise PlanningError(f"sample times must be a 1-D array, got shape {t.shape}")
+        """The Trajectory protocol: t (n,) s -> (n, 1) position, velocity, acceleration.
+
+        ``t``: a number or a 1-D array of finite times (``planners.trajectory.sample_times``).
+        """
+        t = sample_times(t)
         s = self.evaluate(t)
         return TrajectorySample(t=t, position=s.position[:, None], velocity=s.velocity[:, None],
                                 acceleration=s.acceleration[:, None])
@@ -461,22 +465,16 @@ def move_in_time(distance: float, duration: float, v_max: float, a_max: float, v
 # --------------------------------------------------------------------------- helpers
 
 
-def _fmt(x) -> str:
-    """A number as Python writes a float (no ``np.float64(...)``); anything else by repr."""
-    try:
-        return repr(float(x))
-    except (TypeError, ValueError):
-        return repr(x)
+_fmt = fmt_number  # a number as Python writes a float (no ``np.float64(...)``)
 
 
 def _finite(name: str, value, unit: str) -> float:
+    """One finite number within +/-MAX_MAGNITUDE (``planners.trajectory.check_values``)."""
     try:
         x = float(value)
     except (TypeError, ValueError):
         raise PlanningError(f"{name} = {_fmt(value)} {unit} is not a number") from None
-    if not np.isfinite(x):
-        raise PlanningError(f"{name} = {_fmt(value)} {unit} must be finite")
-    return x
+    return float(check_values(x, name, unit))
 
 
 def _positive(name: str, value, unit: str) -> float:

@@ -4,14 +4,29 @@ A planner returns an object with a ``duration`` (s), ``labels`` (one name per ch
 joint or strut) and a vectorized ``sample(t)`` that returns positions, velocities and
 accelerations at an array of times. The runner samples the whole run once, at the control
 rate, so no Python runs per physics step.
+
+Input checks shared by the planners
+-----------------------------------
+Every number a planner takes from its caller must be finite and within +/-``MAX_MAGNITUDE``
+(1e150, in the value's SI unit). No joint, strut, pose, time or limit of a real machine comes
+near it, and it keeps products and squares of inputs and of the quantities planned from them
+representable: the largest double is 1.8e308, sqrt of it 1.3e154, so even a square of 1e4
+times an input stays finite (the B-spline's overshoot check solves quadratics in its
+coefficients). ``check_values`` raises a ``PlanningError`` naming the first entry that breaks
+this and the limit; ``sample_times`` validates the times of every ``Trajectory.sample``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol, Sequence, runtime_checkable
+from typing import Callable, Protocol, Sequence, runtime_checkable
 
 import numpy as np
+
+from planners.errors import PlanningError
+
+#: The largest magnitude a planner accepts for any input number (module docstring).
+MAX_MAGNITUDE = 1e150
 
 
 @dataclass(frozen=True)
@@ -42,6 +57,74 @@ class Trajectory(Protocol):
     def labels(self) -> Sequence[str]: ...
 
     def sample(self, t: np.ndarray | float) -> TrajectorySample: ...
+
+
+def fmt_number(x) -> str:
+    """A number as Python writes a float (``nan``, ``inf``, ``1e+308``, no ``np.float64``)."""
+    try:
+        return repr(float(x))
+    except (TypeError, ValueError):
+        return repr(x)
+
+
+def _as_float_array(values, what: str) -> np.ndarray:
+    try:
+        return np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        text = repr(values)
+        text = text if len(text) <= 60 else text[:57] + "..."
+        raise PlanningError(f"{what} must be numbers, got {text}") from None
+
+
+def check_values(values, name: str | Callable[[tuple[int, ...]], str],
+                 unit: str | Callable[[tuple[int, ...]], str] = "",
+                 max_abs: float = MAX_MAGNITUDE) -> np.ndarray:
+    """``values`` as a float array, after checking every entry is finite and |x| <= max_abs.
+
+    Args:
+      values: anything ``np.asarray(values, dtype=float)`` takes.
+      name: what the values are; a string (the entry's index is appended as ``[i, j]``) or a
+        function of the index tuple giving the entry's name (e.g. "key point 3 of joint q1").
+      unit: the values' SI unit, for the message (or a function of the index, for arrays
+        that mix units such as poses in m and rad).
+
+    Raises:
+      PlanningError naming the first offending entry, its value and the limit.
+    """
+    what = name if isinstance(name, str) else "values"
+    arr = _as_float_array(values, what)
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(arr) | (np.abs(arr) > max_abs)
+    if not bad.any():
+        return arr
+    index = tuple(int(i) for i in np.argwhere(bad)[0]) if arr.ndim else ()
+    value = float(arr[index])
+    if callable(name):
+        label = name(index)
+    else:
+        label = name + (f"[{', '.join(map(str, index))}]" if index else "")
+    unit = unit(index) if callable(unit) else unit
+    u = f" {unit}" if unit else ""
+    if not np.isfinite(value):
+        raise PlanningError(f"{label} = {fmt_number(value)}{u} is non-finite (NaN or inf); "
+                            f"planners take finite numbers within +/-{max_abs:g}{u}")
+    raise PlanningError(f"{label} = {fmt_number(value)}{u} is beyond +/-{max_abs:g}{u}, the "
+                        f"largest magnitude planners take")
+
+
+def sample_times(t) -> np.ndarray:
+    """The times ``t`` (s) of a ``Trajectory.sample`` as a (n,) float array, validated.
+
+    A number or a 1-D array (empty allowed); every time finite and within +/-MAX_MAGNITUDE.
+    Raises a PlanningError naming the offending time (``sample time t[i] = nan s ...``) or the
+    shape, before anything is computed from them (a NaN time used to index a segment raised an
+    IndexError deep in the sampling).
+    """
+    arr = np.atleast_1d(_as_float_array(t, "sample times"))
+    if arr.ndim != 1:
+        raise PlanningError(f"sample times must be a number or a 1-D array, got shape "
+                            f"{arr.shape}")
+    return check_values(arr, lambda i: f"sample time t[{i[0]}]", "s")
 
 
 def control_ticks(duration: float, control_dt: float) -> np.ndarray:
