@@ -21,6 +21,7 @@ servo's velocity feed-forward.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from collections import deque
@@ -35,10 +36,11 @@ from planners import antenna as ant
 from planners.errors import PlanningError
 from planners.geostationary import look_angles
 from planners.trajectory import TrajectorySample
+from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
-from sims.ship_motion import PaperShipMotion, SeaStateMotion, world_from_ship
+from sims.ship_motion import PaperShipMotion, SeaStateMotion, check_sea_state, world_from_ship
 
 CONTROL_DT = 0.005  # s: the runner's tick; the IMU rate is a whole number of ticks
 DECK_JOINTS = ("heave", "yaw", "pitch", "roll")
@@ -55,6 +57,14 @@ IMU_LATENCY_S = 0.020
 IMU_ATTITUDE_NOISE_DEG = 0.02  # 1 sigma per axis of the attitude error
 IMU_ATTITUDE_NOISE_TIME_S = 1.0  # correlation time of the attitude error
 IMU_GYRO_NOISE_DEG_S = 0.02  # 1 sigma per axis, white per sample
+#: Range of the IMU options the model means something for (assumptions, not data): at least
+#: 1 Hz (the paper's IMU updates 20-50 times a second; below 1 Hz the controller would hold
+#: each attitude for longer than an eighth of the paper's 8 s pitch period, no stabilizer),
+#: at most the 200 Hz control rate (one sample per tick); a latency of at most 1 s (a few to
+#: tens of ms for a marine AHRS; a second-old attitude is no longer a measurement of the
+#: motion, and the prediction extrapolates the gyro over the latency).
+IMU_RATE_MIN_HZ = 1.0
+IMU_LATENCY_MAX_S = 1.0
 
 #: Check limits (REFERENCE.md, "Ship antenna"; FCC ESV: transmit off within 100 ms above
 #: 0.5 deg; industry 0.2 deg peak, ~0.1 deg RMS; polarization within 1 deg).
@@ -228,6 +238,14 @@ class ImuModel:
         """(ticks per sample, latency in ticks); raises PlanningError if not whole numbers."""
         if not np.isfinite(self.rate_hz) or self.rate_hz <= 0:
             raise PlanningError(f"IMU rate {self.rate_hz!r} Hz must be > 0")
+        if self.rate_hz < IMU_RATE_MIN_HZ:
+            raise PlanningError(f"IMU rate {self.rate_hz:g} Hz is below {IMU_RATE_MIN_HZ:g} Hz, the "
+                                "slowest the controller models (the paper's IMU: 20-50 Hz)")
+        if not np.isfinite(self.latency_s):
+            raise PlanningError(f"IMU latency {self.latency_s!r} s must be finite")
+        if self.latency_s > IMU_LATENCY_MAX_S:
+            raise PlanningError(f"IMU latency {self.latency_s:g} s is above {IMU_LATENCY_MAX_S:g} s, "
+                                "the longest the controller models (a marine AHRS: a few to tens of ms)")
         period = 1.0 / (self.rate_hz * control_dt)
         latency = self.latency_s / control_dt
         if abs(period - round(period)) > 1e-9 or round(period) < 1:
@@ -587,9 +605,52 @@ class AntennaOptions:
     omega_method: str = "log"
 
 
+def log_bytes_per_tick(imu: ImuModel = ImuModel()) -> float:
+    """Bytes an antenna run preallocates per control tick: the runner's log of the compiled
+    model (4 planned joints); the deck drive's ship-motion reference (t and 3 x 4) and its
+    servo's set-points and feed-forward (4 + 4); the controller's per-update log (t, 4
+    angles, error, iterations, two flags) once per IMU sample; the ideal joint path every
+    REFERENCE_DT (t, 4 angles, error, iterations, two flags and its spline's 16
+    coefficients)."""
+    period, _ = imu.ticks(CONTROL_DT)
+    floats = (run_limits.runlog_floats_per_tick(_model(), 4) + 13 + 8 + (7 + 2 / 8) / period
+              + (7 + 2 / 8 + 16) * CONTROL_DT / REFERENCE_DT)
+    return run_limits.floats(floats)
+
+
+@functools.lru_cache(maxsize=1)
+def _model() -> mujoco.MjModel:
+    return models.load("antenna")
+
+
+def validate_paper_motion(options, antenna_options: AntennaOptions | None = None) -> None:
+    """Bad input of an antenna-paper-motion run as a ValueError subclass naming the value and
+    the limit, before anything is built: the IMU (``ImuModel.ticks``) and the duration (at
+    least one control tick, its log within the memory limit)."""
+    imu = _antenna_options(options, antenna_options).imu
+    duration = PAPER_DURATION_S if options.duration is None else options.duration
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(imu))
+
+
+def validate_sea_state(options, antenna_options: AntennaOptions | None = None) -> None:
+    """As ``validate_paper_motion`` for antenna-sea-state, and the sea state: Hs and Tp in
+    their ranges and no steeper than waves can be (``sims.ship_motion.check_sea_state``), the
+    wave heading within +-360 deg (``sims.run_limits.check_angle``)."""
+    hs = SEA_HS_M if options.hs is None else options.hs
+    tp = SEA_TP_S if options.tp is None else options.tp
+    check_sea_state(hs, tp)
+    if options.heading is not None:
+        run_limits.check_angle("wave heading", options.heading)
+    imu = _antenna_options(options, antenna_options).imu
+    duration = SEA_DURATION_S if options.duration is None else options.duration
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(imu))
+
+
 def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_max_deg,
            rms_limit_deg, description, antenna_options: AntennaOptions,
            video_length_s: float = 60.0) -> Setup:
+    # The ideal path below is proportional to the duration: check it first.
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(antenna_options.imu))
     physics = AntennaPhysics.load()
     satellite = ant.satellite_attitude(azimuth, elevation, polarization)
     theta0 = start_angles(motion, satellite, azimuth, elevation, polarization)
@@ -647,6 +708,7 @@ def _antenna_options(options, antenna_options: AntennaOptions | None) -> Antenna
 
 def build_paper_motion(options, antenna_options: AntennaOptions | None = None) -> Setup:
     """The paper's section 5.1: eq. (15)-(16) ship motion, satellite at 223.49/60/-28.8 deg."""
+    validate_paper_motion(options, antenna_options)
     az, el, pol = np.radians(ant.PAPER_SATELLITE_DEG)
     duration = PAPER_DURATION_S if options.duration is None else options.duration
     description = {"ship_motion": "paper eq. (15)-(16)",
@@ -658,11 +720,16 @@ def build_paper_motion(options, antenna_options: AntennaOptions | None = None) -
 
 
 def sea_state_motion(hs: float, tp: float, heading_deg: float, seed: int) -> SeaStateMotion:
+    """The scenario's sea: a ShipMotionError unless (hs, tp) is a sea state the spectrum and
+    the RAOs describe (``check_sea_state``) and the heading is within +-360 deg."""
+    hs, tp = check_sea_state(hs, tp)
+    run_limits.check_angle("wave heading", heading_deg)
     return SeaStateMotion(hs, tp, heading_deg, np.random.default_rng([seed, 0x5EA]))
 
 
 def build_sea_state(options, antenna_options: AntennaOptions | None = None) -> Setup:
     """A JONSWAP sea state; the satellite named by its orbital slot and the ship's position."""
+    validate_sea_state(options, antenna_options)
     hs = SEA_HS_M if options.hs is None else options.hs
     tp = SEA_TP_S if options.tp is None else options.tp
     heading = SEA_HEADING_DEG if options.heading is None else options.heading

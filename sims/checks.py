@@ -5,14 +5,22 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+#: How the note of a check that could not be evaluated begins.
+NOT_EVALUATED = "not evaluated"
+
 
 @dataclass(frozen=True)
 class Check:
     """One pass/fail check of a run.
 
     ``comparison`` says how ``value`` must relate to ``limit``: "<=", "<", ">=", ">" or "==".
-    A NaN value always fails (a quantity that could not be measured has not been shown to
-    hold).
+
+    A check that cannot be evaluated (the run ended before the quantity exists: a settling
+    window never reached, say) has the value NaN and fails: a quantity that could not be
+    measured has not been shown to hold. Its note says why, and begins with
+    ``NOT_EVALUATED``; build it with ``Check.not_evaluated``. A NaN value given without a
+    reason gets a note that says so. summary.json (``to_json``) writes its value as null,
+    never NaN (which is not JSON).
     """
 
     name: str
@@ -21,6 +29,22 @@ class Check:
     unit: str
     comparison: str = "<="
     note: str = ""
+
+    def __post_init__(self):
+        if not self.evaluated and not self.note.startswith(NOT_EVALUATED):
+            reason = self.note or "its value is NaN and the evaluation gave no reason"
+            object.__setattr__(self, "note", f"{NOT_EVALUATED}: {reason}")
+
+    @classmethod
+    def not_evaluated(cls, name: str, limit: float, unit: str, comparison: str = "<=",
+                      reason: str = "") -> "Check":
+        """A failed check whose value could not be measured, with the reason why."""
+        return cls(name, float("nan"), limit, unit, comparison, note=reason)
+
+    @property
+    def evaluated(self) -> bool:
+        """False when the value could not be measured (NaN)."""
+        return not math.isnan(float(self.value))
 
     @property
     def passed(self) -> bool:
@@ -36,8 +60,10 @@ class Check:
         }[self.comparison]
 
     def to_json(self) -> dict:
+        """The check as summary.json holds it: a value that could not be evaluated is null
+        (its note says why), an infinite one the string "inf" or "-inf"; never NaN."""
         out = asdict(self)
-        out["value"] = _json_float(self.value)
+        out["value"] = _json_float(self.value) if self.evaluated else None
         out["limit"] = _json_float(self.limit)
         out["passed"] = self.passed
         if not self.note:
@@ -47,6 +73,8 @@ class Check:
 
 def _json_float(x: float):
     x = float(x)
+    if math.isnan(x):
+        return None
     return x if math.isfinite(x) else str(x)
 
 

@@ -19,6 +19,7 @@ import argparse
 import contextlib
 import math
 import os
+import re
 import signal
 import sys
 import threading
@@ -34,6 +35,13 @@ class BadInput(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # argparse takes "-1e3" for an option (its pattern knows only -12 and -1.5), so
+        # "--heading -1e3" said "expected one argument" instead of reading the number.
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-inf$|^-nan$",
+                                                   re.IGNORECASE)
+
     def error(self, message):  # one line, exit 2, no usage dump
         raise BadInput(message)
 
@@ -66,13 +74,63 @@ def _seed(text: str) -> int:
 
 
 def _cable_segments(text: str) -> int:
+    """2 ... the model's limit (sims.fast_physics.max_cable_segments: 14 at the 2 ms step)."""
+    from sims.fast_physics import SEGMENT_OMEGA_DT_LIMIT, max_cable_segments
+
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"cable segments {text!r} is not an integer") from None
-    if not 2 <= value <= 50:
-        raise argparse.ArgumentTypeError(f"cable segments {value} must be in [2, 50]")
+    most = max_cable_segments()
+    if not 2 <= value <= most:
+        raise argparse.ArgumentTypeError(
+            f"cable segments {value} must be in [2, {most}]: more segments vibrate beyond the "
+            f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most {most} segments")
     return value
+
+
+def _checked(kind: str, check, minimum: float | None = None, strict: bool = False):
+    """A finite number (``_finite``), then ``check(value)`` of the Python API, whose
+    ValueError (naming the value, the limit and its source) becomes the parse error: the
+    CLI and the API refuse the same values with the same words."""
+    number = _finite(kind, minimum, strict)
+
+    def parse(text: str) -> float:
+        value = number(text)
+        try:
+            check(value)
+        except ValueError as e:
+            raise argparse.ArgumentTypeError(str(e)) from None
+        return value
+
+    return parse
+
+
+def _wind_speed(value: float) -> None:
+    from sims.wind import check_mean_speed
+
+    check_mean_speed(value)
+
+
+def _wave_height(value: float) -> None:
+    from sims.ship_motion import check_wave_height
+
+    check_wave_height(value)
+
+
+def _peak_period(value: float) -> None:
+    from sims.ship_motion import check_peak_period
+
+    check_peak_period(value)
+
+
+def _angle(kind: str):
+    def check(value: float) -> None:
+        from sims.run_limits import check_angle
+
+        check_angle(kind, value)
+
+    return check
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -84,29 +142,36 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", help="output directory (default results/NAME); replaced only if "
                      "planbench wrote it")
     run.add_argument("--seed", type=_seed, default=0)
-    run.add_argument("--wind", type=_finite("wind speed", 0.0), help="mean wind, m/s")
+    run.add_argument("--wind", type=_checked("wind speed", _wind_speed, 0.0),
+                     help="mean wind, m/s (0 ... 50: IEC 61400-1 class I, the Kaimal model's range)")
     run.add_argument("--elevation", type=_finite("elevation"),
                      help="telescope elevation, deg (hexapod scenarios: 15 ... 90)")
-    run.add_argument("--hs", type=_finite("significant wave height", 0.0, strict=True),
-                     help="significant wave height, m (sea-state scenarios)")
-    run.add_argument("--tp", type=_finite("peak period", 0.0, strict=True),
-                     help="spectral peak period, s (sea-state scenarios)")
-    run.add_argument("--heading", type=_finite("wave heading"),
-                     help="wave heading off the bow, deg: 180 head seas, 90 beam seas from starboard (sea-state scenarios)")
+    run.add_argument("--hs", type=_checked("significant wave height", _wave_height, 0.0, strict=True),
+                     help="significant wave height, m (sea-state scenarios; 0 < Hs <= 20, and no steeper "
+                          "than 2 pi Hs / (g Tp^2) = 1/15 at Tp <= 8 s ... 1/25 at Tp >= 15 s, DNV-RP-C205)")
+    run.add_argument("--tp", type=_checked("peak period", _peak_period, 0.0, strict=True),
+                     help="spectral peak period, s (sea-state scenarios; 1 ... 30, wind seas and swell)")
+    run.add_argument("--heading", type=_checked("wave heading", _angle("wave heading")),
+                     help="wave heading off the bow, deg: 180 head seas, 90 beam seas from starboard "
+                          "(sea-state scenarios; -360 ... 360, refused beyond, not wrapped)")
     run.add_argument("--imu-rate", type=_finite("IMU rate", 0.0, strict=True),
-                     help="antenna IMU samples per second, Hz (200 / a whole number: 20, 25, 40, 50)")
+                     help="antenna IMU samples per second, Hz (200 / a whole number, 1 ... 200: "
+                          "20, 25, 40, 50 are the paper's range)")
     run.add_argument("--imu-latency", type=_finite("IMU latency", 0.0),
-                     help="antenna IMU latency, s (a multiple of 5 ms)")
+                     help="antenna IMU latency, s (a multiple of 5 ms, at most 1 s)")
     run.add_argument("--no-prediction", action="store_true",
                      help="antenna controller: use each IMU sample as it is, no gyro prediction")
-    run.add_argument("--wind-direction", type=_finite("wind direction"),
-                     help="azimuth the wind blows toward, deg from east toward north (FAST scenarios; default 0)")
+    run.add_argument("--wind-direction", type=_checked("wind direction", _angle("wind direction")),
+                     help="azimuth the wind blows toward, deg from east toward north (FAST scenarios; "
+                          "default 0; -360 ... 360, refused beyond, not wrapped)")
     run.add_argument("--cable-segments", type=_cable_segments,
-                     help="FAST: each cable as a chain of N elastic segments (2-50; default: straight "
-                          "cables with the lumped catenary law)")
+                     help="FAST: each cable as a chain of N elastic segments (2-14 at the 2 ms timestep; "
+                          "default: straight cables with the lumped catenary law)")
     run.add_argument("--stewart", choices=("on", "off"),
                      help="FAST's Stewart stabilizer: on (default) or off (FAST scenarios)")
-    run.add_argument("--duration", type=_finite("duration", 0.0, strict=True), help="simulated time, s")
+    run.add_argument("--duration", type=_finite("duration", 0.0, strict=True),
+                     help="simulated time, s (at least one control tick; refused if its log would "
+                          "take more than a quarter of this machine's memory)")
     run.add_argument("--video", help="write an H.264 video of the run here (.mp4, .m4v, .mov, .mkv)")
     run.add_argument("--camera", default=None, help="video camera: overview or closeup")
     run.add_argument("--quiet", action="store_true", help="no progress bars")
@@ -141,12 +206,19 @@ def _options(scenario, args):
         raise BadInput(f"scenario {scenario.name} has no cables; --cable-segments is not accepted")
     if args.stewart is not None and "stewart" not in scenario.options:
         raise BadInput(f"scenario {scenario.name} has no Stewart stabilizer; --stewart is not accepted")
-    return RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
-                      elevation=args.elevation, hs=args.hs, tp=args.tp, heading=args.heading,
-                      imu_rate=args.imu_rate, imu_latency=args.imu_latency,
-                      predict=not args.no_prediction,
-                      stewart=None if args.stewart is None else args.stewart == "on",
-                      wind_direction=args.wind_direction, cable_segments=args.cable_segments)
+    options = RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
+                         elevation=args.elevation, hs=args.hs, tp=args.tp, heading=args.heading,
+                         imu_rate=args.imu_rate, imu_latency=args.imu_latency,
+                         predict=not args.no_prediction,
+                         stewart=None if args.stewart is None else args.stewart == "on",
+                         wind_direction=args.wind_direction, cable_segments=args.cable_segments)
+    # Valid numbers that are not a run (a duration under one tick or too long for memory, a
+    # sea no sea has, ...): the scenario's own checks, the ones its build makes again.
+    try:
+        scenario.validate(options)
+    except ValueError as e:
+        raise BadInput(str(e)) from None
+    return options
 
 
 def cmd_list(args) -> int:
@@ -163,10 +235,11 @@ def format_checks(rows) -> str:
     width = max([len("scenario")] + [len(scenario) for scenario, _ in rows])
     lines = [f"{'scenario':<{width}} {'check':<22} {'value':>12} {'limit':>10} {'unit':<6} result"]
     for scenario, c in rows:
-        lines.append(
-            f"{scenario:<{width}} {c.name:<22} {c.value:>12.5g} {c.comparison:>2}{c.limit:>8.4g} "
-            f"{c.unit:<6} {'pass' if c.passed else 'FAIL'}"
-        )
+        # A check that could not be evaluated shows "n/a" and its reason, not "nan".
+        value = f"{c.value:>12.5g}" if c.evaluated else f"{'n/a':>12}"
+        line = (f"{scenario:<{width}} {c.name:<22} {value} {c.comparison:>2}{c.limit:>8.4g} "
+                f"{c.unit:<6} {'pass' if c.passed else 'FAIL'}")
+        lines.append(line if c.evaluated else f"{line} ({c.note})")
     return "\n".join(lines)
 
 

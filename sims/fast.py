@@ -33,11 +33,14 @@ import numpy as np
 from planners import fast
 from planners import fast_plan as fp
 from planners import fast_sky as sky
+from planners.errors import LimitError
+from sims import run_limits
 from sims.checks import Check
 from sims.controllers import demanded_force
-from sims.fast_physics import (CONTROL_DT, CableLoads, ChainCableLoads, ControllerOptions, FastController,
-                               FastPhysics)
+from sims.fast_physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
+                               FastController, FastPhysics, _compiled, max_cable_segments)
 from sims.runner import RunLog, Setup
+from sims.wind import check_mean_speed
 
 #: Calibrators (J2000, NED): 3C 286 13h31m08.29s +30d30m33.0s; 3C 295 14h11m20.5s +52d12m21s.
 SOURCES = {
@@ -384,6 +387,53 @@ class FastEvaluation:
         fast_report(self.timeseries(log), log.t, checks, path, fast.FAST_LIMITS.tension_min)
 
 
+#: Doubles per tick that a FAST run preallocates besides the runner's log: the plan's state at
+#: every tick (FastPlanSample less its t: segment, feed, its velocity and acceleration, axis,
+#: 7 angles, cabin rotation, A-B point, cabin origin, cable lengths, tensions, Stewart legs:
+#: 1 + 3 * 4 + 7 + 9 + 3 + 3 + 6 * 3 = 53); the controller's winch feed-forward (6), platform
+#: rotation and position (9 + 3), true cabin pose (3 + 9), the noise of its two measurements
+#: (2 x (3 + 9)), cable-length feedback and Stewart command (6 + 6), A-B reference and
+#: set-point (2 + 2): 70; the plant's wind speed, wind force and catenary tensions (1 + 3 + 6).
+PER_TICK_FLOATS = 53 + 70 + 10
+
+
+def log_bytes_per_tick(cable_segments: int = 0) -> float:
+    """Bytes a FAST run preallocates per control tick: the runner's log of the compiled model
+    (13 planned channels; the discretized cables add their nodes' joints) and
+    PER_TICK_FLOATS."""
+    return run_limits.floats(run_limits.runlog_floats_per_tick(_compiled(cable_segments), len(fp.PLAN_LABELS))
+                             + PER_TICK_FLOATS)
+
+
+def check_cable_segments(segments) -> int:
+    """``segments`` if it is 0 (the lumped cables) or a whole number in [2, max_cable_segments()],
+    else a LimitError naming the value and the limit."""
+    most = max_cable_segments()
+    if isinstance(segments, bool) or not isinstance(segments, (int, np.integer)) \
+            or not (segments == 0 or 2 <= segments <= most):
+        raise LimitError(f"cable segments {segments!r} must be 0 (lumped cables) or a whole number in "
+                         f"[2, {most}] (the timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g} on the "
+                         "segments' axial mode)")
+    return int(segments)
+
+
+def validate(options, default_duration: float | None = None) -> None:
+    """Bad input of a FAST run as a ValueError subclass naming the value and the limit, before
+    anything is built: the mean wind (sims.wind.check_mean_speed), the wind direction (within
+    +-360 deg), the cable segments (``check_cable_segments``) and the duration (at least one
+    control tick, its log within the memory limit; ``default_duration`` when
+    ``options.duration`` is None, unchecked if both are None)."""
+    if options.wind is not None:
+        check_mean_speed(options.wind)
+    direction = getattr(options, "wind_direction", None)
+    if direction is not None:
+        run_limits.check_angle("wind direction", direction)
+    segments = check_cable_segments(getattr(options, "cable_segments", None) or 0)
+    duration = options.duration if options.duration is not None else default_duration
+    if duration is not None:
+        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
+
+
 def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | None = None,
           cable_segments: int | None = None) -> Setup:
     """A run of ``plan``: the physics at the plan's first pose (at rest, in equilibrium), the
@@ -393,6 +443,9 @@ def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | No
     ``options.cable_segments``."""
     if cable_segments is None:
         cable_segments = getattr(options, "cable_segments", None) or 0
+    duration = plan.duration if options.duration is None else options.duration
+    validate(options, duration)
+    check_cable_segments(cable_segments)
     physics = FastPhysics.load(cable_segments)
     s0 = plan.state(np.array([0.0]))
     physics.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
@@ -406,7 +459,6 @@ def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | No
     loads = (ChainCableLoads if cable_segments else CableLoads)(
         wind, WIND_AZIMUTH_DEG if direction is None else direction)
     evaluation = FastEvaluation(physics, plan, controller, loads)
-    duration = plan.duration if options.duration is None else options.duration
     return Setup(physics=physics, trajectory=plan, controller=controller, control_dt=CONTROL_DT,
                  duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
                  report=evaluation.report, disturbance=loads, video_speed=1.0, seed=options.seed,

@@ -45,7 +45,7 @@ from planners.errors import LimitError
 from planners.legs import leg_lengths, structure_matrix
 from planners.rotations import rot_y, rot_z, skew, vee, wxyz
 from planners.trajectory import TrajectorySample
-from sims.wind import AIR_DENSITY, wind_speed_series
+from sims.wind import AIR_DENSITY, check_mean_speed, wind_speed_series
 
 CONTROL_DT = 0.01  # s: the runner's tick, the Stewart stabilizer's 100 Hz
 
@@ -142,6 +142,32 @@ def cable_drag_force(wind: np.ndarray, vectors: np.ndarray, lengths) -> np.ndarr
 #: cables' internal friction and the still air's drag are not known better.
 NODE_DAMPING_RATIO = 0.005
 STRING_MODE_HZ = 0.2
+
+
+#: Stability of the discretized cables' explicit springs: a segment's axial mode omega
+#: (2 sqrt(EA / mu) / l rad/s) must keep omega dt <= this at the model's timestep dt (20
+#: segments at 1.0 diverge).
+SEGMENT_OMEGA_DT_LIMIT = 0.7
+
+
+def max_cable_segments(shortest_cable_m: float | None = None, timestep: float | None = None) -> int:
+    """The most segments a discretized cable may have: its segments' axial mode
+    omega = 2 sqrt(EA / mu) n / L must keep omega dt <= SEGMENT_OMEGA_DT_LIMIT.
+
+    Args:
+      shortest_cable_m: the shortest cable's unstretched length L, m; default the winches' L0
+        at the model's home keyframe (what ``discretized_spec`` divides). A run checks its
+        own cables at its start (``ChainCableLoads.reset``).
+      timestep: the physics timestep dt, s; default the model's.
+    """
+    if shortest_cable_m is None or timestep is None:
+        model = _compiled(0)
+        if shortest_cable_m is None:
+            shortest_cable_m = float(np.min(model.key("home").ctrl[:len(CABLE_ACTUATORS)]))
+        if timestep is None:
+            timestep = float(model.opt.timestep)
+    wave = 2.0 * math.sqrt(CABLE_EA / fast.FAST.cable_mass_per_length)  # omega l, m/s
+    return int(math.floor(SEGMENT_OMEGA_DT_LIMIT * shortest_cable_m / (wave * timestep) + 1e-9))
 
 
 @functools.lru_cache(maxsize=4)
@@ -448,9 +474,7 @@ class CableLoads:
     """
 
     def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal"):
-        if not np.isfinite(wind_speed) or wind_speed < 0:
-            raise ValueError(f"mean wind speed {wind_speed!r} m/s must be finite and >= 0")
-        self.mean_speed = float(wind_speed)
+        self.mean_speed = check_mean_speed(wind_speed)
         az = math.radians(wind_azimuth_deg)
         self.direction = np.array([math.cos(az), math.sin(az), 0.0])
         self.spectrum = spectrum
@@ -552,14 +576,14 @@ class ChainCableLoads(CableLoads):
         model, data = physics.model.ptr, physics.data.ptr
         rest = data.ctrl[physics.cable_ids] / n
         # A segment's axial mode, 2 sqrt(EA / mu) / l rad/s, must stay slow for the timestep
-        # (the springs are explicit): omega dt <= 0.7 (20 segments at 1.0 diverge).
-        wave = 2.0 * math.sqrt(CABLE_EA / fast.FAST.cable_mass_per_length)  # omega l, m/s
-        omega = wave / rest.min()
-        if omega * model.opt.timestep > 0.7:
+        # (the springs are explicit): ``max_cable_segments`` at this run's cables.
+        most = max_cable_segments(float(rest.min()) * n, float(model.opt.timestep))
+        if n > most:
+            omega = 2.0 * math.sqrt(CABLE_EA / fast.FAST.cable_mass_per_length) / rest.min()
             raise LimitError(f"cable segments {n}: the shortest segment ({rest.min():.1f} m) vibrates at "
                              f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
-                             f"timestep's limit omega dt <= 0.7; use at most "
-                             f"{int(0.7 * rest.min() * n / (wave * model.opt.timestep))} segments")
+                             f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most "
+                             f"{most} segments")
         mass = np.broadcast_to((fast.FAST.cable_mass_per_length * rest)[:, None], self._nodes.shape)
         model.body_mass[self._nodes] = mass
         dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)

@@ -27,10 +27,11 @@ from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
 from planners.rotations import wxyz
 from planners.trajectory import TrajectorySample
+from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
-from sims.wind import BodyWindDrag
+from sims.wind import BodyWindDrag, check_mean_speed
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
 SETTLE_S = 1.0  # s simulated after the move: the integral action settles in ~0.5 s
@@ -387,16 +388,27 @@ class HexapodEvaluation:
         v_cmd = np.abs(ref.velocity).max()
         a_cmd = np.abs(ref.acceleration).max()
         checks = []
+        # Arrivals exist only if the run saw the whole commanded motion, i.e. its reference
+        # rests at the last tick (a short run's last tick would pass for every strut's
+        # arrival); the settling window only comes after them.
+        arrived = not np.any(ref.velocity[-1] != 0.0)
+        short = (f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion "
+                 f"(planned to t = {float(self.move.duration):.3f} s) came to rest")
         if self.synchronous:
             checks.append(Check("arrival_spread", spread, ARRIVAL_SPREAD_LIMIT_S, "s",
-                                note="last minus first strut arrival of the commanded motion"))
+                                note="last minus first strut arrival of the commanded motion")
+                          if arrived else
+                          Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=short))
         else:
             own = 2.0 * np.asarray(self.move.profiles.half_time)
             late = float(np.abs(arrivals - own)[moving].max()) if moving.any() else 0.0
             checks.append(Check("arrival_vs_own_time", late, 2 * CONTROL_DT, "s",
                                 note=f"each strut ends within two ticks of its own time 2 T_i; "
-                                     f"arrival spread {spread:.3f} s"))
-        ended = log.t[-1] >= move_end + SETTLE_S - 1e-9
+                                     f"arrival spread {spread:.3f} s")
+                          if arrived else
+                          Check.not_evaluated("arrival_vs_own_time", 2 * CONTROL_DT, "s", reason=short))
+        ended = arrived and log.t[-1] >= move_end + SETTLE_S - 1e-9
+        settled_at = (move_end if arrived else float(self.move.duration)) + SETTLE_S
         checks += [
             Check("strut_velocity", 1e6 * v_cmd, 1e6 * limits.strut_speed, "um/s",
                   note="commanded; measured peak "
@@ -405,10 +417,12 @@ class HexapodEvaluation:
                   note="commanded by the generator, per tick"),
             Check("following_error", float(following), FOLLOWING_LIMIT_UM, "um",
                   note=f"encoder minus reference, t <= {move_end:.3f} s"),
-            Check("pose_error_final", float(pose_err[window].max()) if ended else float("nan"),
-                  POSE_FINAL_LIMIT_UM, "um",
-                  note=f"largest mirror-side pivot displacement over the last {SETTLE_WINDOW_S} s"
-                  if ended else f"the run ended before the move plus {SETTLE_S} s of settling"),
+            Check("pose_error_final", float(pose_err[window].max()), POSE_FINAL_LIMIT_UM, "um",
+                  note=f"largest mirror-side pivot displacement over the last {SETTLE_WINDOW_S} s")
+            if ended else
+            Check.not_evaluated("pose_error_final", POSE_FINAL_LIMIT_UM, "um",
+                                reason=f"the run ended at t = {log.t[-1]:.3f} s, before the move plus "
+                                       f"{SETTLE_S:g} s of settling (t = {settled_at:.3f} s)"),
             Check("strut_force", float(force), float(p.force_limit.min()), "N",
                   note=f"demanded, peak on {STRUT_LABELS[int(np.argmax(np.abs(demanded).max(0)))]}"),
             Check("stroke", 1e3 * float(stroke), 1e3 * limits.stroke, "mm"),
@@ -489,10 +503,34 @@ def plan(synchronous: bool):
     return hexapod_planner.plan_move(np.zeros(6), target, synchronous=synchronous)
 
 
+def log_bytes_per_tick(wind: bool = True) -> float:
+    """Bytes a hexapod run preallocates per control tick: the runner's log of the compiled
+    model (6 planned struts), the controller's set-points and feed-forward forces (6 + 6
+    doubles) and, with wind, its speed and force (1 + 3)."""
+    model = _compiled(DEFAULT_ELEVATION_DEG)  # every elevation has the same sizes
+    return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6 + (4 if wind else 0))
+
+
+def validate(options, default_duration: float | None = None) -> None:
+    """Bad input of a hexapod run as a ValueError subclass naming the value and the limit,
+    before anything is built: the elevation (ELEVATION_RANGE_DEG), the mean wind
+    (sims.wind.check_mean_speed) and the duration (at least one control tick, its log within
+    the memory limit; ``default_duration`` when ``options.duration`` is None, unchecked if
+    both are None)."""
+    if options.elevation is not None:
+        check_elevation(options.elevation)
+    wind = DEFAULT_WIND_M_S if options.wind is None else check_mean_speed(options.wind)
+    duration = options.duration if options.duration is not None else default_duration
+    if duration is not None:
+        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(wind > 0))
+
+
 def _setup(synchronous: bool, options, controller=None) -> Setup:
+    move = plan(synchronous)
+    duration = options.duration if options.duration is not None else move.duration + SETTLE_S
+    validate(options, duration)
     elevation = DEFAULT_ELEVATION_DEG if options.elevation is None else options.elevation
     physics = HexapodPhysics.load(elevation)
-    move = plan(synchronous)
     physics.set_pose(move.start_pose)
     wind_speed = DEFAULT_WIND_M_S if options.wind is None else options.wind
     wind = None
@@ -500,7 +538,6 @@ def _setup(synchronous: bool, options, controller=None) -> Setup:
         wind = BodyWindDrag("camera", wind_speed, camera_area(physics), CAMERA_DRAG_COEFFICIENT,
                             WIND_AZIMUTH_DEG)
     evaluation = HexapodEvaluation(physics, move, synchronous, wind)
-    duration = options.duration if options.duration is not None else move.duration + SETTLE_S
     return Setup(
         physics=physics,
         trajectory=move,

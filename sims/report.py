@@ -43,8 +43,10 @@ def plan_plot(sample, labels, kinds, path, title: str, key_times=None, key_point
 
 
 def checks_text(checks) -> str:
+    """One line per check; one that could not be evaluated reads "not evaluated", not nan."""
     return "\n".join(
-        f"{'PASS' if c.passed else 'FAIL'} {c.name}: {c.value:.4g} {c.unit} ({c.comparison} {c.limit:g})"
+        f"{'PASS' if c.passed else 'FAIL'} {c.name}: "
+        f"{f'{c.value:.4g} {c.unit}' if c.evaluated else 'not evaluated'} ({c.comparison} {c.limit:g})"
         for c in checks
     )
 

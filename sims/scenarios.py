@@ -59,6 +59,12 @@ class Scenario:
       plan_extras: optional (plan, out_dir) -> None, more files for ``planbench plan`` (the
         antenna's comparison of the paper's methods, FAST's figures).
       demo_cameras: cameras of further videos that ``planbench demo`` renders (NAME-CAMERA.mp4).
+      control_dt: the control period, s (one tick: the shortest run).
+      validate: (RunOptions) -> None, raises a ValueError subclass naming the value and the
+        limit for options that are valid numbers but not a run (a duration under one tick or
+        whose log would not fit in memory, a sea state no sea has, an angle beyond a turn...).
+        Cheap: nothing is built. ``planbench run`` calls it while it reads its options, and
+        ``build`` calls it again (the Python API).
     """
 
     name: str
@@ -71,11 +77,16 @@ class Scenario:
     kinds: Callable = lambda: ()
     plan_extras: Callable | None = None
     demo_cameras: tuple = ()
+    control_dt: float | None = None
+    validate: Callable = lambda options: None
 
 
 #: What the FAST runs share: options, plan plots and the paper's figures.
 FAST_RUN = dict(options=frozenset({"wind", "wind_direction", "stewart", "cables"}), kinds=fast.plan_kinds,
-                plan_extras=fast.write_figures)
+                plan_extras=fast.write_figures, control_dt=fast.CONTROL_DT, validate=fast.validate)
+LOADER_RUN = dict(kinds=loader.joint_kinds, control_dt=loader.CONTROL_DT, validate=loader.validate)
+HEXAPOD_RUN = dict(options=frozenset({"wind", "elevation"}), kinds=hexapod.strut_kinds,
+                   control_dt=hexapod.CONTROL_DT, validate=hexapod.validate)
 
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
@@ -85,7 +96,7 @@ SCENARIOS: dict[str, Scenario] = {
             "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the breechblock and seat ring",
             loader.build_supply,
             lambda: loader.loader_planner.supply_plan(),
-            kinds=loader.joint_kinds,
+            **LOADER_RUN,
         ),
         Scenario(
             "loader-direct",
@@ -93,23 +104,21 @@ SCENARIOS: dict[str, Scenario] = {
             loader.build_direct,
             lambda: loader.loader_planner.direct_plan(),
             expect_pass=False,
-            kinds=loader.joint_kinds,
+            **LOADER_RUN,
         ),
         Scenario(
             "hexapod-sync-move",
             "Rubin camera hexapod, 3 t camera: synchronous move of ~2 mm and 0.1 deg, all six struts arrive on one tick (--elevation, --wind)",
             hexapod.build_sync,
             lambda: hexapod.plan(True),
-            options=frozenset({"wind", "elevation"}),
-            kinds=hexapod.strut_kinds,
+            **HEXAPOD_RUN,
         ),
         Scenario(
             "hexapod-async-move",
             "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at its own minimum time (--elevation, --wind)",
             hexapod.build_async,
             lambda: hexapod.plan(False),
-            options=frozenset({"wind", "elevation"}),
-            kinds=hexapod.strut_kinds,
+            **HEXAPOD_RUN,
         ),
         Scenario(
             "antenna-paper-motion",
@@ -119,6 +128,8 @@ SCENARIOS: dict[str, Scenario] = {
             options=frozenset({"imu"}),
             kinds=antenna.joint_kinds,
             plan_extras=antenna.write_method_comparison,
+            control_dt=antenna.CONTROL_DT,
+            validate=antenna.validate_paper_motion,
         ),
         Scenario(
             "antenna-sea-state",
@@ -127,6 +138,8 @@ SCENARIOS: dict[str, Scenario] = {
             antenna.plan_sea_state,
             options=frozenset({"hs", "tp", "heading", "imu"}),
             kinds=antenna.joint_kinds,
+            control_dt=antenna.CONTROL_DT,
+            validate=antenna.validate_sea_state,
         ),
         Scenario(
             "fast-tracking",

@@ -50,6 +50,69 @@ class ShipMotionError(PlanningError):
     """Bad input to a ship motion: a sea state, vessel parameter or sample time out of range."""
 
 
+# --------------------------------------------------------------------------------------------
+# The sea states a run accepts (``check_sea_state``; the antenna-sea-state scenario and the
+# CLI's --hs, --tp). ``SeaStateMotion`` itself, a sum of waves, takes any Hs, Tp > 0 (the
+# tests drive it with a 60 s swell to see the RAOs' long-wave limits).
+
+#: Peak period range, s: Munk (1950), "Origin and generation of waves" (Proc. 1st Conf.
+#: Coastal Engineering), the band of ordinary gravity waves, 1-30 s, which holds wind seas
+#: and swell. Longer periods are infragravity waves and tides, shorter ones capillary-gravity
+#: ripples: neither is a sea state that a JONSWAP spectrum describes or that moves a ship.
+SEA_TP_RANGE_S = (1.0, 30.0)
+#: Largest significant wave height, m: above any measured. The WMO's record is 19.0 m (buoy
+#: K5, North Atlantic, 4 February 2013; WMO Weather and Climate Extremes Archive, 2016).
+SEA_HS_MAX_M = 20.0
+#: Limiting sea-state steepness Sp = 2 pi Hs / (g Tp^2) (DNV-RP-C205, 2010, section 3.5,
+#: "wave steepness"): 1/15 for Tp <= 8 s, 1/25 for Tp >= 15 s, linear in between; steeper
+#: seas break. The RAOs are linear (Jensen, Mansour & Olsen 2004: small steepness) and for
+#: deep water (depth > g Tp^2 / (4 pi), 700 m at 30 s: the open ocean). DNV-RP-C205 3.5.5.1
+#: adds that JONSWAP is a reasonable model for 3.6 < Tp / sqrt(Hs) < 5 and "should be used
+#: with caution" outside: a caution, not refused here.
+SEA_STEEPNESS_LIMIT = ((8.0, 1.0 / 15.0), (15.0, 1.0 / 25.0))
+
+
+def steepness_limit(tp: float) -> float:
+    """The limiting steepness Sp at peak period tp (s): ``SEA_STEEPNESS_LIMIT``."""
+    (t0, s0), (t1, s1) = SEA_STEEPNESS_LIMIT
+    return float(np.interp(tp, [t0, t1], [s0, s1]))
+
+
+def check_wave_height(hs: float) -> float:
+    """hs (m) if it is a significant wave height in (0, SEA_HS_MAX_M], else a ShipMotionError."""
+    hs = _positive("significant wave height hs", hs, " m")
+    if hs > SEA_HS_MAX_M:
+        raise ShipMotionError(f"significant wave height hs = {hs:g} m is above {SEA_HS_MAX_M:g} m "
+                              "(the highest measured is 19.0 m, WMO)")
+    return hs
+
+
+def check_peak_period(tp: float) -> float:
+    """tp (s) if it is a peak period in SEA_TP_RANGE_S, else a ShipMotionError."""
+    tp = _positive("peak period tp", tp, " s")
+    lo, hi = SEA_TP_RANGE_S
+    if not lo <= tp <= hi:
+        raise ShipMotionError(f"peak period tp = {tp:g} s is outside [{lo:g}, {hi:g}] s, the periods "
+                              "of wind seas and swell (Munk 1950)")
+    return tp
+
+
+def check_sea_state(hs: float, tp: float) -> tuple[float, float]:
+    """(hs, tp) if the sea state is one the spectrum and the RAOs describe: hs and tp in their
+    ranges (``check_wave_height``, ``check_peak_period``) and no steeper than the limiting
+    steepness (``steepness_limit``); else a ShipMotionError naming the value and the limit."""
+    hs, tp = check_wave_height(hs), check_peak_period(tp)
+    steepness = 2.0 * math.pi * hs / (GRAVITY * tp * tp)
+    limit = steepness_limit(tp)
+    if steepness > limit:
+        hs_max = limit * GRAVITY * tp * tp / (2.0 * math.pi)
+        raise ShipMotionError(
+            f"sea state hs = {hs:g} m, tp = {tp:g} s is steeper than waves can be: 2 pi Hs / (g Tp^2) "
+            f"= 1/{1.0 / steepness:.3g} > 1/{1.0 / limit:.3g} (DNV-RP-C205's limit at tp = {tp:g} s; "
+            f"hs <= {hs_max:.3g} m)")
+    return hs, tp
+
+
 def _finite(name: str, value, unit: str = "") -> float:
     value = float(value)
     if not math.isfinite(value):

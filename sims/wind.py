@@ -21,8 +21,25 @@ from typing import Callable
 import numpy as np
 
 AIR_DENSITY = 1.2  # kg/m^3; about 1.0 at Rubin's 2700 m and FAST's 1000 m: conservative
+#: Largest mean wind speed accepted, m/s: the reference wind speed V_ref of IEC 61400-1
+#: (ed. 3, 2005) class I, the 10-min mean 50-year extreme of the windiest class of the
+#: standard whose Kaimal turbulence model this module uses. Beyond it the turbulence model
+#: (and any telescope) is outside its range.
+MAX_MEAN_SPEED_M_S = 50.0
 IEC_KAIMAL_LENGTH = 8.1 * 42.0  # m, IEC 61400-1 longitudinal integral scale above 60 m hub
 IEC_TURBULENCE_B = 0.14  # I_ref of IEC class B
+
+
+def check_mean_speed(mean_speed: float) -> float:
+    """The mean wind speed (m/s) if it is finite and in [0, MAX_MEAN_SPEED_M_S], else a
+    ValueError naming the value and the limit."""
+    value = float(mean_speed)
+    if not np.isfinite(value) or value < 0:
+        raise ValueError(f"mean wind speed {mean_speed!r} m/s must be finite and >= 0")
+    if value > MAX_MEAN_SPEED_M_S:
+        raise ValueError(f"mean wind speed {value:g} m/s is above {MAX_MEAN_SPEED_M_S:g} m/s, the "
+                         "reference wind speed of IEC 61400-1 class I (the Kaimal model's range)")
+    return value
 
 
 def kaimal_spectrum(f, mean_speed: float, turbulence_ref: float = IEC_TURBULENCE_B,
@@ -61,8 +78,7 @@ def wind_speed_series(times: np.ndarray, mean_speed: float, rng: np.random.Gener
         run still sees the slow part of the turbulence (most of a Kaimal spectrum's energy
         lies below 0.01 Hz) as a slowly drifting speed.
     """
-    if not np.isfinite(mean_speed) or mean_speed < 0:
-        raise ValueError(f"mean wind speed {mean_speed!r} m/s must be finite and >= 0")
+    check_mean_speed(mean_speed)
     if spectrum not in SPECTRA:
         raise ValueError(f"wind spectrum {spectrum!r} is not one of {', '.join(SPECTRA)}")
     times = np.asarray(times, dtype=float)
@@ -130,8 +146,7 @@ class BodyWindDrag:
 
     def __init__(self, body: str, mean_speed: float, area: Callable, drag_coefficient: float,
                  azimuth_deg: float = 0.0, spectrum: str = "kaimal"):
-        if not np.isfinite(mean_speed) or mean_speed < 0:
-            raise ValueError(f"mean wind speed {mean_speed!r} m/s must be finite and >= 0")
+        check_mean_speed(mean_speed)
         self.body = body
         self.mean_speed = float(mean_speed)
         self.area = area

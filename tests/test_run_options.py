@@ -1,0 +1,385 @@
+"""Run options that are valid numbers but not a run (issue 12, section 5).
+
+Refused up front, before anything is built or written: a duration under one control tick or
+whose log would not fit in memory (sims.run_limits), sea states outside the range of the
+spectrum and the RAOs (sims.ship_motion.check_sea_state), angles beyond one turn, winds
+beyond IEC 61400-1's classes, IMU rates and latencies the controller does not model, cable
+segments beyond the timestep's limit. The CLI says so in one line (exit 2); the Python API
+raises a ValueError subclass with the same words. A check that cannot be evaluated fails
+with a note and is null (never NaN) in summary.json.
+"""
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+from sims import antenna, fast, hexapod, loader, run_limits, runner, scenarios, ship_motion, wind
+from sims.checks import NOT_EVALUATED, Check
+from sims.cli import BadInput, _options, build_parser, format_checks, main
+from sims.fast_physics import CableLoads, max_cable_segments
+from sims.scenarios import RunOptions
+
+
+def _memory_limit_words():
+    limit, why = run_limits.log_memory_limit()
+    return f"more than the limit of {run_limits.format_bytes(limit)} ({why})"
+
+
+def _snapshot(root):
+    return sorted((str(p.relative_to(root)), p.stat().st_size if p.is_file() else -1)
+                  for p in root.rglob("*"))
+
+
+def _no_nan(text: str):
+    def refuse(constant):
+        raise ValueError(f"{constant} in JSON")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+#: (arguments after "run", words the one line must hold: the value and the limit).
+BAD_RUNS = [
+    # a duration under one control tick (the scenario's own tick)
+    (("fast-tracking", "--duration", "1e-6"), ("duration 1e-06 s", "one control tick (10 ms)")),
+    (("loader-supply", "--duration", "0.0049"), ("duration 0.0049 s", "one control tick (5 ms)")),
+    (("hexapod-async-move", "--duration", "0.001"), ("duration 0.001 s", "(5 ms)")),
+    (("antenna-sea-state", "--duration", "0.004"), ("duration 0.004 s", "(5 ms)")),
+    (("fast-ra-scan", "--duration", "0.0099"), ("duration 0.0099 s", "(10 ms)")),
+    # a log that would not fit in memory: the estimate and the limit
+    (("fast-tracking", "--duration", "1e12"), ("duration 1e+12 s", "PiB of log", "LIMIT")),
+    (("antenna-paper-motion", "--duration", "1e12"), ("duration 1e+12 s", "PiB of log", "LIMIT")),
+    (("loader-direct", "--duration", "1e9"), ("duration 1e+09 s", "TiB of log", "LIMIT")),
+    (("hexapod-sync-move", "--duration", "1e308"), ("duration 1e+308 s", "LIMIT")),
+    (("fast-source-switch", "--duration", "1e9", "--cable-segments", "4"), ("duration 1e+09 s", "LIMIT")),
+    # sea states the spectrum and the RAOs do not describe
+    (("antenna-sea-state", "--tp", "1e-3"), ("tp = 0.001 s", "[1, 30] s", "Munk 1950")),
+    (("antenna-sea-state", "--tp", "1e4"), ("tp = 10000 s", "[1, 30] s")),
+    (("antenna-sea-state", "--tp", "0.9"), ("tp = 0.9 s", "[1, 30] s")),
+    (("antenna-sea-state", "--tp", "31"), ("tp = 31 s", "[1, 30] s")),
+    (("antenna-sea-state", "--hs", "1e308"), ("hs = 1e+308 m", "above 20 m", "WMO")),
+    (("antenna-sea-state", "--hs", "20.5"), ("hs = 20.5 m", "above 20 m")),
+    (("antenna-sea-state", "--hs", "15", "--tp", "8"), ("hs = 15 m, tp = 8 s", "1/15", "DNV-RP-C205")),
+    (("antenna-sea-state", "--hs", "18", "--tp", "12"), ("hs = 18 m, tp = 12 s", "DNV-RP-C205")),
+    (("antenna-sea-state", "--hs", "12"), ("hs = 12 m, tp = 10 s", "DNV-RP-C205")),  # default Tp
+    (("antenna-sea-state", "--hs", "1", "--tp", "1"), ("hs = 1 m, tp = 1 s", "1/15")),
+    # angles: refused beyond one turn, not wrapped
+    (("antenna-sea-state", "--heading", "1e308"), ("wave heading 1e+308 deg", "[-360, 360] deg")),
+    (("antenna-sea-state", "--heading", "-360.5"), ("wave heading -360.5 deg", "[-360, 360] deg")),
+    (("fast-tracking", "--wind-direction", "1e308"), ("wind direction 1e+308 deg", "[-360, 360] deg")),
+    (("fast-ra-scan", "--wind-direction", "720"), ("wind direction 720 deg", "[-360, 360] deg")),
+    (("hexapod-sync-move", "--elevation", "1e308"), ("elevation 1e+308 deg", "[15, 90] deg")),
+    (("hexapod-async-move", "--elevation", "14.9"), ("elevation 14.9 deg", "[15, 90] deg")),
+    (("hexapod-sync-move", "--elevation", "90.01"), ("elevation 90.01 deg", "[15, 90] deg")),
+    # winds beyond the turbulence model's range
+    (("fast-tracking", "--wind", "1e308"), ("mean wind speed 1e+308 m/s", "50 m/s", "IEC 61400-1")),
+    (("hexapod-sync-move", "--wind", "50.5"), ("mean wind speed 50.5 m/s", "50 m/s")),
+    # the IMU
+    (("antenna-paper-motion", "--imu-rate", "1e-300"), ("IMU rate 1e-300 Hz", "below 1 Hz")),
+    (("antenna-sea-state", "--imu-rate", "0.5"), ("IMU rate 0.5 Hz", "below 1 Hz")),
+    (("antenna-paper-motion", "--imu-latency", "1e9"), ("IMU latency 1e+09 s", "above 1 s")),
+    (("antenna-sea-state", "--imu-latency", "1.005"), ("IMU latency 1.005 s", "above 1 s")),
+    # cable segments: the real limit, at parse time
+    (("fast-tracking", "--cable-segments", "15"), ("cable segments 15", "[2, SEGMENTS]")),
+    (("fast-tracking", "--cable-segments", "50"), ("cable segments 50", "[2, SEGMENTS]")),
+    (("fast-source-switch", "--cable-segments", "1"), ("cable segments 1", "[2, SEGMENTS]")),
+]
+
+
+@pytest.mark.parametrize("args, words", BAD_RUNS, ids=[" ".join(a) for a, _ in BAD_RUNS])
+def test_bad_run_options_exit_2_with_one_line(tmp_path, capsys, args, words):
+    out = tmp_path / "out"
+    before = _snapshot(tmp_path)
+    code = main(["run", *args, "--out", str(out), "--quiet"])
+    captured = capsys.readouterr()
+    assert code == 2, captured.err
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1, captured.err
+    assert "Traceback" not in captured.err and captured.out == ""
+    for word in words:
+        word = word.replace("LIMIT", _memory_limit_words()).replace("SEGMENTS", str(max_cable_segments()))
+        assert word in lines[0], lines[0]
+    assert not out.exists() and _snapshot(tmp_path) == before
+    # Found while the options are read (parse or ``_options``), before the scenario is built.
+    with pytest.raises(BadInput) as refused:
+        _options(scenarios.get(args[0]), build_parser().parse_args(["run", *args, "--out", str(out)]))
+    assert str(refused.value) in lines[0]
+
+
+def test_the_cable_segment_limit_is_the_models():
+    """14 at the model's 2 ms timestep (the issue's number), from the one function the run
+    checks its cables with; at half the timestep twice as many."""
+    assert max_cable_segments() == 14
+    assert max_cable_segments(timestep=0.001) in (28, 29)
+    # The lumped law's 320 m cables: 14 segments of 22.9 m keep omega dt <= 0.7, 15 do not.
+    assert max_cable_segments(320.13646, 0.002) == 14
+
+
+# ---------------------------------------------------------------- what is still accepted
+
+
+@pytest.mark.parametrize("args", [
+    ("loader-supply", "--duration", "0.005"),  # exactly one tick
+    ("fast-tracking", "--duration", "0.01"),
+    ("antenna-sea-state", "--hs", "20", "--tp", "30"),
+    ("antenna-sea-state", "--hs", "6.6", "--tp", "8"),  # just under 1/15
+    ("antenna-sea-state", "--hs", "0.1", "--tp", "1"),
+    ("antenna-sea-state", "--heading", "-360"),
+    ("antenna-sea-state", "--heading", "360"),
+    ("fast-ra-scan", "--wind-direction", "-90", "--wind", "50"),
+    ("fast-tracking", "--cable-segments", "14"),
+    ("hexapod-sync-move", "--elevation", "15", "--wind", "0"),
+    ("antenna-paper-motion", "--imu-rate", "1", "--imu-latency", "1"),
+    ("antenna-paper-motion", "--imu-rate", "200", "--imu-latency", "0"),
+    ("antenna-sea-state", "--duration", "600"),
+])
+def test_the_limits_themselves_are_accepted(args):
+    scenario = scenarios.get(args[0])
+    options = _options(scenario, build_parser().parse_args(["run", *args]))
+    assert isinstance(options, RunOptions)
+
+
+def test_default_runs_are_well_under_the_memory_limit():
+    """Every scenario's default run (what ``make demo`` runs) needs under 1 GiB of log, a
+    quarter of the fallback limit, so it runs on any machine the limit would allow; with
+    14-segment cables FAST's longest still under the 4 GiB fallback."""
+    durations = {
+        "loader-supply": loader.loader_planner.supply_plan().duration + loader.SETTLE_S,
+        "loader-direct": loader.loader_planner.direct_plan().duration + loader.SETTLE_S,
+        "hexapod-sync-move": hexapod.plan(True).duration + hexapod.SETTLE_S,
+        "hexapod-async-move": hexapod.plan(False).duration + hexapod.SETTLE_S,
+        "antenna-paper-motion": antenna.PAPER_DURATION_S,
+        "antenna-sea-state": antenna.SEA_DURATION_S,
+        "fast-tracking": fast.tracking_plan().duration,
+        "fast-ra-scan": fast.ra_scan_plan().duration,
+        "fast-source-switch": fast.source_switch_plan().duration,
+    }
+    per_tick = {"loader": loader.log_bytes_per_tick(), "hexapod": hexapod.log_bytes_per_tick(),
+                "antenna": antenna.log_bytes_per_tick(), "fast": fast.log_bytes_per_tick()}
+    limit = run_limits.FALLBACK_LOG_LIMIT_BYTES
+    for name, duration in durations.items():
+        dt = scenarios.get(name).control_dt
+        need = (duration / dt + 1) * per_tick[name.split("-")[0]]
+        assert need < limit / 4, (name, run_limits.format_bytes(need))
+        run_limits.check_duration(duration, dt, per_tick[name.split("-")[0]], (limit, "test"))
+    assert durations["fast-tracking"] == pytest.approx(1330.0, abs=1.0)
+    longest = (durations["fast-tracking"] / fast.CONTROL_DT + 1) * fast.log_bytes_per_tick(14)
+    assert longest < limit
+
+
+def _held_bytes(*objects) -> int:
+    """Bytes of the distinct numpy buffers reachable from objects (attributes, lists,
+    dicts, dataclasses; not the MuJoCo physics)."""
+    seen, buffers = set(), {}
+
+    def walk(o, depth):
+        if id(o) in seen or depth > 6:
+            return
+        seen.add(id(o))
+        if isinstance(o, np.ndarray):
+            base = o
+            while isinstance(base.base, np.ndarray):
+                base = base.base
+            buffers[id(base)] = base.nbytes
+        elif isinstance(o, (list, tuple)):
+            for x in o:
+                walk(x, depth + 1)
+        elif isinstance(o, dict):
+            for x in o.values():
+                walk(x, depth + 1)
+        elif not type(o).__module__.startswith(("numpy", "mujoco", "dm_control", "builtins")):
+            fields = getattr(o, "__dict__", None)
+            if fields is None and hasattr(o, "__dataclass_fields__"):
+                fields = {k: getattr(o, k) for k in o.__dataclass_fields__}
+            for key, x in (fields or {}).items():
+                if key != "physics":
+                    walk(x, depth + 1)
+
+    for o in objects:
+        walk(o, 0)
+    return sum(buffers.values())
+
+
+@pytest.mark.parametrize("name, estimate", [
+    ("loader-supply", lambda o: loader.log_bytes_per_tick()),
+    ("hexapod-sync-move", lambda o: hexapod.log_bytes_per_tick()),
+    ("hexapod-async-move", lambda o: hexapod.log_bytes_per_tick(wind=False)),
+    ("antenna-paper-motion", lambda o: antenna.log_bytes_per_tick(antenna.ImuModel(rate_hz=25.0))),
+    ("antenna-sea-state", lambda o: antenna.log_bytes_per_tick()),
+    ("fast-tracking", lambda o: fast.log_bytes_per_tick()),
+    ("fast-source-switch", lambda o: fast.log_bytes_per_tick(3)),
+])
+def test_log_estimate_matches_the_arrays_a_run_holds(name, estimate):
+    """The per-tick estimate against what two short runs hold after the loop (log,
+    controller, disturbance, trajectory): the difference of their bytes over the difference
+    of their ticks. Within 10 %, never below."""
+    scenario = scenarios.get(name)
+    extra = {"hexapod-async-move": {"wind": 0.0}, "antenna-paper-motion": {"imu_rate": 25.0},
+             "fast-source-switch": {"cable_segments": 3}}.get(name, {})
+    held = []
+    for ticks in (20, 120):
+        options = RunOptions(duration=ticks * scenario.control_dt, **extra)
+        setup = scenario.build(options)
+        log = runner.simulate(setup)
+        held.append((log.t.size, _held_bytes(log, setup.controller, setup.disturbance, setup.trajectory)))
+    (n1, b1), (n2, b2) = held
+    measured = (b2 - b1) / (n2 - n1)
+    assert measured <= estimate(None) <= 1.1 * measured, (measured, estimate(None))
+
+
+# ---------------------------------------------------------------- the Python API
+
+
+@pytest.mark.parametrize("name", list(scenarios.SCENARIOS))
+def test_build_refuses_a_duration_under_one_tick(name):
+    scenario = scenarios.get(name)
+    with pytest.raises(ValueError, match=rf"shorter than one control tick \({scenario.control_dt * 1e3:g} ms\)"):
+        scenario.build(RunOptions(duration=0.5 * scenario.control_dt))
+    with pytest.raises(run_limits.RunLimitError, match="of log, more than the limit of"):
+        scenario.validate(RunOptions(duration=1e12))
+
+
+@pytest.mark.parametrize("name, heavy", [
+    ("loader-supply", "sims.loader.LoaderPhysics.load"),
+    ("hexapod-sync-move", "sims.hexapod.HexapodPhysics.load"),
+    ("antenna-paper-motion", "sims.antenna.ideal_path"),
+    ("antenna-sea-state", "sims.antenna.ideal_path"),
+    ("fast-tracking", "sims.fast.FastPhysics.load"),
+])
+def test_build_checks_before_any_work(monkeypatch, name, heavy):
+    """The refusal comes before the work proportional to the duration (the antenna's ideal
+    path) and before any physics is loaded."""
+    def must_not_run(*args, **kwargs):
+        raise AssertionError(f"{heavy} ran before the duration was checked")
+
+    monkeypatch.setattr(heavy, must_not_run)
+    with pytest.raises(run_limits.RunLimitError, match="duration 1e\\+12 s needs"):
+        scenarios.get(name).build(RunOptions(duration=1e12))
+
+
+def test_memory_rule_is_stated_and_follows_the_machine(monkeypatch):
+    limit, why = run_limits.log_memory_limit()
+    total = run_limits.physical_memory_bytes()
+    if total is not None:
+        assert limit == pytest.approx(total / 4) and why.startswith("a quarter of this machine's")
+    monkeypatch.setattr(run_limits, "physical_memory_bytes", lambda: None)
+    assert run_limits.log_memory_limit() == (run_limits.FALLBACK_LOG_LIMIT_BYTES,
+                                             "this system does not report its memory")
+    with pytest.raises(run_limits.RunLimitError,
+                       match=r"duration 1e\+12 s needs ~1\.4 PiB of log, more than the limit of 4 GiB \(this"):
+        run_limits.check_duration(1e12, 0.005, 8.0)  # 2e14 ticks x 8 B = 1.42 PiB
+    assert run_limits.format_bytes(12 * 2**30) == "12 GiB" and run_limits.format_bytes(512) == "512 B"
+
+
+@pytest.mark.parametrize("hs, tp, words", [
+    (5.0, 1e-3, "tp = 0.001 s is outside [1, 30] s"),
+    (5.0, 1e4, "tp = 10000 s is outside [1, 30] s"),
+    (1e308, 10.0, "hs = 1e+308 m is above 20 m"),
+    (0.0, 10.0, "hs = 0 m must be > 0"),
+    (float("nan"), 10.0, "hs = nan m must be finite"),
+    (15.0, 8.0, "hs = 15 m, tp = 8 s is steeper than waves can be"),
+    (15.0, 15.0, r"tp = 15 s is steeper than waves can be: 2 pi Hs / \(g Tp\^2\) = 1/23.4 > 1/25"),
+])
+def test_sea_states_outside_the_models_range_are_named(hs, tp, words):
+    with pytest.raises(ship_motion.ShipMotionError, match=words if "\\" in words else re.escape(words)):
+        ship_motion.check_sea_state(hs, tp)
+    with pytest.raises(ValueError):
+        antenna.sea_state_motion(hs, tp, 135.0, 0)
+    with pytest.raises(ValueError):
+        antenna.build_sea_state(RunOptions(hs=hs, tp=tp))
+
+
+def test_sea_state_limits_hold_the_default_and_the_steepness_rule():
+    assert ship_motion.check_sea_state(antenna.SEA_HS_M, antenna.SEA_TP_S) == (5.0, 10.0)
+    assert ship_motion.steepness_limit(5.0) == pytest.approx(1 / 15)
+    assert ship_motion.steepness_limit(20.0) == pytest.approx(1 / 25)
+    assert ship_motion.steepness_limit(11.5) == pytest.approx(0.5 * (1 / 15 + 1 / 25))
+    # The limit is Hs = Sp g Tp^2 / (2 pi): 6.66 m at 8 s is in, 6.7 m out.
+    ship_motion.check_sea_state(6.66, 8.0)
+    with pytest.raises(ship_motion.ShipMotionError):
+        ship_motion.check_sea_state(6.7, 8.0)
+
+
+def test_angles_winds_and_the_imu_are_refused_in_the_python_api():
+    with pytest.raises(ValueError, match=r"wave heading 1e\+308 deg is outside \[-360, 360\] deg"):
+        antenna.sea_state_motion(5.0, 10.0, 1e308, 0)
+    with pytest.raises(ValueError, match=r"wind direction 400 deg is outside \[-360, 360\] deg"):
+        fast.validate(RunOptions(wind_direction=400.0))
+    with pytest.raises(ValueError, match=r"elevation 1e\+308 deg is outside"):
+        hexapod.validate(RunOptions(elevation=1e308))
+    for make in (lambda: CableLoads(1e308), lambda: wind.check_mean_speed(60.0),
+                 lambda: wind.wind_speed_series(np.arange(3.0), 51.0, np.random.default_rng(0))):
+        with pytest.raises(ValueError, match=r"above 50 m/s"):
+            make()
+    with pytest.raises(ValueError, match="IMU rate 1e-300 Hz is below 1 Hz"):
+        antenna.ImuModel(rate_hz=1e-300).ticks(antenna.CONTROL_DT)
+    with pytest.raises(ValueError, match=r"IMU latency 1e\+09 s is above 1 s"):
+        antenna.build_paper_motion(RunOptions(imu_latency=1e9))
+    with pytest.raises(ValueError, match=r"cable segments 20 must be 0 \(lumped cables\) or a whole number in \[2, 14\]"):
+        fast.build(fast.source_switch_plan(), RunOptions(cable_segments=20))
+    with pytest.raises(ValueError, match=r"cable segments 2\.5"):
+        fast.validate(RunOptions(cable_segments=2.5))
+
+
+# ---------------------------------------------------------------- checks not evaluated
+
+
+def test_a_nan_check_fails_with_a_note_and_is_null_in_json():
+    c = Check.not_evaluated("settled", 1.0, "um", reason="the run ended early")
+    assert not c.passed and not c.evaluated
+    assert c.note == f"{NOT_EVALUATED}: the run ended early"
+    j = _no_nan(json.dumps(c.to_json()))
+    assert j["value"] is None and j["passed"] is False and j["note"].startswith(NOT_EVALUATED)
+    bare = Check("bare", float("nan"), 1.0, "m")  # an evaluation that forgot the reason
+    assert bare.note.startswith(NOT_EVALUATED) and "no reason" in bare.note
+    assert _no_nan(json.dumps(bare.to_json()))["value"] is None
+    assert _no_nan(json.dumps(Check("inf", float("inf"), 1.0, "m").to_json()))["value"] == "inf"
+    ok = Check("fine", 0.5, 1.0, "m")
+    assert ok.passed and ok.evaluated and ok.note == "" and "note" not in ok.to_json()
+    table = format_checks([("s", c), ("s", ok)])
+    assert "nan" not in table.lower().replace("not evaluated", "")
+    assert "n/a" in table.splitlines()[1] and "the run ended early" in table.splitlines()[1]
+    assert "n/a" not in table.splitlines()[2]
+
+
+@pytest.mark.parametrize("name, check", [("hexapod-sync-move", "arrival_spread"),
+                                         ("hexapod-async-move", "arrival_vs_own_time")])
+def test_short_hexapod_run_cannot_claim_its_arrival_or_settling(name, check):
+    result = runner.run(name, scenarios.get(name).build(RunOptions(duration=1.0, wind=0.0)))
+    by_name = {c.name: c for c in result.checks}
+    for key in (check, "pose_error_final"):
+        assert not by_name[key].evaluated and not by_name[key].passed
+        assert by_name[key].note.startswith(NOT_EVALUATED), by_name[key].note
+    assert "settling" in by_name["pose_error_final"].note
+    assert "came to rest" in by_name[check].note
+    assert by_name["following_error"].evaluated  # what was seen is still checked
+
+
+def test_short_hexapod_run_writes_a_failed_check_with_a_note_and_no_nan(tmp_path, capsys):
+    out = tmp_path / "short"
+    code = main(["run", "hexapod-sync-move", "--duration", "0.5", "--wind", "0", "--out", str(out),
+                 "--quiet"])
+    captured = capsys.readouterr()
+    assert code == 1, captured.err
+    summary = _no_nan((out / "summary.json").read_text())
+    entry = next(c for c in summary["checks"] if c["name"] == "pose_error_final")
+    assert entry["value"] is None and entry["passed"] is False
+    assert entry["note"].startswith(NOT_EVALUATED) and "settling" in entry["note"]
+    assert summary["passed"] is False
+    row = next(line for line in captured.out.splitlines() if "pose_error_final" in line)
+    assert "n/a" in row and "FAIL" in row and "nan" not in row
+
+
+def test_no_nan_in_any_short_run():
+    """One tick and a few ticks of every scenario: every check is a number or carries the
+    reason it is not, and the checks and metrics serialize without NaN."""
+    for name, scenario in scenarios.SCENARIOS.items():
+        for ticks in (1, 3):
+            result = runner.run(name, scenario.build(RunOptions(duration=ticks * scenario.control_dt)))
+            for c in result.checks:
+                assert c.evaluated or c.note.startswith(NOT_EVALUATED), (name, c)
+                assert c.evaluated or not c.passed
+            text = json.dumps({"checks": [c.to_json() for c in result.checks],
+                               "metrics": result.metrics}, default=float)
+            _no_nan(text)
