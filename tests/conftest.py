@@ -1,7 +1,9 @@
 import os
 
-# Offscreen rendering without a display; sims/__init__ picks EGL or OSMesa.
+# Offscreen rendering without a display; sims/__init__ picks EGL or OSMesa. It must run
+# before any test module imports mujoco, which fixes its GL back end on import.
 os.environ.setdefault("MPLBACKEND", "Agg")
+import sims  # noqa: E402,F401
 
 from hypothesis import settings  # noqa: E402
 
