@@ -20,7 +20,7 @@ import pytest
 
 from sims.cli import main
 from sims.outputs import MANIFEST
-from tests.test_outputs import snapshot
+from tests.test_outputs import _chattr, snapshot
 
 LONG_NAME = "n" * 300
 DEEP = "/".join(["d" * 200] * 21)  # 4221 bytes: over PATH_MAX
@@ -43,6 +43,9 @@ CASES = [
     (["run", "loader-supply", "--out", "/proc/planbench"], ["/proc", "nothing can be created"]),
     (["run", "loader-supply", "--out", "/sys/planbench/run"], ["/sys", "nothing can be created"]),
     (["run", "loader-supply", "--out", "/proc/self/planbench"], ["/proc/self", "nothing can be created"]),
+    (["run", "loader-supply", "--out", "{tmp}/locked/run"], ["locked", "nothing can be created"]),
+    (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/locked/v.mp4"], ["locked", "nothing can be created"]),
+    (["plan", "loader-supply", "--out", "{tmp}/locked/p"], ["locked", "nothing can be created"]),
     (["run", "loader-supply", "--out", "{tmp}/" + LONG_NAME], ["300 bytes", "limit of 255"]),
     (["run", "loader-supply", "--out", "{tmp}/" + DEEP], ["bytes", "limit of 4095"]),
     # -- videos ---------------------------------------------------------------------------
@@ -140,8 +143,20 @@ CASES = [
 
 @pytest.fixture
 def scene(tmp_path, monkeypatch):
-    """The test's directory (also the working directory), laid out for the cases."""
+    """The test's directory (also the working directory), laid out for the cases; ``locked``
+    is an immutable directory (chattr +i; read-only mode bits where not root, since root
+    writes through them)."""
     monkeypatch.chdir(tmp_path)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    if not _chattr("+i", locked) and os.geteuid() != 0:
+        locked.chmod(0o555)
+    yield _lay_out(tmp_path)
+    _chattr("-i", locked)
+    locked.chmod(0o755)
+
+
+def _lay_out(tmp_path):
     (tmp_path / "mydata").mkdir()
     (tmp_path / "mydata" / "thesis.tex").write_text("years of work")
     (tmp_path / "notes.txt").write_text("notes")
@@ -170,6 +185,8 @@ def test_the_table_is_large_enough():
 @pytest.mark.parametrize("argv, expected", CASES, ids=[" ".join(a)[:60] or "(none)" for a, _ in CASES])
 def test_bad_invocation(argv, expected, scene, capsys):
     tmp = str(scene)
+    if "{tmp}/locked" in " ".join(argv) and os.access(scene / "locked", os.W_OK):
+        pytest.skip("no immutable or read-only directory can be made here")
     argv = [a.replace("{tmp}", tmp) for a in argv]
     before = snapshot(scene)
     code = main(argv)
