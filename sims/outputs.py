@@ -150,16 +150,66 @@ def _absolute(raw, what: str, option: str) -> Path:
     return Path(os.path.abspath(os.path.expanduser(str(raw))))
 
 
+def _safe_relative(name) -> bool:
+    """A path a manifest may list: relative, inside its directory (no '..', no root)."""
+    if not isinstance(name, str) or not name or "\0" in name:
+        return False
+    path = Path(name)
+    return not path.is_absolute() and ".." not in path.parts
+
+
 def read_manifest(directory: Path) -> dict | None:
-    """The manifest of a directory planbench wrote, or None if there is none or it is not one."""
+    """The manifest of a directory planbench wrote, or None if there is none, it is not one,
+    or it lists a path outside its directory (which planbench never writes)."""
     try:
         manifest = json.loads((Path(directory) / MANIFEST).read_text())
     except (OSError, ValueError, UnicodeDecodeError):
         return None
     if not isinstance(manifest, dict) or manifest.get("written_by") != "planbench" \
-            or not isinstance(manifest.get("files"), list):
+            or not isinstance(manifest.get("files"), list) \
+            or not all(_safe_relative(f) for f in manifest["files"]):
         return None
     return manifest
+
+
+def _foreign_entries(directory: Path) -> list[str] | None:
+    """What in ``directory`` planbench did not write: [] for an empty directory or one whose
+    every entry its manifest lists; None when it has entries and no (valid) manifest."""
+    files, dirs = _entries(directory)
+    if not files and not dirs:
+        return []
+    manifest = read_manifest(directory)
+    if manifest is None:
+        return None
+    listed = set(manifest["files"]) | {MANIFEST}
+    parents = {p.as_posix() for f in listed for p in Path(f).parents}
+    return sorted([f for f in files if f not in listed] + [d for d in dirs if d not in parents])
+
+
+def _shown(names: list[str]) -> str:
+    return ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+
+
+def _discard_old_output(old: Path, target: Path) -> None:
+    """Remove a replaced output directory ``old``: only the files its manifest lists, then its
+    emptied directories. Anything else (a file added after the last check) is kept: the
+    directory is renamed, visibly, to ``TARGET.kept-<UTC time>`` beside the target, less the
+    manifest, so that nothing ever takes it for planbench's again."""
+    manifest = read_manifest(old) or {"files": []}
+    for name in manifest["files"]:
+        with contextlib.suppress(OSError):
+            (old / name).unlink()
+    with contextlib.suppress(OSError):
+        (old / MANIFEST).unlink()
+    for root, dirs, _ in os.walk(old, topdown=False):
+        for d in dirs:
+            with contextlib.suppress(OSError):
+                os.rmdir(os.path.join(root, d))
+    try:
+        old.rmdir()
+    except OSError:
+        stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+        os.rename(old, target.with_name(f"{target.name}.kept-{stamp}"))
 
 
 def _entries(directory: Path) -> tuple[list[str], list[str]]:
@@ -270,22 +320,15 @@ class OutputDir(_Target):
         _probe(what, path)
 
     def _check_replaceable(self) -> None:
-        files, dirs = _entries(self.path)
-        if not files and not dirs:
-            return  # an empty directory: nothing to lose
-        manifest = read_manifest(self.path)
-        if manifest is None:
+        foreign = _foreign_entries(self.path)
+        if foreign is None:
             raise OutputError(
                 f"{self.what} {self.path} is not empty and planbench did not write it (no "
                 f"{MANIFEST}); choose another {self.option} or empty it yourself")
-        listed = set(manifest["files"]) | {MANIFEST}
-        parents = {p.as_posix() for f in listed for p in Path(f).parents}
-        foreign = [f for f in files if f not in listed] + [d for d in dirs if d not in parents]
         if foreign:
-            shown = ", ".join(sorted(foreign)[:3]) + (", ..." if len(foreign) > 3 else "")
             raise OutputError(
-                f"{self.what} {self.path} holds files planbench did not write ({shown}); "
-                f"choose another {self.option} or move them away")
+                f"{self.what} {self.path} holds files planbench did not write "
+                f"({_shown(foreign)}); choose another {self.option} or move them away")
 
     @contextlib.contextmanager
     def staging(self, info: dict | None = None):
@@ -307,11 +350,31 @@ class OutputDir(_Target):
                 (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
                 (tmp / STAGING_MARKER).unlink()
                 _usual_mode(tmp, 0o777)
+                self._check_unchanged(tmp)
                 swap_in(tmp, self.path)
         except BaseException:
             with signals_deferred():
                 shutil.rmtree(tmp, ignore_errors=True)
             raise
+
+
+    def _check_unchanged(self, tmp: Path) -> None:
+        """Just before the swap: if files planbench did not write appeared in the target
+        while it ran, keep them and the target as they are, move this run's output beside it
+        (``TARGET.new-<UTC time>``) and refuse."""
+        if not os.path.lexists(self.path):
+            return
+        foreign = _foreign_entries(self.path) if self.path.is_dir() and not self.path.is_symlink() else ["(not a directory)"]
+        if foreign is None or foreign:
+            stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+            kept = self.path.with_name(f"{self.path.name}.new-{stamp}")
+            manifest = json.loads((tmp / MANIFEST).read_text())
+            manifest["target"] = kept.name
+            (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+            os.rename(tmp, kept)
+            what = "files planbench did not write" if foreign is None else f"{_shown(foreign)}"
+            raise OutputError(f"{self.what} {self.path} gained {what} during the run; it was left "
+                              f"as it is and this run's output is in {kept}")
 
 
 def _new_staging(parent: Path, target_name: str) -> Path:
@@ -359,7 +422,7 @@ def swap_in(tmp: Path, target: Path) -> None:
         os.rename(tmp, target)  # rename replaces an empty directory atomically
         return
     if USE_EXCHANGE and _exchange(tmp, target):
-        shutil.rmtree(tmp)  # now the old output
+        _discard_old_output(tmp, target)  # tmp now holds the old output
         return
     # Per file: move each new file over the old one, then drop the old ones not rewritten.
     old = read_manifest(target) or {"files": []}
@@ -372,6 +435,10 @@ def swap_in(tmp: Path, target: Path) -> None:
         if f not in new_files:
             with contextlib.suppress(OSError):
                 (target / f).unlink()
+    for root, dirs, _ in os.walk(target, topdown=False):  # the old output's emptied folders
+        for d in dirs:
+            if not os.listdir(os.path.join(root, d)):
+                os.rmdir(os.path.join(root, d))
     shutil.rmtree(tmp)
 
 
@@ -410,7 +477,10 @@ def remove_leftovers(target: Path) -> list[Path]:
                     or not entry.is_dir():
                 continue
             if _owned_leftover(entry, target.name):
-                shutil.rmtree(entry, ignore_errors=True)
+                if (entry / STAGING_MARKER).exists() or entry.name.startswith(PROBE_PREFIX):
+                    shutil.rmtree(entry, ignore_errors=True)  # only ever written by planbench
+                else:  # an old output swapped out: its listed files only
+                    _discard_old_output(entry, target)
                 removed.append(entry)
             elif not any(entry.iterdir()) and time.time() - entry.stat().st_mtime > EMPTY_LEFTOVER_AGE_S:
                 with contextlib.suppress(OSError):

@@ -306,3 +306,54 @@ def test_video_inside_out_may_not_shadow_the_runs_files(tmp_path):
         with pytest.raises(OutputError):
             VideoFile(tmp_path / "run" / bad, out)
     assert VideoFile(tmp_path / "run" / "videos" / "v.mp4", out).relative == Path("videos/v.mp4")
+
+
+def test_a_manifest_listing_paths_outside_is_not_planbenchs(tmp_path):
+    out = tmp_path / "run"
+    write_dummy(OutputDir(out), "first")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("outside")
+    manifest = json.loads((out / MANIFEST).read_text())
+    for bad in ("../victim.txt", str(victim), "sub/../../victim.txt", ""):
+        (out / MANIFEST).write_text(json.dumps({**manifest, "files": manifest["files"] + [bad]}))
+        with pytest.raises(OutputError, match="planbench did not write it"):
+            OutputDir(out)
+    assert victim.read_text() == "outside"
+
+
+def test_files_added_to_the_target_during_the_run_are_kept(tmp_path):
+    out = tmp_path / "run"
+    write_dummy(OutputDir(out), "old")
+    target = OutputDir(out)  # validated: only planbench's files
+    with pytest.raises(OutputError, match=r"gained notes.txt during the run; .* output is in .*run\.new-"):
+        with target.staging() as tmp:
+            (tmp / "summary.json").write_text(json.dumps({"run": "new"}))
+            (out / "notes.txt").write_text("written while it ran")
+    assert (out / "notes.txt").read_text() == "written while it ran"
+    assert json.loads((out / "summary.json").read_text()) == {"run": "old"}
+    [kept] = tmp_path.glob("run.new-*")
+    assert json.loads((kept / "summary.json").read_text()) == {"run": "new"}
+    assert json.loads((kept / MANIFEST).read_text())["target"] == kept.name
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["run", kept.name])
+
+
+@pytest.mark.parametrize("exchange", [True, False], ids=["rename-exchange", "per-file-fallback"])
+def test_the_old_output_loses_only_its_listed_files(exchange, tmp_path, monkeypatch):
+    """Past every check (a file that appears between the last check and the swap): the old
+    output's own files go, anything else is kept where the user can see it."""
+    monkeypatch.setattr(outputs, "USE_EXCHANGE", exchange)
+    out = tmp_path / "run"
+    write_dummy(OutputDir(out), "old")
+    (out / "late.txt").write_text("mine")
+    new = outputs._new_staging(tmp_path, "run")
+    (new / "summary.json").write_text(json.dumps({"run": "new"}))
+    (new / MANIFEST).write_text(json.dumps({"written_by": "planbench", "target": "run",
+                                            "files": ["summary.json", MANIFEST]}))
+    (new / outputs.STAGING_MARKER).unlink()
+    outputs.swap_in(new, out)
+    assert json.loads((out / "summary.json").read_text()) == {"run": "new"}
+    if exchange:
+        [kept] = tmp_path.glob("run.kept-*")
+        assert sorted(p.name for p in kept.iterdir()) == ["late.txt"]  # no manifest: never ours again
+    else:
+        assert (out / "late.txt").read_text() == "mine"
