@@ -601,9 +601,20 @@ class VideoFile(_Target):
         with signals_deferred():
             rendered = self._staged / ("video" + self.path.suffix)
             _usual_mode(rendered, 0o666)
-            os.replace(rendered, self.path)
+            # Checked again: a file of someone else's may have appeared there during the run.
+            taken = os.path.lexists(self.path) and (
+                os.path.islink(self.path) or not self.path.is_file() or not is_planbench_video(self.path))
+            if taken:
+                stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+                kept = self.path.with_name(f"{self.path.stem}.new-{stamp}{self.path.suffix}")
+                os.rename(rendered, kept)
+            else:
+                os.replace(rendered, self.path)
             shutil.rmtree(self._staged, ignore_errors=True)
             self._staged = None
+        if taken:
+            raise OutputError(f"video {self.path} appeared during the run and planbench did not "
+                              f"write it; it was left as it is and this run's video is {kept}")
 
     def discard(self) -> None:
         if self._staged is not None:

@@ -357,3 +357,17 @@ def test_the_old_output_loses_only_its_listed_files(exchange, tmp_path, monkeypa
         assert sorted(p.name for p in kept.iterdir()) == ["late.txt"]  # no manifest: never ours again
     else:
         assert (out / "late.txt").read_text() == "mine"
+
+
+def test_a_video_that_appears_during_the_run_is_kept(tmp_path):
+    video = VideoFile(tmp_path / "clip.mp4")
+    with video.reserved():
+        with video.staging() as path:
+            path.write_bytes(b"rendered")
+        (tmp_path / "clip.mp4").write_bytes(b"someone else's")
+        with pytest.raises(OutputError, match=r"appeared during the run .* video is .*clip\.new-.*\.mp4"):
+            video.commit()
+    assert (tmp_path / "clip.mp4").read_bytes() == b"someone else's"
+    [kept] = tmp_path.glob("clip.new-*.mp4")
+    assert kept.read_bytes() == b"rendered"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["clip.mp4", kept.name])
