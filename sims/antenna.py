@@ -497,7 +497,7 @@ class AntennaEvaluation:
         checks += [
             Check("polarization_error_max", float(np.abs(polarization).max()), POLARIZATION_MAX_DEG, "deg"),
             Check("attitude_error_fro_max", float(np.max(updates["error_fro"], initial=0.0)),
-                  ATTITUDE_FRO_LIMIT, "",
+                  ATTITUDE_FRO_LIMIT, "1",  # a norm of rotation matrices: dimensionless
                   note=f"the planner's ||f(Theta) - N||_F over {updates['t'].size} updates"),
             Check("joint_rate", float(rate_ratio.max()), 1.0, "of limit",
                   note=f"measured joint speed / rated speed, worst {JOINTS[int(np.argmax(rate_ratio))]}"),

@@ -119,6 +119,9 @@ class RunLog:
 
 @dataclass
 class RunResult:
+    """A finished run. ``components``: what ran, by class (``module.QualName``): the planned
+    ``trajectory``, the ``controller`` and the ``disturbance`` (None when there is none)."""
+
     scenario: str
     seed: int
     log: RunLog
@@ -126,6 +129,7 @@ class RunResult:
     metrics: dict
     sim_time_s: float
     wall_time_s: float
+    components: dict = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
@@ -270,4 +274,7 @@ def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
     metrics = dict(metrics)
     metrics["physics_steps"] = log.physics_steps
     metrics["loop_wall_s"] = log.loop_wall_s
-    return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall)
+    components = {role: None if obj is None else f"{type(obj).__module__}.{type(obj).__qualname__}"
+                  for role, obj in (("trajectory", setup.trajectory), ("controller", setup.controller),
+                                    ("disturbance", setup.disturbance))}
+    return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall, components)

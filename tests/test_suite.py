@@ -1,0 +1,94 @@
+"""Suite-wide tests over every registered scenario (in the spirit of dm_control's
+``suite_test.py``): a scenario added to ``sims.scenarios.SCENARIOS`` gets them with no new
+test code. Each runs a short stretch (SHORT_S) of the scenario, twice with one seed and once
+with another.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+
+import numpy as np
+import pytest
+
+from sims import outputs, runner, scenarios
+from sims.checks import NOT_EVALUATED
+from sims.scenarios import RunOptions
+
+SHORT_S = 0.25  # s: 25-50 control ticks, enough for every disturbance and sensor to act
+LOGGED = ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata", "mocap_pos", "mocap_quat")
+NAMES = list(scenarios.SCENARIOS)
+
+
+@functools.lru_cache(maxsize=None)
+def short_run(name: str, seed: int):
+    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=seed))
+    return setup, runner.run(name, setup)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_short_run_has_no_mujoco_warning(name):
+    _, result = short_run(name, 1)
+    log = result.log
+    assert log.diverged_at is None and log.warnings == {}, (log.warnings, log.divergence_message)
+    assert log.t[-1] == pytest.approx(SHORT_S) and np.isfinite(log.qpos).all() and np.isfinite(log.qvel).all()
+    [warnings] = [c for c in result.checks if c.name == "simulation_warnings"]
+    assert warnings.passed and warnings.value == 0
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_same_seed_gives_an_identical_log(name):
+    _, a = short_run(name, 1)
+    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=1))
+    b = runner.run(name, setup)  # a fresh build, not the cached one
+    for field in LOGGED:
+        x, y = getattr(a.log, field), getattr(b.log, field)
+        assert x.shape == y.shape and x.tobytes() == y.tobytes(), field  # bit for bit
+    assert [c.to_json() for c in a.checks] == [c.to_json() for c in b.checks]
+
+
+#: Scenarios whose runs draw random numbers (wind, sea, sensor noise): another seed must
+#: change their log. The loader has none.
+STOCHASTIC = [n for n in NAMES if not n.startswith("loader")]
+
+
+@pytest.mark.parametrize("name", STOCHASTIC)
+def test_another_seed_gives_another_log(name):
+    _, a = short_run(name, 1)
+    _, b = short_run(name, 2)
+    assert not np.array_equal(a.log.qpos, b.log.qpos)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_check_has_a_unit_and_a_limit(name):
+    _, result = short_run(name, 1)
+    names = [c.name for c in result.checks]
+    assert len(names) == len(set(names)) >= 2
+    for c in result.checks:
+        assert c.name.isidentifier() and c.name.islower()
+        assert isinstance(c.unit, str) and c.unit.strip(), c
+        assert math.isfinite(float(c.limit)), c
+        assert c.comparison in ("<=", "<", ">=", ">", "=="), c
+        if not c.evaluated:  # a short run may not reach a check's window: it says so and fails
+            assert c.note.startswith(NOT_EVALUATED) and not c.passed, c
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_summary_is_strict_json_and_names_what_ran(name, tmp_path):
+    setup, result = short_run(name, 1)
+    out = tmp_path / "out"
+    outputs.write_run(result, setup, out)
+
+    def no_constants(text):
+        raise AssertionError(f"summary.json holds {text}, which is not JSON")
+
+    summary = json.loads((out / "summary.json").read_text(), parse_constant=no_constants)
+    assert summary["scenario"] == name and summary["seed"] == 1
+    components = summary["components"]
+    assert set(components) == {"trajectory", "controller", "disturbance"}
+    assert components["trajectory"].startswith("planners.") and components["controller"].startswith("sims.")
+    assert [c["name"] for c in summary["checks"]] == [c.name for c in result.checks]
+    manifest = json.loads((out / outputs.MANIFEST).read_text())
+    assert manifest["scenario"] == name and set(manifest["files"]) >= set(outputs.RUN_FILES)
