@@ -84,3 +84,12 @@ def divergence_check(warnings: dict[str, int], diverged_at: float | None, messag
     if diverged_at is not None and count == 0:
         count = 1  # NaN found by the runner itself
     return Check("simulation_warnings", count, 0, "count", "==", note=message)
+
+
+def controller_check(error: tuple[float, str] | None) -> Check:
+    """The controller ran every tick without raising and wrote only finite commands (count of
+    faults must be 0). ``error``: (time in s, message) of the fault that ended the run."""
+    if error is None:
+        return Check("controller_errors", 0, 0, "count", "==")
+    t, message = error
+    return Check("controller_errors", 1, 0, "count", "==", note=f"the run ended at t = {t:.4f} s: {message}")

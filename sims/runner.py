@@ -7,12 +7,17 @@ rendering) works on whole arrays before or after the loop.
 
 Divergence (a NaN in the state, or any MuJoCo warning such as the bad-qacc reset) ends the
 run early; the ``simulation_warnings`` check then fails with a message that says when and why.
+So does a controller fault, ours or a user's: an exception raised by the controller, or a
+non-finite command it wrote (found before MuJoCo steps with it), ends the run at that tick and
+fails ``controller_errors`` with the exception's message or the command; the log up to it is
+evaluated and written as usual.
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from math import isfinite
 from typing import Callable, Protocol
 
 import mujoco
@@ -20,7 +25,7 @@ import numpy as np
 from tqdm import tqdm
 
 from planners.trajectory import Trajectory, TrajectorySample, control_ticks
-from sims.checks import Check, divergence_check
+from sims.checks import Check, controller_check, divergence_check
 
 #: How often (in control ticks) the loop scans for divergence: NaN or inf in the logged
 #: state since the last scan, and MuJoCo's warning counters (its bad-qacc detection resets the
@@ -113,6 +118,7 @@ class RunLog:
     warnings: dict = field(default_factory=dict)
     diverged_at: float | None = None
     divergence_message: str = ""
+    controller_error: tuple[float, str] | None = None
     physics_steps: int = 0
     loop_wall_s: float = 0.0
 
@@ -178,6 +184,19 @@ def _divergence(data, qpos, qvel, times, i: int, window: int):
     return None
 
 
+def _exception_text(e: BaseException) -> str:
+    """``Type: message`` on one line, at most 300 characters."""
+    text = " ".join(f"{type(e).__name__}: {e}".split())
+    return text if len(text) <= 300 else text[:297] + "..."
+
+
+def _bad_command(model, ctrl: np.ndarray, t: float) -> str:
+    """What is wrong with a command vector that is not finite, for the check's note."""
+    j = int(np.argmax(~np.isfinite(ctrl)))
+    name = model.actuator(j).name or f"actuator {j}"
+    return f"the controller wrote ctrl[{j}] ({name}) = {ctrl[j]} at t = {t:.4f} s"
+
+
 def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) -> RunLog:
     """Run the control loop of ``setup`` and return its log."""
     physics = setup.physics
@@ -219,6 +238,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
             mquat[i] = data.mocap_quat
 
     record(0)
+    initial_ctrl = data.ctrl.copy()
     controller, disturbance = setup.controller, setup.disturbance
     contacts = log.contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
@@ -227,7 +247,16 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
     last = n - 1
     start = time.perf_counter()
     for i in range(n - 1):
-        controller(i, physics)
+        try:
+            controller(i, physics)
+        except Exception as e:  # a controller's fault ends the run as a failed check
+            log.controller_error = (float(times[i]), _exception_text(e))
+            last = i
+            break
+        if not isfinite(data.ctrl.sum()):  # ~1 us: no NaN command ever reaches MuJoCo
+            log.controller_error = (float(times[i]), _bad_command(model, data.ctrl, times[i]))
+            last = i
+            break
         if disturbance is not None:
             disturbance(i, physics)
         ctrl[i] = data.ctrl
@@ -247,7 +276,10 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
             bar.update(update_every)
     log.loop_wall_s = time.perf_counter() - start
     bar.close()
-    ctrl[last] = data.ctrl  # held at the end (no controller call there)
+    if log.controller_error is None:
+        ctrl[last] = data.ctrl  # held at the end (no controller call there)
+    else:
+        ctrl[last] = ctrl[last - 1] if last > 0 else initial_ctrl  # the last good command, held
     log.physics_steps = last * k
     if last < n - 1:
         for name in ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata",
@@ -267,7 +299,8 @@ def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
     log = simulate(setup, quiet=quiet)
     checks, metrics = setup.evaluate(log)
     checks = list(checks) + [
-        divergence_check(log.warnings, log.diverged_at, log.divergence_message)
+        divergence_check(log.warnings, log.diverged_at, log.divergence_message),
+        controller_check(log.controller_error),
     ]
     wall = time.perf_counter() - start
     sim_time = float(log.t[-1])

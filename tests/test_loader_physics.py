@@ -35,7 +35,7 @@ def test_supply_checks_hold(supply):
     c = checks(result)
     assert result.passed, [x.to_json() for x in result.checks if not x.passed]
     assert set(c) == {"keypoint_error", "tracking_error", "obstacle_contacts", "min_clearance",
-                      "joint_torque", "simulation_warnings"}
+                      "joint_torque", "simulation_warnings", "controller_errors"}
     assert c["obstacle_contacts"].value == 0
     assert c["min_clearance"].value > 0.05  # the planned path clears by ~6 cm
     assert c["keypoint_error"].value < 0.1 and c["joint_torque"].value < 1.0

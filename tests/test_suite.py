@@ -92,3 +92,42 @@ def test_the_summary_is_strict_json_and_names_what_ran(name, tmp_path):
     assert [c["name"] for c in summary["checks"]] == [c.name for c in result.checks]
     manifest = json.loads((out / outputs.MANIFEST).read_text())
     assert manifest["scenario"] == name and set(manifest["files"]) >= set(outputs.RUN_FILES)
+
+
+class FaultyController:
+    """The scenario's own controller until ``tick``, then a fault: it raises, or writes NaN
+    into its last actuator (a user's controller with a bug)."""
+
+    def __init__(self, inner, tick: int, fault: str):
+        self.inner, self.tick, self.fault = inner, tick, fault
+
+    def reset(self, physics, reference, control_dt):
+        self.inner.reset(physics, reference, control_dt)
+
+    def __call__(self, tick, physics):
+        self.inner(tick, physics)
+        if tick == self.tick:
+            if self.fault == "raise":
+                raise RuntimeError("observation 'imu' missing\nin my controller")
+            physics.data.ctrl[-1] = np.nan
+
+
+@pytest.mark.parametrize("fault", ["raise", "nan"])
+@pytest.mark.parametrize("name", NAMES)
+def test_a_controller_fault_ends_the_run_as_a_failed_check(name, fault, tmp_path):
+    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=1))
+    fault_tick = 7
+    setup.controller = FaultyController(setup.controller, fault_tick, fault)
+    result = runner.run(name, setup)
+    checks = {c.name: c for c in result.checks}
+    error = checks["controller_errors"]
+    assert not error.passed and error.value == 1 and not result.passed
+    expected = ("RuntimeError: observation 'imu' missing in my controller" if fault == "raise"
+                else f"({setup.physics.model.actuator(setup.physics.model.nu - 1).name}) = nan")
+    assert expected in error.note, error.note
+    assert checks["simulation_warnings"].passed  # no NaN ever reached MuJoCo
+    assert result.log.t[-1] == pytest.approx(result.log.t[1] * fault_tick)  # ended at the fault
+    assert np.isfinite(result.log.ctrl).all()
+    outputs.write_run(result, setup, tmp_path / "out")  # outputs still written
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["passed"] is False
