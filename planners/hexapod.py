@@ -47,7 +47,7 @@ import numpy as np
 
 from planners.errors import LimitError, PlanningError
 from planners.legs import leg_forces, leg_lengths, leg_vectors, structure_matrix
-from planners.trajectory import TrajectorySample, check_values, sample_times
+from planners.trajectory import TrajectorySample, check_positive, check_values, sample_times
 
 POSE_LABELS = ("x", "y", "z", "rx", "ry", "rz")
 STRUT_LABELS = tuple(f"strut{i}" for i in range(1, 7))
@@ -134,14 +134,7 @@ class HexapodLimits:
                                 f"{_pose_unit(axis)} is above pose_upper "
                                 f"{POSE_LABELS[axis]} = {self.pose_upper[axis]:.6g}")
         for name in ("stroke", "strut_speed", "strut_accel", "linear_speed", "angular_speed"):
-            value = getattr(self, name)
-            try:
-                ok = bool(np.isfinite(value) and value > 0)
-            except (TypeError, ValueError):
-                ok = False
-            if not ok:
-                raise PlanningError(f"limit {name} = {value!r} must be finite and > 0")
-            check_values(value, f"limit {name}")
+            check_positive(getattr(self, name), f"limit {name}")
 
     @property
     def threshold_distance(self) -> float:
@@ -720,12 +713,7 @@ def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = 
         check_values(value, lambda i, name=name: f"{name} {STRUT_LABELS[i[1]]} position"
                      + (f" of row {i[0]}" if value.shape[0] > 1 else ""), "m")
         check_stroke(value, limits, what=name)
-    try:
-        dt_ok = bool(np.isfinite(dt) and dt > 0)
-    except (TypeError, ValueError):
-        dt_ok = False
-    if not dt_ok:
-        raise PlanningError(f"tick {dt!r} s must be finite and > 0")
+    check_positive(dt, "tick", "s")
     distance = np.abs(target - start)
     half = distance / 2.0
     t_hex = np.zeros(start.shape[0])

@@ -18,6 +18,7 @@ this and the limit; ``sample_times`` validates the times of every ``Trajectory.s
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable, Protocol, Sequence, runtime_checkable
 
@@ -110,6 +111,19 @@ def check_values(values, name: str | Callable[[tuple[int, ...]], str],
                             f"planners take finite numbers within +/-{max_abs:g}{u}")
     raise PlanningError(f"{label} = {fmt_number(value)}{u} is beyond +/-{max_abs:g}{u}, the "
                         f"largest magnitude planners take")
+
+
+def check_positive(value, name: str, unit: str = "") -> float:
+    """``value`` as a float if it is a finite number > 0 within +/-MAX_MAGNITUDE; else a
+    PlanningError ``{name} = {value} {unit} must be finite and > 0`` (or the magnitude's)."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not (math.isfinite(x) and x > 0):
+        u = f" {unit}" if unit else ""
+        raise PlanningError(f"{name} = {value!r}{u} must be finite and > 0")
+    return float(check_values(x, name, unit))
 
 
 def sample_times(t) -> np.ndarray:

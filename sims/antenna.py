@@ -649,8 +649,6 @@ def validate_sea_state(options, antenna_options: AntennaOptions | None = None) -
 def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_max_deg,
            rms_limit_deg, description, antenna_options: AntennaOptions,
            video_length_s: float = 60.0) -> Setup:
-    # The ideal path below is proportional to the duration: check it first.
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(antenna_options.imu))
     physics = AntennaPhysics.load()
     satellite = ant.satellite_attitude(azimuth, elevation, polarization)
     theta0 = start_angles(motion, satellite, azimuth, elevation, polarization)

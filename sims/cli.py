@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import math
 import os
 import re
@@ -106,34 +107,11 @@ def _checked(kind: str, check, minimum: float | None = None, strict: bool = Fals
     return parse
 
 
-def _wind_speed(value: float) -> None:
+def build_parser() -> argparse.ArgumentParser:
+    from sims.run_limits import check_angle
+    from sims.ship_motion import check_peak_period, check_wave_height
     from sims.wind import check_mean_speed
 
-    check_mean_speed(value)
-
-
-def _wave_height(value: float) -> None:
-    from sims.ship_motion import check_wave_height
-
-    check_wave_height(value)
-
-
-def _peak_period(value: float) -> None:
-    from sims.ship_motion import check_peak_period
-
-    check_peak_period(value)
-
-
-def _angle(kind: str):
-    def check(value: float) -> None:
-        from sims.run_limits import check_angle
-
-        check_angle(kind, value)
-
-    return check
-
-
-def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="planbench", description="MuJoCo testbed for motion planners.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sub.add_parser("list", help="list the scenarios")
@@ -142,16 +120,16 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", help="output directory (default results/NAME); replaced only if "
                      "planbench wrote it")
     run.add_argument("--seed", type=_seed, default=0)
-    run.add_argument("--wind", type=_checked("wind speed", _wind_speed, 0.0),
+    run.add_argument("--wind", type=_checked("wind speed", check_mean_speed, 0.0),
                      help="mean wind, m/s (0 ... 50: IEC 61400-1 class I, the Kaimal model's range)")
     run.add_argument("--elevation", type=_finite("elevation"),
                      help="telescope elevation, deg (hexapod scenarios: 15 ... 90)")
-    run.add_argument("--hs", type=_checked("significant wave height", _wave_height, 0.0, strict=True),
+    run.add_argument("--hs", type=_checked("significant wave height", check_wave_height, 0.0, strict=True),
                      help="significant wave height, m (sea-state scenarios; 0 < Hs <= 20, and no steeper "
                           "than 2 pi Hs / (g Tp^2) = 1/15 at Tp <= 8 s ... 1/25 at Tp >= 15 s, DNV-RP-C205)")
-    run.add_argument("--tp", type=_checked("peak period", _peak_period, 0.0, strict=True),
+    run.add_argument("--tp", type=_checked("peak period", check_peak_period, 0.0, strict=True),
                      help="spectral peak period, s (sea-state scenarios; 1 ... 30, wind seas and swell)")
-    run.add_argument("--heading", type=_checked("wave heading", _angle("wave heading")),
+    run.add_argument("--heading", type=_checked("wave heading", functools.partial(check_angle, "wave heading")),
                      help="wave heading off the bow, deg: 180 head seas, 90 beam seas from starboard "
                           "(sea-state scenarios; -360 ... 360, refused beyond, not wrapped)")
     run.add_argument("--imu-rate", type=_finite("IMU rate", 0.0, strict=True),
@@ -161,7 +139,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="antenna IMU latency, s (a multiple of 5 ms, at most 1 s)")
     run.add_argument("--no-prediction", action="store_true",
                      help="antenna controller: use each IMU sample as it is, no gyro prediction")
-    run.add_argument("--wind-direction", type=_checked("wind direction", _angle("wind direction")),
+    run.add_argument("--wind-direction", type=_checked("wind direction", functools.partial(check_angle, "wind direction")),
                      help="azimuth the wind blows toward, deg from east toward north (FAST scenarios; "
                           "default 0; -360 ... 360, refused beyond, not wrapped)")
     run.add_argument("--cable-segments", type=_cable_segments,
@@ -355,15 +333,15 @@ class _Interrupt:
     """SIGINT, SIGTERM and SIGHUP become one KeyboardInterrupt (the first only: a second
     Ctrl-C must not break the clean-up of the first); ``signum`` remembers which came."""
 
-    SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-
     def __init__(self):
         self.signum = None
         self._old = {}
 
     def __enter__(self):
+        from sims.outputs import INTERRUPT_SIGNALS  # the ones its clean-ups defer
+
         if threading.current_thread() is threading.main_thread():
-            self._old = {s: signal.signal(s, self._handle) for s in self.SIGNALS}
+            self._old = {s: signal.signal(s, self._handle) for s in INTERRUPT_SIGNALS}
         return self
 
     def __exit__(self, *exc):

@@ -430,8 +430,7 @@ def validate(options, default_duration: float | None = None) -> None:
         run_limits.check_angle("wind direction", direction)
     segments = check_cable_segments(getattr(options, "cable_segments", None) or 0)
     duration = options.duration if options.duration is not None else default_duration
-    if duration is not None:
-        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
 
 
 def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | None = None,

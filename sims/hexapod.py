@@ -521,8 +521,7 @@ def validate(options, default_duration: float | None = None) -> None:
         check_elevation(options.elevation)
     wind = DEFAULT_WIND_M_S if options.wind is None else check_mean_speed(options.wind)
     duration = options.duration if options.duration is not None else default_duration
-    if duration is not None:
-        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(wind > 0))
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(wind > 0))
 
 
 def _setup(synchronous: bool, options, controller=None) -> Setup:

@@ -210,8 +210,7 @@ def validate(options, default_duration: float | None = None) -> None:
     memory limit; ``default_duration`` when ``options.duration`` is None, unchecked if both
     are None)."""
     duration = options.duration if options.duration is not None else default_duration
-    if duration is not None:
-        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
 
 
 def _setup(trajectory: Trajectory, key_times, key_points, options) -> Setup:

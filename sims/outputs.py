@@ -60,7 +60,8 @@ _LONGEST_INNER = max(len(n) for n in (*RUN_FILES, *PLAN_FILES, "segments.json", 
                                       "methods.png", "methods.npz", STAGING_MARKER))
 _RENAME_EXCHANGE = 2
 _AT_FDCWD = -100
-_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+#: The signals that interrupt a run (the CLI turns them into exit 128 + signal).
+INTERRUPT_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 class OutputError(ValueError):
@@ -80,7 +81,7 @@ def _version() -> str:
 def signals_deferred():
     """Hold back SIGINT, SIGTERM and SIGHUP: a step in here (a swap, a clean-up) completes,
     and a signal that came meanwhile is delivered right after."""
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, INTERRUPT_SIGNALS)
     try:
         yield
     finally:
@@ -174,7 +175,9 @@ def read_manifest(directory: Path) -> dict | None:
 
 def _foreign_entries(directory: Path) -> list[str] | None:
     """What in ``directory`` planbench did not write: [] for an empty directory or one whose
-    every entry its manifest lists; None when it has entries and no (valid) manifest."""
+    every entry its manifest lists; None when it has entries and no (valid) manifest. A
+    symbolic link is always foreign: planbench writes none, and deleting "through" one could
+    reach a file outside."""
     files, dirs = _entries(directory)
     if not files and not dirs:
         return []
@@ -183,7 +186,26 @@ def _foreign_entries(directory: Path) -> list[str] | None:
         return None
     listed = set(manifest["files"]) | {MANIFEST}
     parents = {p.as_posix() for f in listed for p in Path(f).parents}
-    return sorted([f for f in files if f not in listed] + [d for d in dirs if d not in parents])
+    links = {e for e in files + dirs if os.path.islink(directory / e)}
+    return sorted({f for f in files if f not in listed} | {d for d in dirs if d not in parents} | links)
+
+
+def _remove_listed(root: Path, names) -> None:
+    """Delete the files ``names`` (relative paths) inside ``root``, then the folders that held
+    them once empty. A name is skipped if anything on its way is a symbolic link (the link
+    could lead outside ``root``) or it is not a regular file."""
+    folders = set()
+    for name in names:
+        path = root / name
+        steps = [root / Path(*Path(name).parts[:k]) for k in range(1, len(Path(name).parts))]
+        if any(os.path.islink(p) for p in steps) or os.path.islink(path) or not path.is_file():
+            continue
+        with contextlib.suppress(OSError):
+            path.unlink()
+            folders.update(steps)
+    for folder in sorted(folders, key=lambda p: len(p.parts), reverse=True):
+        with contextlib.suppress(OSError):
+            folder.rmdir()  # only if empty
 
 
 def _shown(names: list[str]) -> str:
@@ -196,15 +218,7 @@ def _discard_old_output(old: Path, target: Path) -> None:
     directory is renamed, visibly, to ``TARGET.kept-<UTC time>`` beside the target, less the
     manifest, so that nothing ever takes it for planbench's again."""
     manifest = read_manifest(old) or {"files": []}
-    for name in manifest["files"]:
-        with contextlib.suppress(OSError):
-            (old / name).unlink()
-    with contextlib.suppress(OSError):
-        (old / MANIFEST).unlink()
-    for root, dirs, _ in os.walk(old, topdown=False):
-        for d in dirs:
-            with contextlib.suppress(OSError):
-                os.rmdir(os.path.join(root, d))
+    _remove_listed(old, [f for f in manifest["files"] if f != MANIFEST] + [MANIFEST])
     try:
         old.rmdir()
     except OSError:
@@ -431,14 +445,7 @@ def swap_in(tmp: Path, target: Path) -> None:
         (target / d).mkdir(exist_ok=True)
     for f in sorted(new_files, key=lambda f: f == MANIFEST):  # the manifest last
         os.replace(tmp / f, target / f)
-    for f in old["files"]:
-        if f not in new_files:
-            with contextlib.suppress(OSError):
-                (target / f).unlink()
-    for root, dirs, _ in os.walk(target, topdown=False):  # the old output's emptied folders
-        for d in dirs:
-            if not os.listdir(os.path.join(root, d)):
-                os.rmdir(os.path.join(root, d))
+    _remove_listed(target, [f for f in old["files"] if f not in new_files])
     shutil.rmtree(tmp)
 
 

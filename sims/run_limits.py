@@ -90,18 +90,20 @@ def floats(n: float) -> float:
     return _BYTES_PER_FLOAT * n
 
 
-def check_duration(duration: float, control_dt: float, bytes_per_tick: float,
-                   limit: tuple[float, str] | None = None) -> float:
+def check_duration(duration: float | None, control_dt: float, bytes_per_tick: float,
+                   limit: tuple[float, str] | None = None) -> float | None:
     """The duration (s) if it is at least one control tick and its log fits the memory limit;
     a RunLimitError naming the value and the limit otherwise.
 
     Args:
-      duration: simulated time asked for, s.
+      duration: simulated time asked for, s; None (nothing asked, no default known) passes.
       control_dt: the scenario's control period, s.
       bytes_per_tick: the log's bytes per control tick (``log_bytes_per_tick`` of the
         mechanism).
       limit: (bytes, why), default ``log_memory_limit()``.
     """
+    if duration is None:
+        return None
     duration = float(duration)
     if not math.isfinite(duration):
         raise RunLimitError(f"duration {duration!r} s is not finite")

@@ -158,6 +158,16 @@ def scenario_run(tmp_path_factory, name: str) -> Written:
     return write(tmp_path_factory, name, setup, setup.duration, scenario.plan, model)
 
 
+def scenario_fixture(name: str):
+    """A module-scoped fixture of the scenario ``name``'s run (``scenario_run``)."""
+
+    @pytest.fixture(scope="module")
+    def run(tmp_path_factory) -> Written:
+        return scenario_run(tmp_path_factory, name)
+
+    return run
+
+
 @pytest.fixture(scope="module", params=list(CHECKS))
 def any_run(request, tmp_path_factory):
     return request.getfixturevalue(_FIXTURE[request.param])
@@ -216,14 +226,10 @@ def assert_value(w: Written, name: str, recomputed: float, rtol: float, atol: fl
 # ============================================================================ loader
 
 
-@pytest.fixture(scope="module")
-def loader_supply(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "loader-supply")
+loader_supply = scenario_fixture("loader-supply")
 
 
-@pytest.fixture(scope="module")
-def loader_direct(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "loader-direct")
+loader_direct = scenario_fixture("loader-direct")
 
 
 @pytest.fixture(params=["loader-supply", "loader-direct"])
@@ -327,14 +333,10 @@ def test_loader_joint_torque(loader):
 # ============================================================================ hexapod
 
 
-@pytest.fixture(scope="module")
-def hexapod_sync(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "hexapod-sync-move")
+hexapod_sync = scenario_fixture("hexapod-sync-move")
 
 
-@pytest.fixture(scope="module")
-def hexapod_async(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "hexapod-async-move")
+hexapod_async = scenario_fixture("hexapod-async-move")
 
 
 @pytest.fixture(scope="module")
@@ -458,14 +460,10 @@ def test_hexapod_stroke(hexapod):
 # ============================================================================ antenna
 
 
-@pytest.fixture(scope="module")
-def antenna_paper(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "antenna-paper-motion")
+antenna_paper = scenario_fixture("antenna-paper-motion")
 
 
-@pytest.fixture(scope="module")
-def antenna_sea(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "antenna-sea-state")
+antenna_sea = scenario_fixture("antenna-sea-state")
 
 
 @pytest.fixture(params=["antenna-paper-motion", "antenna-sea-state"])
@@ -571,19 +569,13 @@ def test_antenna_joint_torque(antenna):
 # ============================================================================ FAST
 
 
-@pytest.fixture(scope="module")
-def fast_tracking(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "fast-tracking")
+fast_tracking = scenario_fixture("fast-tracking")
 
 
-@pytest.fixture(scope="module")
-def fast_ra_scan(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "fast-ra-scan")
+fast_ra_scan = scenario_fixture("fast-ra-scan")
 
 
-@pytest.fixture(scope="module")
-def fast_source_switch(tmp_path_factory):
-    return scenario_run(tmp_path_factory, "fast-source-switch")
+fast_source_switch = scenario_fixture("fast-source-switch")
 
 
 def _short_scan_plan() -> fp.FastPlan:

@@ -371,3 +371,40 @@ def test_a_video_that_appears_during_the_run_is_kept(tmp_path):
     [kept] = tmp_path.glob("clip.new-*.mp4")
     assert kept.read_bytes() == b"rendered"
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["clip.mp4", kept.name])
+
+
+def _output_with_a_linked_folder(tmp_path):
+    """A planbench output ``run`` listing videos/v.mp4, whose folder ``videos`` was then
+    replaced by a link to the user's folder holding a v.mp4 of their own."""
+    out = tmp_path / "run"
+    with OutputDir(out).staging() as tmp:
+        (tmp / "videos").mkdir()
+        (tmp / "videos" / "v.mp4").write_bytes(b"ours")
+    shutil.rmtree(out / "videos")
+    elsewhere = tmp_path / "my-videos"
+    elsewhere.mkdir()
+    (elsewhere / "v.mp4").write_bytes(b"the user's")
+    (out / "videos").symlink_to(elsewhere)
+    return out, elsewhere
+
+
+def test_a_symbolic_link_in_a_planbench_directory_is_foreign(tmp_path):
+    out, elsewhere = _output_with_a_linked_folder(tmp_path)
+    with pytest.raises(OutputError, match=r"holds files planbench did not write \(videos"):
+        OutputDir(out)
+
+
+@pytest.mark.parametrize("exchange", [True, False], ids=["rename-exchange", "per-file-fallback"])
+def test_deleting_the_old_output_never_follows_a_link(exchange, tmp_path, monkeypatch):
+    """Past every check (a link that appears between the last check and the swap): the file
+    the link leads to survives."""
+    monkeypatch.setattr(outputs, "USE_EXCHANGE", exchange)
+    out, elsewhere = _output_with_a_linked_folder(tmp_path)
+    new = outputs._new_staging(tmp_path, "run")
+    (new / "summary.json").write_text("{}")
+    (new / MANIFEST).write_text(json.dumps({"written_by": "planbench", "target": "run",
+                                            "files": ["summary.json", MANIFEST]}))
+    (new / outputs.STAGING_MARKER).unlink()
+    outputs.swap_in(new, out)
+    assert (elsewhere / "v.mp4").read_bytes() == b"the user's"
+    assert (out / "summary.json").read_text() == "{}"
