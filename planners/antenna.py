@@ -524,3 +524,67 @@ def check_rates(rates, limits: AntennaLimits, where: str = "") -> None:
         if value > limit:
             raise LimitError(f"{name} rate {np.degrees(value):.2f} deg/s is beyond its limit "
                              f"{np.degrees(limit):.2f} deg/s{where}")
+
+
+# --------------------------------------------------------------------------------------
+# The planning problem and the online planners
+
+
+@dataclass(frozen=True)
+class AntennaProblem:
+    """The antenna's planning problem: hold a satellite while the ship moves.
+
+    Attributes:
+      satellite: eTs (3, 3), the satellite frame in East-North-Up (its z: the direction to
+        the satellite; its x, y: the polarization).
+      azimuth, elevation, polarization: the same as look angles from the level ship, rad.
+      theta0: (4,) the joint angles at the start, rad.
+      limits: the joint rate limits and the singularity damping.
+      weights: (4,) the joint weights of the weighted pseudo-inverse (paper, eq. 9).
+      update_dt: the interval between two attitude samples (the IMU's period), s.
+    The online planner gets, per sample, N = bTe eTs (paper, eq. 1) and returns Theta.
+    """
+
+    satellite: np.ndarray
+    azimuth: float
+    elevation: float
+    polarization: float
+    theta0: np.ndarray
+    limits: AntennaLimits
+    weights: np.ndarray = field(default_factory=lambda: PAPER_WEIGHTS.copy())
+    update_dt: float = 0.02
+
+
+class CrrPlanner:
+    """The paper's online planner: one CRR update per attitude sample (section 4.2).
+
+    ``step(t, N)`` runs ``crr_step`` from the last solution to N over t - t_last (the first
+    from the problem's theta0 and its attitude at t = 0).
+
+    Args:
+      method: "crr" (the paper's) or "crr-full" (CRR with Newton steps on the whole attitude).
+      omega_method: the angular velocity of step 3: "log" (exact) or "eq6" (the paper's
+        first-order reading).
+    """
+
+    def __init__(self, method: str = "crr", omega_method: str = "log"):
+        if method not in ("crr", "crr-full"):
+            raise PlanningError(f"planner method {method!r} is not 'crr' or 'crr-full'")
+        if omega_method not in ("log", "eq6"):
+            raise PlanningError(f"angular velocity method {omega_method!r} is not 'log' or 'eq6'")
+        self.method = method
+        self.omega_method = omega_method
+        self.last_info = None
+
+    def reset(self, problem: AntennaProblem) -> None:
+        self.problem = problem
+        self.theta = np.asarray(problem.theta0, dtype=float).copy()
+        self.attitude = forward_kinematics(self.theta)
+        self.t = 0.0
+
+    def step(self, t: float, attitude: np.ndarray) -> np.ndarray:
+        p = self.problem
+        theta, info = crr_step(self.theta, self.attitude, attitude, t - self.t, p.weights, limits=p.limits,
+                               omega_method=self.omega_method, full_correction=self.method == "crr-full")
+        self.theta, self.attitude, self.t, self.last_info = theta, attitude, t, info
+        return theta

@@ -446,6 +446,32 @@ class FastPlanSample:
     stewart_leg: np.ndarray
 
 
+def feed_state(t, feed, feed_velocity, feed_acceleration, multifeed, segment=None,
+               geometry: fast.FastGeometry = fast.FAST, limits: fast.FastLimits = fast.FAST_LIMITS
+               ) -> FastPlanSample:
+    """Everything the mechanism must do to put the feed at ``feed`` (n, 3) m: the focal axis,
+    the tilt law, the cabin pose, the A-B angles, the cable lengths and the static tensions
+    (planners.fast), at the times ``t`` (n,) s. ``segment``: (n,) segment indices, or None
+    (-1: a trajectory without segments, e.g. a user's)."""
+    axis = -feed / np.linalg.norm(feed, axis=1, keepdims=True)
+    tilt = fast.tilt_law(geometry, limits)(axis)
+    p = fast.cabin_pose(feed, axis, tilt, geometry)
+    lengths = fast.cable_lengths(p.origin, p.rotation, geometry)
+    tensions = fast.pose_tensions(p, geometry)
+    stewart = np.broadcast_to(fast.stewart_leg_lengths(), (t.size, 6))
+    segment = np.full(t.size, -1) if segment is None else segment
+    return FastPlanSample(t, segment, feed, feed_velocity, feed_acceleration, axis, fast.zenith_angle(axis),
+                          p.cabin_tilt, p.ab_tilt, p.phi, p.theta_a, p.theta_b, multifeed, p.rotation,
+                          p.ab_point, p.origin, lengths, tensions, stewart.copy())
+
+
+def reference_state(reference) -> FastPlanSample:
+    """``feed_state`` of a sampled FAST trajectory (its channels PLAN_LABELS: the feed position
+    and the multi-feed angle are used; the rest follows from them)."""
+    return feed_state(reference.t, reference.position[:, :3], reference.velocity[:, :3],
+                      reference.acceleration[:, :3], reference.position[:, PLAN_LABELS.index("multifeed")])
+
+
 @dataclass
 class FastPlan:
     """A complete plan: segments end to end from t = 0, and the multi-feed rotation.
@@ -556,15 +582,7 @@ class FastPlan:
     def state(self, t) -> FastPlanSample:
         t = sample_times(t)  # a number or 1-D array of finite times
         index, pos, vel, acc = self.feed(t)
-        axis = -pos / np.linalg.norm(pos, axis=1, keepdims=True)
-        tilt = fast.tilt_law(self.geometry, self.limits)(axis)
-        p = fast.cabin_pose(pos, axis, tilt, self.geometry)
-        lengths = fast.cable_lengths(p.origin, p.rotation, self.geometry)
-        tensions = fast.pose_tensions(p, self.geometry)
-        stewart = np.broadcast_to(fast.stewart_leg_lengths(), (t.size, 6))
-        return FastPlanSample(t, index, pos, vel, acc, axis, fast.zenith_angle(axis), p.cabin_tilt,
-                              p.ab_tilt, p.phi, p.theta_a, p.theta_b, self._multifeed(t), p.rotation,
-                              p.ab_point, p.origin, lengths, tensions, stewart.copy())
+        return feed_state(t, pos, vel, acc, self._multifeed(t), index, self.geometry, self.limits)
 
     def _channels(self, t) -> np.ndarray:
         s = self.state(t)
@@ -685,3 +703,65 @@ class _Window:
 
     def evaluate(self, tau):
         return self.profile.evaluate(np.asarray(tau) + self.offset)
+
+
+# ----------------------------------------------------------------------------- the planning problem
+
+
+@dataclass(frozen=True)
+class ObservingWindow:
+    """A time span of the run during which the feed must be on its goal path.
+
+    Attributes:
+      name: the goal plan's segment (e.g. "observation (3C 286)", "leg 2", "transition 1").
+      t_start, t_end: s from the start of the run.
+    """
+
+    name: str
+    t_start: float
+    t_end: float
+
+
+@dataclass(frozen=True)
+class FastProblem:
+    """FAST's planning problem: the sources and times of an observing session.
+
+    Attributes:
+      park: (3,) the feed's position at the start, m (at rest).
+      windows: the observing windows, in time order.
+      goal: the paper's plan of the session (``FastPlan``): during the windows its feed path
+        is the goal, the sources' focal points (observations, scan legs) and the scans'
+        transitions; a planner may reuse its segments.
+      info: the session in words and numbers (sources, UTC, scan parameters).
+      geometry, limits: the mechanism (planners.fast).
+    A planner returns a Trajectory with the channels PLAN_LABELS; the task judges its feed
+    against ``goal`` during the windows, and its cable tensions everywhere.
+    """
+
+    park: np.ndarray
+    windows: tuple
+    goal: "FastPlan"
+    info: dict = field(default_factory=dict)
+    geometry: fast.FastGeometry = fast.FAST
+    limits: fast.FastLimits = fast.FAST_LIMITS
+
+    @property
+    def duration(self) -> float:
+        """The session's length, s: the goal plan's."""
+        return self.goal.duration
+
+
+class PaperPlanner:
+    """The paper's planner (sections 3.1-3.3): its plan of the session is the goal itself."""
+
+    def plan(self, problem: FastProblem) -> "FastPlan":
+        return problem.goal
+
+
+def problem_of(plan: "FastPlan", observing_prefixes: tuple, park=None) -> FastProblem:
+    """The problem whose goal is ``plan``: its windows are the segments whose names start with
+    ``observing_prefixes``; the park position is the plan's first feed position."""
+    windows = tuple(ObservingWindow(s.name, float(s.t0), float(s.t0 + s.duration))
+                    for s in plan.segments if s.name.startswith(observing_prefixes))
+    start = plan.feed(np.array([0.0]))[1][0] if park is None else np.asarray(park, dtype=float)
+    return FastProblem(start, windows, plan, dict(plan.info), plan.geometry, plan.limits)

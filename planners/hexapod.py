@@ -769,3 +769,46 @@ def plan_move(start_pose, target_pose, synchronous: bool = True,
     """One pose-to-pose move (the paper's iteration for the long-move acceleration)."""
     return plan_moves(start_pose, target_pose, synchronous, geometry, limits, dt,
                       method="iteration").move(0)
+
+
+@dataclass(frozen=True)
+class MoveProblem:
+    """The hexapod's planning problem: one pose-to-pose move within the limits.
+
+    Attributes:
+      start_pose, target_pose: (6,) poses (x, y, z, rx, ry, rz) of the mirror-side pivot
+        frame, m and rad (the paper's hexapod coordinates).
+      synchronous: all six struts must arrive on the same tick (else each at its own time).
+      limits: pose limits, stroke, strut speed and acceleration, hexapod-space speeds.
+      geometry: the pivots and nominal strut lengths.
+      dt: the controller's tick, s: the trajectory is sampled at it.
+    The trajectory's channels are the six strut length changes STRUT_LABELS, m.
+    """
+
+    start_pose: np.ndarray
+    target_pose: np.ndarray
+    synchronous: bool = True
+    limits: HexapodLimits = RUBIN_LIMITS
+    geometry: HexapodGeometry = RUBIN_CAMERA
+    dt: float = CONTROL_DT
+
+
+class PaperMovePlanner:
+    """The paper's move generator (``plan_move``): synchronous or asynchronous as the problem
+    says, the long-move acceleration by the paper's iteration."""
+
+    def plan(self, problem: MoveProblem) -> StrutMove:
+        return plan_move(problem.start_pose, problem.target_pose, problem.synchronous,
+                         problem.geometry, problem.limits, problem.dt)
+
+
+def own_move_times(problem: MoveProblem) -> np.ndarray:
+    """(6,) each strut's own minimum move time for the problem, s: twice the larger of its
+    strut-space half time under v_max and a_max and the move's hexapod-space time
+    (``strut_min_time``, ``hexapod_space_min_time``), before any tick rounding. What the
+    asynchronous check compares each strut's arrival with, from the problem alone."""
+    start = strut_positions(np.atleast_2d(problem.start_pose), problem.geometry)
+    target = strut_positions(np.atleast_2d(problem.target_pose), problem.geometry)
+    half = np.abs(target - start) / 2.0
+    t_hex = hexapod_space_min_time(np.atleast_2d(problem.target_pose - problem.start_pose), problem.limits)
+    return 2.0 * np.maximum(strut_min_time(half, problem.limits), t_hex[:, None])[0]

@@ -9,6 +9,8 @@ model's joints is in ``models/loader/README.md``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -42,6 +44,53 @@ def si_to_table1(q: np.ndarray) -> np.ndarray:
     """Joint SI units (m, rad) to Table 1 units (mm, deg)."""
     q = np.asarray(q, dtype=float)
     return np.concatenate([q[..., :1] * 1e3, np.rad2deg(q[..., 1:])], axis=-1)
+
+
+@dataclass(frozen=True)
+class LoaderProblem:
+    """The loader's planning problem: pass through key points at given times, within limits.
+
+    Attributes:
+      key_times: (k,) s, increasing, from 0.
+      key_points: (k, 6) joint values theta1 (m) and theta2 ... theta6 (rad) at those times.
+      labels: the joint names, in the key points' column order (the trajectory's channels).
+      lower, upper: (6,) joint ranges, m and rad.
+      rate_limit: (6,) the drives' set-point rate limits, m/s and rad/s.
+      force_limit: (6,) the drives' force and torque limits, N and N m.
+    """
+
+    key_times: np.ndarray
+    key_points: np.ndarray
+    labels: tuple
+    lower: np.ndarray
+    upper: np.ndarray
+    rate_limit: np.ndarray
+    force_limit: np.ndarray
+
+
+def supply_problem(spec: SerialChainSpec | None = None) -> LoaderProblem:
+    """The paper's supply stage: Table 1's P2, M1 ... M4, P3 at t = 0, 0.5, ... 2.5 s."""
+    return _problem(TABLE1_TIMES, table1_to_si(TABLE1), spec or loader_spec())
+
+
+def direct_problem(spec: SerialChainSpec | None = None) -> LoaderProblem:
+    """P2 to P3 in the same 2.5 s, with no key points between (the obstacles are the
+    planner's to avoid)."""
+    return _problem(TABLE1_TIMES[[0, -1]], table1_to_si(TABLE1)[[0, -1]], spec or loader_spec())
+
+
+def _problem(times, points, spec: SerialChainSpec) -> LoaderProblem:
+    return LoaderProblem(np.asarray(times, dtype=float), np.asarray(points, dtype=float), tuple(spec.names),
+                         spec.lower, spec.upper, spec.rate_limit, spec.force_limit)
+
+
+class CubicBSplinePlanner:
+    """The paper's planner: the cubic B-spline through the problem's key points (section 3,
+    ``planners.bspline``), checked against the joint ranges."""
+
+    def plan(self, problem: LoaderProblem) -> CubicBSplineTrajectory:
+        return CubicBSplineTrajectory(problem.key_times, problem.key_points, labels=list(problem.labels),
+                                      lower=problem.lower, upper=problem.upper)
 
 
 def supply_plan(spec: SerialChainSpec | None = None) -> CubicBSplineTrajectory:

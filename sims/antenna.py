@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import functools
 import math
-import time
 from collections import deque
 from dataclasses import dataclass
 
@@ -40,6 +39,7 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
+from sims.task import ControlContext, JointEncoders, nominal_copy, RecordingPlanner, Sensors, SensorSpec, check_planner
 from sims.ship_motion import PaperShipMotion, SeaStateMotion, check_sea_state, world_from_ship
 
 CONTROL_DT = 0.005  # s: the runner's tick; the IMU rate is a whole number of ticks
@@ -195,20 +195,33 @@ class ShipMotionDrive:
     def __init__(self, physics: AntennaPhysics, motion):
         kp, kv = physics.drive_gains(DECK_JOINTS)
         self.motion = motion
-        self.servo = ServoFeedforwardController(kp, kv, physics.deck_dofs, joint_qpos=physics.deck_qpos)
+        self.servo = ServoFeedforwardController(kp, kv)
+        self.qpos_adr = physics.deck_qpos
         self.reference = None
 
     def reset(self, physics, times, rng) -> None:
+        # The deck drives are the model's first four actuators; the sea's servo reads the
+        # deck joints exactly (it is the plant, not a controller under test).
         self.reference = ShipMotionTrajectory(self.motion, times[-1]).sample(times)
-        self.servo.reset(physics, self.reference, times[1] - times[0] if times.size > 1 else CONTROL_DT)
+        model, data = physics.model.ptr, physics.data.ptr
+        encoders = JointEncoders(physics.deck_qpos, physics.deck_dofs, model.actuator_actadr[:4],
+                                 "deck joints", "m|rad", CONTROL_DT)
+        self.observation = encoders.reset(physics, times, 0)
+        self.encoders = encoders
+        dt = times[1] - times[0] if times.size > 1 else CONTROL_DT
+        self.servo.reset(ControlContext(
+            model=model, nominal_physics=nominal_copy(physics), problem=None, trajectory=None,
+            reference=self.reference, control_dt=dt, command=data.ctrl, setpoint=data.act,
+            actuators=DECK_JOINTS, observation=self.observation))
 
     def __call__(self, tick: int, physics) -> None:
-        self.servo(tick, physics)
+        self.encoders(tick, physics)
+        self.servo(tick, self.observation)
 
     def tracking_error(self, log: RunLog) -> np.ndarray:
         """(4,) largest |deck joint - ship motion| over the run (m, rad)."""
         n = log.t.size
-        deck = log.qpos[:, self.servo.qpos_adr]
+        deck = log.qpos[:, self.qpos_adr]
         return np.abs(deck - self.reference.position[:n]).max(axis=0)
 
 
@@ -257,94 +270,67 @@ class ImuModel:
         return int(round(period)), int(round(latency))
 
 
-class AntennaController:
-    """Reads the IMU, runs the joint-position planner per sample, drives the antenna servos.
+class AntennaImu(Sensors):
+    """The antenna's sensors: the IMU on the pedestal base, and the antenna's encoders.
 
-    Per control tick: every ``n`` ticks (the IMU period) the IMU is sampled with noise; a
-    sample reaches the controller ``latency`` ticks later. On each arrival the deck attitude
-    is predicted to the next arrival (``predict``: from the gyro rate and its change over the
-    last sample, R(t) = R_m exp([w tau + a tau^2 / 2]x); without: the last sample is used as
-    is), N = R^T eTs (eq. 1) and one planner step gives the joint angles for that time. The
-    set-points ramp to them linearly, plus kv/kp times the joint rates that hold the attitude
-    against the (predicted) gyro rate, ramped between updates (the servo's velocity
-    feed-forward), so the drive force is a PD on the error to the ramp.
+    The IMU is sampled every ``imu.ticks`` control ticks from MuJoCo's ``imu_quat`` and
+    ``imu_gyro`` sensors; its attitude error is a first-order Gauss-Markov process, its gyro
+    noise white (``ImuModel``); a sample reaches the controller ``latency`` ticks later (the
+    newest that has arrived by a tick is the one it sees). The first sample is taken and
+    delivered at t = 0 (the run starts in steady tracking).
 
-    Args:
-      satellite: eTs, (3, 3), the satellite frame in East-North-Up.
-      imu: ImuModel.
-      method: "crr" or "crr-full" (planners.antenna).
-      predict: False to use each IMU sample as it is (its age becomes lag).
-      limits: planners.antenna.AntennaLimits for the rate-aware solution (None: the model's).
-      omega_method: the angular velocity of CRR's step 3: "log" (exact) or "eq6" (the paper's
-        first-order reading); at the IMU's 20 ms the first-order one leaves ~1e-7 of
-        attitude error per update under the paper's motion, the exact one ~1e-11.
-      seed: seed of the IMU noise.
+    Observation keys:
+      imu_attitude (3, 3): the measured deck attitude, world from IMU frame.
+      imu_gyro (3,): the measured angular rate, rad/s, in the IMU frame.
+      imu_time (1,): when that sample was taken, s (MuJoCo's sensors after a step describe
+        the start of its last physics step).
+      imu_count (1,): samples delivered so far (a new one arrived when it changes).
+      joint_positions, joint_velocities, setpoints (4,): the antenna's encoders (exact) and
+        its drives' set-points, rad and rad/s.
     """
 
-    def __init__(self, satellite: np.ndarray, imu: ImuModel = ImuModel(), method: str = "crr",
-                 predict: bool = True, limits: ant.AntennaLimits | None = None,
-                 weights=ant.PAPER_WEIGHTS, omega_method: str = "log", seed: int = 0):
-        if method not in ("crr", "crr-full"):
-            raise PlanningError(f"controller method {method!r} is not 'crr' or 'crr-full'")
-        self.satellite = np.asarray(satellite, dtype=float)
+    def __init__(self, physics: "AntennaPhysics", imu: ImuModel, control_dt: float):
+        super().__init__()
         self.imu = imu
-        self.method = method
-        self.predict = predict
-        self.limits = limits
-        self.weights = np.asarray(weights, dtype=float)
-        self.omega_method = omega_method
-        self.seed = seed
-
-    # Per-update log, filled during the run.
-    def _new_log(self, size: int) -> None:
-        self.update_t = np.full(size, np.nan)
-        self.update_theta = np.full((size, 4), np.nan)
-        self.update_error_fro = np.full(size, np.nan)
-        self.update_iterations = np.zeros(size, dtype=int)
-        self.update_damped = np.zeros(size, dtype=bool)
-        self.update_rate_limited = np.zeros(size, dtype=bool)
-        self.updates = 0
-        self.planner_wall_s = 0.0  # wall time spent in the planner updates
-
-    def reset(self, physics: AntennaPhysics, reference: TrajectorySample, control_dt: float) -> None:
         self.dt = control_dt
-        self.period, self.latency = self.imu.ticks(control_dt)
-        self.rng = np.random.default_rng([self.seed, 0x1A7E])
-        self.att_sigma = math.radians(self.imu.attitude_noise_deg)
-        h, corr = self.period * control_dt, self.imu.attitude_noise_time_s
+        self.period, self.latency = imu.ticks(control_dt)
+        self.encoders = JointEncoders(physics.antenna_qpos, physics.antenna_dofs,
+                                      physics.model.ptr.actuator_actadr[physics.antenna_actuators],
+                                      "antenna joint encoders theta1 ... theta4", "rad", control_dt)
+        self.specs = [
+            SensorSpec("imu_attitude", "deck attitude of the pedestal IMU (world from IMU)", "rotation matrix",
+                       imu.rate_hz, imu.latency_s,
+                       f"Gauss-Markov, {imu.attitude_noise_deg:g} deg 1-sigma per axis, correlation time "
+                       f"{imu.attitude_noise_time_s:g} s"),
+            SensorSpec("imu_gyro", "angular rate of the pedestal IMU, IMU frame", "rad/s", imu.rate_hz,
+                       imu.latency_s, f"white, {imu.gyro_noise_deg_s:g} deg/s 1-sigma per axis"),
+        ] + self.encoders.specs
+
+    def reset(self, physics, times: np.ndarray, seed: int) -> dict:
+        imu = self.imu
+        self.rng = np.random.default_rng([seed, 0x1A7E])
+        self.att_sigma = math.radians(imu.attitude_noise_deg)
+        h, corr = self.period * self.dt, imu.attitude_noise_time_s
         self.att_decay = math.exp(-h / corr) if corr > 0 else 0.0
         self.att_error = self.rng.normal(0.0, self.att_sigma, 3)  # stationary start
-        self.gyro_sigma = math.radians(self.imu.gyro_noise_deg_s)
-        model = physics.model.ptr
-        self.physics_dt = model.opt.timestep
+        self.gyro_sigma = math.radians(imu.gyro_noise_deg_s)
+        self.physics_dt = physics.model.ptr.opt.timestep
         self.quat_slice = physics.sensor_slice("imu_quat")
         self.gyro_slice = physics.sensor_slice("imu_gyro")
-        self.actuators = physics.antenna_actuators
-        self.qpos_adr = physics.antenna_qpos
-        kp, kv = physics.drive_gains()
-        self.lead = kv / kp  # s: velocity feed-forward through the set-point
-        if self.limits is None:
-            self.limits = ant.AntennaLimits(rate=physics.rate_limit())
-        data = physics.data.ptr
-        theta = data.qpos[self.qpos_adr].copy()
-        self.theta_from, self.theta_to = theta.copy(), theta.copy()
-        self.ff_from = data.qvel[physics.antenna_dofs].copy()
-        self.ff_to = self.ff_from.copy()
-        self.tick_from, self.tick_to = 0, 0
-        self.attitude = ant.forward_kinematics(theta)  # N at tick_to
+        self._data = physics.data.ptr
         self.queue = deque()
-        self.last_gyro = None
-        n_ticks = reference.t.size
-        self._new_log(n_ticks // self.period + 2)
-        # The first sample is taken and used at t = 0 (the run starts in steady tracking).
-        self._measure(0, data, lag=0.0)  # mj_forward just evaluated the sensors at t = 0
-        self._update(0, self.queue.popleft()[1])
+        obs = dict(self.encoders.reset(physics, times, seed))
+        obs.update(imu_attitude=np.eye(3), imu_gyro=np.zeros(3), imu_time=np.zeros(1),
+                   imu_count=np.zeros(1, dtype=int))
+        self.observation = obs
+        self._measure(0, lag=0.0)  # mj_forward just evaluated the sensors at t = 0
+        self._deliver(self.queue.popleft()[1])
+        return obs
 
-    def _measure(self, tick: int, data, lag: float | None = None) -> None:
-        sd = data.sensordata
-        q = sd[self.quat_slice]
+    def _measure(self, tick: int, lag: float | None = None) -> None:
+        sd = self._data.sensordata
         rotation = np.empty(9)
-        mujoco.mju_quat2Mat(rotation, q)
+        mujoco.mju_quat2Mat(rotation, sd[self.quat_slice])
         rotation = rotation.reshape(3, 3)
         if self.att_sigma > 0:
             if tick > 0:
@@ -359,9 +345,72 @@ class AntennaController:
         arrival = tick + self.latency if tick > 0 else 0
         self.queue.append((arrival, (tick * self.dt - lag, rotation, gyro)))
 
-    def _update(self, tick: int, sample) -> None:
-        start = time.perf_counter()
-        measured_t, rotation, gyro = sample
+    def _deliver(self, sample) -> None:
+        obs = self.observation
+        obs["imu_time"][0], obs["imu_attitude"][:], obs["imu_gyro"][:] = sample
+        obs["imu_count"][0] += 1
+
+    def __call__(self, tick: int, physics) -> None:
+        self.encoders(tick, physics)
+        if tick > 0 and tick % self.period == 0:
+            self._measure(tick)
+        sample = None
+        while self.queue and self.queue[0][0] <= tick:  # the newest sample that has arrived
+            sample = self.queue.popleft()[1]
+        if sample is not None:
+            self._deliver(sample)
+
+
+class AntennaController:
+    """Reads the IMU, asks the online planner for the joint solution, drives the antenna servos.
+
+    On each IMU sample (a new ``imu_count``) the deck attitude is predicted to the next
+    sample's arrival (``predict``: from the gyro rate and its change over the last sample,
+    R(t) = R_m exp([w tau + a tau^2 / 2]x); without: the last sample is used as is), N = R^T eTs
+    (eq. 1) and the planner (``ControlContext.planner``, the paper's CRR by default) gives the
+    joint angles for that time. The set-points ramp to them linearly, plus kv/kp times the
+    joint rates that hold the attitude against the (predicted) gyro rate, ramped between
+    updates (the servo's velocity feed-forward), so the drive force is a PD on the error to the
+    ramp. The IMU's rate and latency are the sensor's published ones (``ControlContext``'s
+    sensor specs), as a real controller is configured with its IMU's datasheet.
+
+    Args:
+      predict: False to use each IMU sample as it is (its age becomes lag).
+    """
+
+    def __init__(self, predict: bool = True):
+        self.predict = predict
+
+    def reset(self, context) -> None:
+        problem = context.problem
+        self.planner = context.planner
+        self.satellite = problem.satellite
+        self.weights = problem.weights
+        self.limits = problem.limits
+        self.dt = context.control_dt
+        imu = next(s for s in context.sensors if s.name == "imu_attitude")
+        self.period = int(round(1.0 / (imu.rate_hz * self.dt)))
+        self.latency = int(round(imu.latency_s / self.dt))
+        model = context.model
+        self.actuators = np.array([model.actuator(n).id for n in JOINTS])
+        self.act_adr = model.actuator_actadr[self.actuators]
+        kp = model.actuator_gainprm[self.actuators, 0]
+        kv = -model.actuator_biasprm[self.actuators, 2]
+        self.lead = kv / kp  # s: velocity feed-forward through the set-point
+        obs = context.observation
+        theta = obs["joint_positions"].copy()
+        self.theta_from, self.theta_to = theta.copy(), theta.copy()
+        self.ff_from = obs["joint_velocities"].copy()
+        self.ff_to = self.ff_from.copy()
+        self.tick_from, self.tick_to = 0, 0
+        self.last_gyro = None
+        self.command = context.command
+        # The first sample arrived at t = 0: the first update is planned now.
+        self.seen = int(obs["imu_count"][0])
+        self._update(0, obs)
+
+    def _update(self, tick: int, obs) -> None:
+        measured_t, rotation, gyro = float(obs["imu_time"][0]), obs["imu_attitude"], obs["imu_gyro"].copy()
         target_tick = tick + self.period if tick > 0 else self.period + self.latency
         rate = gyro
         if self.predict:
@@ -371,25 +420,13 @@ class AntennaController:
             rate = gyro + accel * tau
         self.last_gyro = gyro
         attitude = rotation.T @ self.satellite
-        step_dt = (target_tick - self.tick_to) * self.dt
-        theta, info = ant.crr_step(self.theta_to, self.attitude, attitude, step_dt, self.weights,
-                                   limits=self.limits, omega_method=self.omega_method,
-                                   full_correction=self.method == "crr-full")
+        theta = self.planner.step(target_tick * self.dt, attitude)
         # N = R^T eTs turns at -w_body in the ship frame: the joint rates that hold it, from
         # the gyro (its noise is far smaller than that of differenced attitudes).
         feedforward = ant.joint_rates(theta, -rate, self.weights, self.limits)[0]
         self.theta_from, self.ff_from = self._ramp(tick), self._feedforward(tick)
         self.tick_from, self.tick_to = tick, target_tick
-        self.theta_to, self.ff_to, self.attitude = theta, feedforward, attitude
-        i = self.updates
-        self.update_t[i] = target_tick * self.dt
-        self.update_theta[i] = theta
-        self.update_error_fro[i] = info.error_fro
-        self.update_iterations[i] = info.iterations
-        self.update_damped[i] = info.damped
-        self.update_rate_limited[i] = info.rate_limited
-        self.updates += 1
-        self.planner_wall_s += time.perf_counter() - start
+        self.theta_to, self.ff_to = theta, feedforward
 
     def _fraction(self, tick: int) -> float:
         span = self.tick_to - self.tick_from
@@ -401,25 +438,13 @@ class AntennaController:
     def _ramp(self, tick: int) -> np.ndarray:
         return self.theta_from + self._fraction(tick) * (self.theta_to - self.theta_from)
 
-    def __call__(self, tick: int, physics) -> None:
-        data = physics.data.ptr
-        if tick > 0 and tick % self.period == 0:
-            self._measure(tick, data)
-        sample = None
-        while self.queue and self.queue[0][0] <= tick:  # the newest sample that has arrived
-            sample = self.queue.popleft()[1]
-        if sample is not None:
-            self._update(tick, sample)
+    def __call__(self, tick: int, observation) -> None:
+        count = int(observation["imu_count"][0])
+        if count != self.seen:
+            self.seen = count
+            self._update(tick, observation)
         target = self._ramp(tick + 1) + self.lead * self._feedforward(tick + 1)
-        data.ctrl[self.actuators] = (target - data.act[self.actuators]) / self.dt
-
-    def update_log(self) -> dict:
-        n = self.updates
-        return {
-            "t": self.update_t[:n], "theta": self.update_theta[:n],
-            "error_fro": self.update_error_fro[:n], "iterations": self.update_iterations[:n],
-            "damped": self.update_damped[:n], "rate_limited": self.update_rate_limited[:n],
-        }
+        self.command[self.actuators] = (target - observation["setpoints"]) / self.dt
 
 
 def _exp_so3(rotvec) -> np.ndarray:
@@ -454,13 +479,13 @@ def pointing_errors(dish: np.ndarray, satellite: np.ndarray):
 class AntennaEvaluation:
     """Checks and outputs of an antenna run."""
 
-    def __init__(self, physics: AntennaPhysics, satellite, controller: AntennaController,
+    def __init__(self, physics: AntennaPhysics, satellite, planner: RecordingPlanner,
                  drive: "ShipMotionDrive", pointing_max_deg: float, rms_limit_deg: float | None,
                  description: dict):
         self.physics = physics
         self.drive = drive
         self.satellite = satellite
-        self.controller = controller
+        self.planner = planner  # the task's record of every update the planner returned
         self.pointing_max_deg = pointing_max_deg
         self.rms_limit_deg = rms_limit_deg
         self.description = description
@@ -468,6 +493,15 @@ class AntennaEvaluation:
     def _joint_log(self, log: RunLog):
         p = self.physics
         return log.qpos[:, p.antenna_qpos], log.qvel[:, p.antenna_dofs]
+
+    def updates(self) -> dict:
+        """The planner's updates as the task recorded them, with ||f(Theta) - N||_F of each:
+        the returned angles against the attitude they were asked for."""
+        records = self.planner.records()
+        # One matrix at a time: the same arithmetic as the planner's own residual, to the bit.
+        records["error_fro"] = np.array([float(ant.frobenius_error(ant.forward_kinematics(theta), n))
+                                         for theta, n in zip(records["theta"], records["attitude"])])
+        return records
 
     def errors_deg(self, log: RunLog):
         pointing, twist = pointing_errors(self.physics.dish_rotation(log.qpos), self.satellite)
@@ -482,7 +516,7 @@ class AntennaEvaluation:
         torque_ratio = np.abs(torque).max(0) / p.torque_limit()
         rate_ratio = np.abs(qd).max(0) / p.rate_limit()
         ctrl_ratio = np.abs(log.ctrl[:, p.antenna_actuators]).max(0) / p.rate_limit()
-        updates = self.controller.update_log()
+        updates = self.updates()
         deck_error = self.drive.tracking_error(log)
         checks = [
             Check("pointing_error_max", float(pointing.max()), self.pointing_max_deg, "deg",
@@ -498,7 +532,7 @@ class AntennaEvaluation:
             Check("polarization_error_max", float(np.abs(polarization).max()), POLARIZATION_MAX_DEG, "deg"),
             Check("attitude_error_fro_max", float(np.max(updates["error_fro"], initial=0.0)),
                   ATTITUDE_FRO_LIMIT, "1",  # a norm of rotation matrices: dimensionless
-                  note=f"the planner's ||f(Theta) - N||_F over {updates['t'].size} updates"),
+                  note=f"||f(Theta) - N||_F of the angles the planner returned, over {updates['t'].size} updates"),
             Check("joint_rate", float(rate_ratio.max()), 1.0, "of limit",
                   note=f"measured joint speed / rated speed, worst {JOINTS[int(np.argmax(rate_ratio))]}"),
             Check("joint_torque", float(torque_ratio.max()), 1.0, "of limit",
@@ -515,7 +549,7 @@ class AntennaEvaluation:
             "joint_range_deg": {n: [float(np.degrees(q[:, j].min()).round(3)), float(np.degrees(q[:, j].max()).round(3))]
                                 for j, n in enumerate(JOINTS)},
             "planner_updates": int(updates["t"].size),
-            "planner_wall_s": self.controller.planner_wall_s,
+            "planner_wall_s": self.planner.wall_s,
             "newton_iterations_mean": float(np.mean(updates["iterations"])) if updates["t"].size else 0.0,
             "newton_iterations_max": int(np.max(updates["iterations"], initial=0)),
             # Distance to a singularity along the run: sigma_min of J W^-1/2 (0 = singular;
@@ -537,7 +571,7 @@ class AntennaEvaluation:
         q, qd = self._joint_log(log)
         kp, kv = p.drive_gains()
         pointing, polarization = self.errors_deg(log)
-        updates = self.controller.update_log()
+        updates = self.updates()
         deck = log.qpos[:, p.deck_qpos]
         return {
             "joint_names": np.array(JOINTS),
@@ -596,8 +630,8 @@ def _slerp(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class AntennaOptions:
-    """How the antenna's controller is set up (tests and users vary it; the CLI runs the
-    defaults)."""
+    """How the antenna's sensors, controller and planner are set up (tests and users vary it;
+    the CLI sets the IMU's rate and latency and the prediction)."""
 
     imu: ImuModel = ImuModel()
     predict: bool = True
@@ -608,12 +642,13 @@ class AntennaOptions:
 def log_bytes_per_tick(imu: ImuModel = ImuModel()) -> float:
     """Bytes an antenna run preallocates per control tick: the runner's log of the compiled
     model (4 planned joints); the deck drive's ship-motion reference (t and 3 x 4) and its
-    servo's set-points and feed-forward (4 + 4); the controller's per-update log (t, 4
-    angles, error, iterations, two flags) once per IMU sample; the ideal joint path every
+    servo's set-points and feed-forward (4 + 4); the task's record of the planner's updates
+    (t, the 3 x 3 attitude, 4 angles, iterations, two flags) once per IMU sample; the ideal
+    joint path every
     REFERENCE_DT (t, 4 angles, error, iterations, two flags and its spline's 16
     coefficients)."""
     period, _ = imu.ticks(CONTROL_DT)
-    floats = (run_limits.runlog_floats_per_tick(_model(), 4) + 13 + 8 + (7 + 2 / 8) / period
+    floats = (run_limits.runlog_floats_per_tick(_model(), 4) + 13 + 8 + (15 + 2 / 8) / period
               + (7 + 2 / 8 + 16) * CONTROL_DT / REFERENCE_DT)
     return run_limits.floats(floats)
 
@@ -648,7 +683,7 @@ def validate_sea_state(options, antenna_options: AntennaOptions | None = None) -
 
 def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_max_deg,
            rms_limit_deg, description, antenna_options: AntennaOptions,
-           video_length_s: float = 60.0) -> Setup:
+           video_length_s: float = 60.0, planner=None, controller=None) -> Setup:
     physics = AntennaPhysics.load()
     satellite = ant.satellite_attitude(azimuth, elevation, polarization)
     theta0 = start_angles(motion, satellite, azimuth, elevation, polarization)
@@ -658,9 +693,17 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
     deck_pos, deck_vel, _ = ship0.joint_arrays()
     physics.set_state(deck_pos[0], deck_vel[0], start.position[0], start.velocity[0])
     drive = ShipMotionDrive(physics, motion)
-    controller = AntennaController(satellite, antenna_options.imu, antenna_options.method,
-                                   antenna_options.predict, omega_method=antenna_options.omega_method,
-                                   seed=seed)
+    imu = antenna_options.imu
+    problem = ant.AntennaProblem(satellite, float(azimuth), float(elevation), float(polarization),
+                                 start.position[0].copy(), ant.AntennaLimits(rate=physics.rate_limit()),
+                                 update_dt=1.0 / imu.rate_hz)
+    if planner is None:
+        planner = ant.CrrPlanner(antenna_options.method, antenna_options.omega_method)
+    check_planner(planner, online=True)
+    period, _ = imu.ticks(CONTROL_DT)
+    recorder = RecordingPlanner(planner, int(math.ceil(duration / (period * CONTROL_DT))) + 2)
+    if controller is None:
+        controller = AntennaController(antenna_options.predict)
     description = dict(description)
     description.update({
         "imu_rate_hz": antenna_options.imu.rate_hz,
@@ -669,15 +712,19 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
         "imu_attitude_noise_time_s": antenna_options.imu.attitude_noise_time_s,
         "imu_gyro_noise_deg_s": antenna_options.imu.gyro_noise_deg_s,
         "prediction": antenna_options.predict,
-        "planner": antenna_options.method,
-        "planner_angular_velocity": antenna_options.omega_method,
     })
-    evaluation = AntennaEvaluation(physics, satellite, controller, drive, pointing_max_deg,
+    if isinstance(planner, ant.CrrPlanner):
+        description.update({"planner": planner.method, "planner_angular_velocity": planner.omega_method})
+    evaluation = AntennaEvaluation(physics, satellite, recorder, drive, pointing_max_deg,
                                    rms_limit_deg, description)
     return Setup(
         physics=physics,
         trajectory=reference,
         controller=controller,
+        sensors=AntennaImu(physics, imu, CONTROL_DT),
+        problem=problem,
+        planner=recorder,
+        controlled=physics.antenna_actuators,
         control_dt=CONTROL_DT,
         duration=duration,
         evaluate=evaluation,
@@ -704,7 +751,8 @@ def _antenna_options(options, antenna_options: AntennaOptions | None) -> Antenna
     return AntennaOptions(imu=imu, predict=options.predict)
 
 
-def build_paper_motion(options, antenna_options: AntennaOptions | None = None) -> Setup:
+def build_paper_motion(options, antenna_options: AntennaOptions | None = None, planner=None,
+                       controller=None) -> Setup:
     """The paper's section 5.1: eq. (15)-(16) ship motion, satellite at 223.49/60/-28.8 deg."""
     validate_paper_motion(options, antenna_options)
     az, el, pol = np.radians(ant.PAPER_SATELLITE_DEG)
@@ -714,7 +762,7 @@ def build_paper_motion(options, antenna_options: AntennaOptions | None = None) -
     # A 30 s video: the 8 s and 10 s periods shown at 4 s and 5 s.
     return _setup(PaperShipMotion(), az, el, pol, duration, options.seed, POINTING_MAX_PAPER_DEG,
                   None, description, _antenna_options(options, antenna_options),
-                  video_length_s=30.0)
+                  video_length_s=30.0, planner=planner, controller=controller)
 
 
 def sea_state_motion(hs: float, tp: float, heading_deg: float, seed: int) -> SeaStateMotion:
@@ -725,7 +773,8 @@ def sea_state_motion(hs: float, tp: float, heading_deg: float, seed: int) -> Sea
     return SeaStateMotion(hs, tp, heading_deg, np.random.default_rng([seed, 0x5EA]))
 
 
-def build_sea_state(options, antenna_options: AntennaOptions | None = None) -> Setup:
+def build_sea_state(options, antenna_options: AntennaOptions | None = None, planner=None,
+                    controller=None) -> Setup:
     """A JONSWAP sea state; the satellite named by its orbital slot and the ship's position."""
     validate_sea_state(options, antenna_options)
     hs = SEA_HS_M if options.hs is None else options.hs
@@ -745,7 +794,8 @@ def build_sea_state(options, antenna_options: AntennaOptions | None = None) -> S
         "satellite_az_el_pol_deg": np.degrees([az, el, pol]).round(4).tolist(),
     }
     return _setup(motion, az, el, pol, duration, options.seed, POINTING_MAX_SEA_DEG,
-                  POINTING_RMS_DEG, description, _antenna_options(options, antenna_options))
+                  POINTING_RMS_DEG, description, _antenna_options(options, antenna_options),
+                  planner=planner, controller=controller)
 
 
 def plan_paper_motion() -> ant.JointPathTrajectory:

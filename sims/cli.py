@@ -5,6 +5,7 @@
                 [--hs M] [--tp S] [--heading DEG] [--imu-rate HZ] [--imu-latency S]
                 [--no-prediction] [--wind-direction DEG] [--stewart on|off]
                 [--cable-segments N] [--duration S]
+                [--controller MODULE:FACTORY] [--planner MODULE:FACTORY]
                 [--video FILE] [--camera overview|closeup] [--quiet]
   planbench plan NAME --out DIR
   planbench bench
@@ -150,6 +151,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--duration", type=_finite("duration", 0.0, strict=True),
                      help="simulated time, s (at least one control tick; refused if its log would "
                           "take more than a quarter of this machine's memory)")
+    run.add_argument("--controller", metavar="MODULE:FACTORY",
+                     help="your controller: FACTORY() in MODULE (an importable module or a .py file) "
+                          "returns it (README, \"Your own planner or controller\")")
+    run.add_argument("--planner", metavar="MODULE:FACTORY",
+                     help="your planner, the same way (the antenna's: an online planner)")
     run.add_argument("--video", help="write an H.264 video of the run here (.mp4, .m4v, .mov, .mkv)")
     run.add_argument("--camera", default=None, help="video camera: overview or closeup")
     run.add_argument("--quiet", action="store_true", help="no progress bars")
@@ -230,6 +236,7 @@ def _camera(scenario, requested: str | None) -> str:
 
 def cmd_run(args) -> int:
     from sims import outputs, runner, scenarios
+    from sims import plugins as plugins_module
 
     try:
         scenario = scenarios.get(args.name)
@@ -237,14 +244,19 @@ def cmd_run(args) -> int:
         raise BadInput(str(e)) from None
     options = _options(scenario, args)
     camera = _camera(scenario, args.camera)
+    plugins = {role: plugin_spec for role, plugin_spec in (("planner", args.planner), ("controller", args.controller))
+               if plugin_spec is not None}
+    made = {role: plugins_module.make(plugin_spec, role, online_planner=scenario.online_planner)
+            for role, plugin_spec in plugins.items()}
     out = outputs.OutputDir(Path("results") / scenario.name if args.out is None else args.out)
     video = None if args.video is None else outputs.VideoFile(args.video, out)
     with contextlib.ExitStack() as reserved:  # lock before simulating: a second run is refused
         reserved.enter_context(out.reserved())
         if video is not None:
             reserved.enter_context(video.reserved())
-        setup = scenario.build(options)
+        setup = scenario.build(options, **made)
         result = runner.run(scenario.name, setup, quiet=args.quiet)
+        result.plugins = plugins
         outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
     print(format_checks([(scenario.name, c) for c in result.checks]))
     print(f"{'PASSED' if result.passed else 'FAILED'}: {scenario.name}, "
@@ -359,6 +371,7 @@ def main(argv=None) -> int:
     """Run the CLI; returns the exit code (0, 1, 2, or 130 / 128 + signal on an interrupt)."""
     from planners.errors import PlanningError
     from sims.outputs import OutputError
+    from sims.task import PluginError
 
     with _Interrupt() as interrupt:
         try:
@@ -372,7 +385,7 @@ def main(argv=None) -> int:
                 print(f"planbench: interrupted by {signal.Signals(signum).name}; nothing "
                       "half-written was left", file=sys.stderr)
                 return 128 + int(signum)
-            if isinstance(e, (BadInput, PlanningError, OutputError)):
+            if isinstance(e, (BadInput, PlanningError, OutputError, PluginError)):
                 print(f"planbench: error: {e}", file=sys.stderr)
                 return EXIT_BAD_INPUT
             raise

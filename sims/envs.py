@@ -1,245 +1,164 @@
-"""Each mechanism as a ``dm_control.rl.control.Environment``, for users' own controllers.
+"""Each mechanism as a ``dm_control.rl.control.Environment``: a thin adapter over its Task.
 
-The task follows a planner's trajectory: the action is the actuators' ``ctrl`` (for the
-loader, the drives' set-point rates), observations are the joint state and the planned
-motion at the current time, and the reward is exp(-|tracking error| / scale), in (0, 1].
+The adapter (``TaskAdapter``) runs a scenario's ``runner.Setup`` the way the runner does
+(``runner.start_episode``): the same initial state, the same sensors and disturbances seeded
+the same way, ``steps_per_tick`` physics steps per action. The agent plays the controller:
+its action is the commands of the actuators a controller drives (``Setup.controlled``), its
+observation what the task's sensors report (``sims.task``) plus the reference at the current
+tick, never the physics state. An episode starts as the reference controller's run starts (the
+machine at rest, its drives holding the start), and lasts the scenario's duration. The reward
+is exp(-error / scale) of the task's goal: the joint tracking error (loader, hexapod), the
+pointing error (antenna), the feed's distance from its goal path (FAST).
 """
 
 from __future__ import annotations
 
 import collections
 
+import mujoco
 import numpy as np
 from dm_control.rl import control
+from dm_env import specs
 
-from planners.trajectory import Trajectory
+from sims import runner
 
 
-class TrajectoryTrackingTask(control.Task):
-    """Follow ``trajectory`` with the joints ``joint_names`` of a physics.
+class TaskAdapter(control.Task):
+    """A planbench Setup as a dm_control Task.
 
     Args:
-      trajectory: planned motion, one channel per joint.
-      joint_names: MJCF joint names, in the trajectory's channel order.
-      error_scale: tracking error (m or rad) at which the reward falls to 1/e.
+      setup: a scenario's ``runner.Setup`` (its physics at the initial state).
+      reward: (physics, tick, adapter) -> reward in (0, 1].
     """
 
-    def __init__(self, trajectory: Trajectory, joint_names, error_scale: float = np.deg2rad(0.1)):
-        self._trajectory = trajectory
-        self._joints = list(joint_names)
-        self._scale = float(error_scale)
-
-    def initialize_episode(self, physics):
-        physics.reset(keyframe_id=0)
-        start = self._trajectory.sample(0.0).position[0]
-        physics.named.data.qpos[self._joints] = start
-        if physics.model.na:
-            physics.data.act[:] = start
-        physics.forward()
-
-    def before_step(self, action, physics):
-        physics.set_control(action)
-
-    def action_spec(self, physics):
-        from dm_env import specs
-
-        lo, hi = physics.model.actuator_ctrlrange.T
-        return specs.BoundedArray((physics.model.nu,), float, lo, hi, name="ctrl")
-
-    def reference(self, physics) -> np.ndarray:
-        return self._trajectory.sample(physics.data.time).position[0]
-
-    def get_observation(self, physics):
-        obs = collections.OrderedDict()
-        obs["joint_positions"] = physics.named.data.qpos[self._joints].copy()
-        obs["joint_velocities"] = physics.named.data.qvel[self._joints].copy()
-        sample = self._trajectory.sample(physics.data.time)
-        obs["reference_positions"] = sample.position[0]
-        obs["reference_velocities"] = sample.velocity[0]
-        return obs
-
-    def get_reward(self, physics):
-        error = physics.named.data.qpos[self._joints] - self.reference(physics)
-        return float(np.exp(-np.abs(error).max() / self._scale))
-
-
-def loader_environment(plan: str = "supply", control_dt: float = 0.005) -> control.Environment:
-    """The loader as a dm_control Environment following the supply (or direct) plan."""
-    import models
-    from planners import loader as loader_planner
-    from sims.loader import LoaderPhysics, SETTLE_S
-
-    trajectory = loader_planner.supply_plan() if plan == "supply" else loader_planner.direct_plan()
-    physics = LoaderPhysics.load()
-    task = TrajectoryTrackingTask(trajectory, models.loader_spec().names)
-    n_sub = int(round(control_dt / physics.model.opt.timestep))
-    return control.Environment(
-        physics, task, time_limit=trajectory.duration + SETTLE_S, n_sub_steps=n_sub
-    )
-
-
-def hexapod_environment(synchronous: bool = True, elevation_deg: float = 45.0,
-                        control_dt: float = 0.005) -> control.Environment:
-    """The hexapod as a dm_control Environment following the sync (or async) move.
-
-    The action is the six drives' set-point rates (m/s); the episode starts at rest at the
-    zero pose with the set-points at zero, so a controller must take up the gravity load.
-    """
-    from sims.hexapod import SETTLE_S, HexapodPhysics, plan
-
-    trajectory = plan(synchronous)
-    physics = HexapodPhysics.load(elevation_deg)
-    task = TrajectoryTrackingTask(trajectory, list(trajectory.labels), error_scale=10e-6)
-    n_sub = int(round(control_dt / physics.model.opt.timestep))
-    return control.Environment(
-        physics, task, time_limit=trajectory.duration + SETTLE_S, n_sub_steps=n_sub
-    )
-
-
-class AntennaTask(TrajectoryTrackingTask):
-    """Hold the satellite while the ship moves: the ship antenna for a user's controller.
-
-    The action is the four antenna drives' set-point rates (rad/s); the deck follows the ship
-    motion by itself (the sea). Observations add what a real controller has: the IMU's
-    orientation quaternion and gyro; ``reference_positions`` are the joint angles for the
-    true ship motion (what a perfect controller would reach; a real one must estimate them
-    from the IMU). The reward is exp(-pointing error / scale).
-    """
-
-    def __init__(self, setup, error_scale: float = np.deg2rad(0.1)):
-        super().__init__(setup.trajectory, list(setup.trajectory.labels), error_scale)
+    def __init__(self, setup: runner.Setup, reward):
         self._setup = setup
-        self._times = None
+        self._reward = reward
+        episode = runner.start_episode(setup)  # the reference controller's start of the run
+        self._times = episode.times
+        self._reference = episode.reference
+        physics = setup.physics
+        model = physics.model.ptr
+        self._state_spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        self._initial = np.empty(mujoco.mj_stateSize(model, self._state_spec))
+        mujoco.mj_getState(model, physics.data.ptr, self._initial, self._state_spec)
+        self._controlled = np.asarray(setup.controlled if setup.controlled is not None else np.arange(model.nu))
+        self.tick = 0
+
+    @property
+    def setup(self) -> runner.Setup:
+        return self._setup
+
+    @property
+    def reference(self):
+        """The trajectory sampled at every control tick."""
+        return self._reference
 
     def initialize_episode(self, physics):
-        from sims.antenna import AntennaPhysics  # noqa: F401  (the setup's physics type)
-
-        physics.set_state(*self._initial)
-        self._setup.disturbance.reset(physics, self._times, np.random.default_rng(0))
-
-    def prepare(self, physics, control_dt: float, duration: float):
-        from planners.trajectory import control_ticks
-
-        self._times = control_ticks(duration, control_dt)
-        data = physics.data.ptr
-        self._initial = (data.qpos[physics.deck_qpos].copy(), data.qvel[physics.deck_dofs].copy(),
-                         data.qpos[physics.antenna_qpos].copy(), data.qvel[physics.antenna_dofs].copy())
-        self._dt = control_dt
+        setup = self._setup
+        model, data = physics.model.ptr, physics.data.ptr
+        mujoco.mj_setState(model, data, self._initial, self._state_spec)
+        self._observation = setup.sensors.reset(physics, self._times, setup.seed)
+        if setup.disturbance is not None:
+            setup.disturbance.reset(physics, self._times, np.random.default_rng(setup.seed))
+        mujoco.mj_forward(model, data)
+        self.tick = 0
 
     def before_step(self, action, physics):
-        tick = int(round(physics.data.time / self._dt))
-        self._setup.disturbance(min(tick, self._times.size - 1), physics)
-        physics.data.ctrl[physics.antenna_actuators] = action
+        physics.data.ctrl[self._controlled] = action
+        if self._setup.disturbance is not None:
+            self._setup.disturbance(min(self.tick, self._times.size - 1), physics)
+
+    def after_step(self, physics):
+        self.tick += 1
+        self._setup.sensors(min(self.tick, self._times.size - 1), physics)
 
     def action_spec(self, physics):
-        from dm_env import specs
-
-        lo, hi = physics.model.actuator_ctrlrange[physics.antenna_actuators].T
-        return specs.BoundedArray((4,), float, lo, hi, name="antenna_setpoint_rates")
+        model = physics.model.ptr
+        lo, hi = model.actuator_ctrlrange[self._controlled].T
+        limited = model.actuator_ctrllimited[self._controlled].astype(bool)
+        return specs.BoundedArray((self._controlled.size,), float, np.where(limited, lo, -np.inf),
+                                  np.where(limited, hi, np.inf), name="ctrl")
 
     def get_observation(self, physics):
-        obs = super().get_observation(physics)
-        obs["imu_quat"] = physics.sensor("imu_quat").copy()
-        obs["imu_gyro"] = physics.sensor("imu_gyro").copy()
+        k = min(self.tick, self._times.size - 1)
+        obs = collections.OrderedDict((name, np.array(value, dtype=float)) for name, value in self._observation.items())
+        obs["reference_positions"] = self._reference.position[k].copy()
+        obs["reference_velocities"] = self._reference.velocity[k].copy()
         return obs
 
     def get_reward(self, physics):
-        from sims.antenna import pointing_errors
-
-        pointing, _ = pointing_errors(physics.dish_rotation(physics.data.qpos), self._setup.evaluate.satellite)
-        return float(np.exp(-pointing[0] / self._scale))
+        return self._reward(physics, min(self.tick, self._times.size - 1), self)
 
 
-def antenna_environment(sea_state: bool = True, duration: float = 60.0,
-                        control_dt: float = 0.005) -> control.Environment:
-    """The ship antenna as a dm_control Environment (default: the default sea state)."""
+def environment(setup: runner.Setup, reward) -> control.Environment:
+    """The dm_control Environment of ``setup``: one action per control tick, ``steps_per_tick``
+    physics steps each, for the scenario's duration."""
+    task = TaskAdapter(setup, reward)
+    n_sub = runner.steps_per_tick(setup.physics.model.ptr, setup.control_dt)
+    return control.Environment(setup.physics, task, time_limit=setup.duration, n_sub_steps=n_sub)
+
+
+def joint_tracking_reward(qpos_index, scale: float):
+    """exp(-max |q - q_ref| / scale) over the planned channels (m or rad)."""
+    index = np.asarray(qpos_index)
+
+    def reward(physics, tick, adapter):
+        error = physics.data.qpos[index] - adapter.reference.position[tick]
+        return float(np.exp(-np.abs(error).max() / scale))
+
+    return reward
+
+
+def loader_environment(plan: str = "supply") -> control.Environment:
+    """The loader following the supply (or direct) problem's cubic B-spline."""
+    from sims import loader
+    from sims.scenarios import RunOptions
+
+    setup = (loader.build_supply if plan == "supply" else loader.build_direct)(RunOptions())
+    return environment(setup, joint_tracking_reward(setup.sensors.qpos, np.deg2rad(0.1)))
+
+
+def hexapod_environment(synchronous: bool = True, elevation_deg: float = 45.0) -> control.Environment:
+    """The hexapod's sync (or async) move at an elevation; the action is the six drives'
+    set-point rates (m/s)."""
+    from sims import hexapod
+    from sims.scenarios import RunOptions
+
+    setup = (hexapod.build_sync if synchronous else hexapod.build_async)(RunOptions(elevation=elevation_deg))
+    return environment(setup, joint_tracking_reward(setup.sensors.qpos, 10e-6))
+
+
+def antenna_environment(sea_state: bool = True, duration: float = 60.0) -> control.Environment:
+    """The ship antenna holding its satellite (default: the default sea state); the action is
+    the four antenna drives' set-point rates (rad/s), the deck follows the sea by itself."""
     from sims import antenna
     from sims.scenarios import RunOptions
 
     build = antenna.build_sea_state if sea_state else antenna.build_paper_motion
     setup = build(RunOptions(duration=duration))
-    task = AntennaTask(setup)
-    task.prepare(setup.physics, control_dt, duration)
-    n_sub = int(round(control_dt / setup.physics.model.opt.timestep))
-    return control.Environment(setup.physics, task, time_limit=duration, n_sub_steps=n_sub)
+    satellite = setup.problem.satellite
 
+    def reward(physics, tick, adapter, scale=np.deg2rad(0.1)):
+        pointing, _ = antenna.pointing_errors(physics.dish_rotation(physics.data.qpos), satellite)
+        return float(np.exp(-pointing[0] / scale))
 
-class FastTask(TrajectoryTrackingTask):
-    """Keep FAST's feed on its plan: the feed support for a user's controller.
-
-    The action is every actuator's ctrl: the six winches' unstretched lengths (m), the A-B
-    set-points (rad), the six Stewart legs' set-point rates (m/s) and the multi-beam angle
-    (rad). The plant's per-tick physics (the cables' catenary law, their weight and the wind,
-    ``sims.fast_physics.CableLoads``) runs before every step. Observations: the cabin pose
-    (position, quaternion), the feed position, the cable tensions and lengths, the A-B angles,
-    the leg encoders, the planned feed and the plan's static tensions and unstretched-length
-    feed-forward at the current time. The reward is exp(-feed error / scale).
-    """
-
-    def __init__(self, setup, error_scale: float = 0.01):
-        super().__init__(setup.trajectory, [], error_scale)
-        self._setup = setup
-
-    def prepare(self, physics, control_dt: float, duration: float):
-        from planners.trajectory import control_ticks
-
-        self._times = control_ticks(duration, control_dt)
-        self._dt = control_dt
-        self._initial = physics.get_state().copy()
-        self._setup.controller.reset(physics, self._setup.trajectory.sample(self._times), control_dt)
-        self._initial_ctrl = physics.data.ctrl.copy()
-
-    def initialize_episode(self, physics):
-        physics.set_state(self._initial)
-        physics.data.ctrl[:] = self._initial_ctrl
-        physics.forward()
-        self._setup.disturbance.reset(physics, self._times, np.random.default_rng(self._setup.seed))
-
-    def tick(self, physics) -> int:
-        return min(int(round(physics.data.time / self._dt)), self._times.size - 1)
-
-    def before_step(self, action, physics):
-        physics.data.ctrl[:] = action
-        self._setup.disturbance(self.tick(physics), physics)
-
-    def action_spec(self, physics):
-        from dm_env import specs
-
-        lo, hi = physics.model.actuator_ctrlrange.T
-        return specs.BoundedArray((physics.model.nu,), float, lo, hi, name="ctrl")
-
-    def get_observation(self, physics):
-        state = self._setup.controller.state
-        k = self.tick(physics)
-        origin, rotation = physics.cabin_pose()
-        obs = collections.OrderedDict()
-        obs["cabin_position"] = origin
-        obs["cabin_quat"] = physics.data.xquat[physics.cabin_body].copy()
-        obs["feed_position"] = physics.feed_position()
-        obs["cable_tensions"] = physics.cable_tensions()
-        obs["cable_lengths"] = physics.cable_lengths()
-        obs["ab_angles"] = physics.ab_angles()
-        obs["stewart_legs"] = physics.stewart_legs()
-        obs["reference_feed"] = state.feed[k]
-        obs["reference_tensions"] = state.tension[k]
-        obs["reference_unstretched_lengths"] = self._setup.controller.l0_ff[k]
-        return obs
-
-    def get_reward(self, physics):
-        error = np.linalg.norm(physics.feed_position() - self._setup.controller.state.feed[self.tick(physics)])
-        return float(np.exp(-error / self._scale))
+    return environment(setup, reward)
 
 
 def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0) -> control.Environment:
-    """FAST's feed support as a dm_control Environment: ``duration`` s of tracking 3C 286 (no
-    switch: the episode starts on the source at rest), in ``wind`` m/s."""
+    """FAST's feed support: ``duration`` s of tracking 3C 286 (no switch: the episode starts
+    on the source at rest), in ``wind`` m/s. The action is every actuator's ctrl: the six
+    winches' unstretched lengths (m), the A-B set-points (rad), the six Stewart legs'
+    set-point rates (m/s) and the multi-beam angle (rad)."""
     from sims import fast
-    from sims.fast_physics import CONTROL_DT
     from sims.scenarios import RunOptions
 
     setup = fast.build(fast.observation_plan(duration), RunOptions(wind=wind, seed=seed))
-    task = FastTask(setup)
-    total = setup.trajectory.duration
-    task.prepare(setup.physics, CONTROL_DT, total)
-    n_sub = int(round(CONTROL_DT / setup.physics.model.opt.timestep))
-    return control.Environment(setup.physics, task, time_limit=total, n_sub_steps=n_sub)
+    goal = setup.problem.goal
+
+    def reward(physics, tick, adapter, scale=0.01):
+        _, feed, _, _ = goal.feed(np.array([adapter.reference.t[tick]]))
+        return float(np.exp(-np.linalg.norm(physics.feed_position() - feed[0]) / scale))
+
+    return environment(setup, reward)

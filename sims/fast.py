@@ -38,8 +38,10 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import demanded_force
 from sims.fast_physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
-                               FastController, FastPhysics, _compiled, max_cable_segments)
+                               FastController, FastPhysics, FastSensors, SensorOptions, _compiled,
+                               max_cable_segments, parked_command, winch_feedforward)
 from sims.runner import RunLog, Setup
+from sims.task import plan_checked
 from sims.wind import check_mean_speed
 
 #: Calibrators (J2000, NED): 3C 286 13h31m08.29s +30d30m33.0s; 3C 295 14h11m20.5s +52d12m21s.
@@ -252,8 +254,10 @@ def _rms(x: np.ndarray) -> float:
 class FastEvaluation:
     """Checks, timeseries and report of a FAST run."""
 
-    def __init__(self, physics: FastPhysics, plan: fp.FastPlan, controller: FastController, loads: CableLoads):
-        self.physics, self.plan, self.controller, self.loads = physics, plan, controller, loads
+    def __init__(self, physics: FastPhysics, problem: fp.FastProblem, loads: CableLoads, description: dict):
+        self.physics, self.problem, self.loads = physics, problem, loads
+        self.goal = problem.goal
+        self.description = description
         self._series = (None, None)  # (log, its series): checks, timeseries and report share it
 
     def series(self, log: RunLog) -> dict:
@@ -263,37 +267,42 @@ class FastEvaluation:
         return self._series[1]
 
     def _compute_series(self, log: RunLog) -> dict:
-        p, c = self.physics, self.controller
-        n = log.t.size
-        state = c.state
+        """The goal (``problem.goal``'s feed and segments at the logged times), the returned
+        trajectory (``log.reference``, and the cabin pose and tensions that go with it) and the
+        run (its sensors, actuators and the plant's catenary tensions)."""
+        p = self.physics
+        state = fp.reference_state(log.reference)  # what the returned trajectory asks of the cabin
+        segment, goal_feed, _, _ = self.goal.feed(log.t)
         feed = log.sensordata[:, p.sensor_block("feed_pos")]
         cabin = log.sensordata[:, p.sensor_block("cabin_pos")]
         legs = log.qpos[:, p.leg_qpos]
         kp, kv = p.drive_gains(p.leg_ids)
+        unstretched = winch_feedforward(state, p.tower_tops)
         return {
+            "feed_goal": goal_feed,
             "feed_planned": log.reference.position[:, :3],
             "feed_actual": feed,
-            "feed_error": np.linalg.norm(feed - log.reference.position[:, :3], axis=1),
-            "cabin_planned": state.cabin_origin[:n],
+            "feed_error": np.linalg.norm(feed - goal_feed, axis=1),
+            "cabin_planned": state.cabin_origin,
             "cabin_actual": cabin,
-            "cabin_error": np.linalg.norm(cabin - state.cabin_origin[:n], axis=1),
+            "cabin_error": np.linalg.norm(cabin - state.cabin_origin, axis=1),
             "cable_tension": -log.actuator_force[:, p.cable_ids],
-            "cable_tension_law": _hold_last(self.loads.tension_log, n),
-            "cable_tension_planned": state.tension[:n],
+            "cable_tension_law": _hold_last(self.loads.tension_log, log.t.size),
+            "cable_tension_planned": state.tension,
             "cable_length": log.sensordata[:, p.sensor_columns([f"cable{i}_length" for i in range(1, 7)])],
             "cable_unstretched": log.ctrl[:, p.cable_ids],
-            "cable_length_feedback": c.cable_length_correction[:n],
-            "ab_planned": c.ab_reference[:n],
+            "cable_unstretched_planned": unstretched,
+            "ab_planned": np.column_stack([state.theta_a, state.theta_b]),
             "ab_actual": log.qpos[:, p.ab_qpos],
             "stewart_leg": legs,
-            "stewart_command": c.stewart_command[:n],
             "stewart_setpoint": log.act[:, p.leg_act],
             "stewart_force_demanded": demanded_force(kp, kv, log.act[:, p.leg_act], legs, log.qvel[:, p.leg_dofs]),
-            "observing": observing_mask(self.plan, state.segment[:n]),
+            "segment": segment,
+            "observing": observing_mask(self.goal, segment),
         }
 
     def __call__(self, log: RunLog):
-        p, c = self.physics, self.controller
+        p = self.physics
         s = self.series(log)
         n = log.t.size
         observing = s["observing"]
@@ -305,13 +314,13 @@ class FastEvaluation:
         t_min = fast.FAST_LIMITS.tension_min
         low = np.unravel_index(np.argmin(tension), tension.shape)
         high = np.unravel_index(np.argmax(s["cable_tension_law"]), tension.shape)
-        stroke = np.maximum(np.abs(s["stewart_leg"]).max(initial=0.0), np.abs(s["stewart_command"]).max(initial=0.0))
+        stroke = np.maximum(np.abs(s["stewart_leg"]).max(initial=0.0), np.abs(s["stewart_setpoint"]).max(initial=0.0))
         force = np.abs(s["stewart_force_demanded"])
         force_limit = float(p.force_limit(p.leg_ids).min())
-        stewart = "on" if c.options.stewart else "off"
+        stewart = self.description.get("stewart")
         checks = [
             Check("feed_error_rms", _rms(feed_mm[window]), FEED_RMS_LIMIT_MM, "mm",
-                  note=f"Stewart {stewart}; {where}"),
+                  note=(f"Stewart {stewart}; " if stewart else "") + f"against the goal feed path; {where}"),
             Check("feed_error_max", float(feed_mm[window].max()), FEED_MAX_LIMIT_MM, "mm", note=where),
             Check("cabin_error_rms", _rms(cabin_mm[window]), CABIN_RMS_LIMIT_MM, "mm",
                   note=f"cabin origin; {where}"),
@@ -320,19 +329,19 @@ class FastEvaluation:
             Check("cable_tension_max", float(s["cable_tension_law"].max()) / 1e3, p.tension_max / 1e3, "kN",
                   note=f"cable{high[1] + 1} at t = {log.t[high[0]]:.2f} s (catenary law, before the winch's clamp)"),
             Check("stewart_stroke", 1e3 * float(stroke), 1e3 * fast.STEWART.stroke, "mm",
-                  note="largest leg change, measured or commanded"),
+                  note="largest leg change, measured or its drive's set-point"),
             Check("stewart_force", float(force.max()) / 1e3, force_limit / 1e3, "kN", note="demanded"),
         ]
         segments = {}
-        for k, seg in enumerate(self.plan.segments):
-            mask = c.state.segment[:n] == k
+        for k, seg in enumerate(self.goal.segments):
+            mask = s["segment"] == k
             if mask.any():
                 segments[seg.name] = segments.get(seg.name, []) + [{
                     "t0_s": seg.t0, "feed_error_rms_mm": _rms(feed_mm[mask]),
                     "feed_error_max_mm": float(feed_mm[mask].max()), "cabin_error_rms_mm": _rms(cabin_mm[mask])}]
         ab_error = np.degrees(np.abs(s["ab_actual"] - s["ab_planned"]).max(axis=0)) * 3600.0
-        metrics = {
-            "stewart": stewart,
+        metrics = dict(self.description)
+        metrics.update({
             "cables": (f"{p.cable_segments} segments each" if p.cable_segments
                        else "straight, lumped catenary law"),
             "wind_mean_m_s": self.loads.mean_speed,
@@ -345,10 +354,11 @@ class FastEvaluation:
             "cable_tension_range_kN": [float(tension.min()) / 1e3, float(tension.max()) / 1e3],
             "planned_tension_range_kN": [float(s["cable_tension_planned"].min()) / 1e3,
                                          float(s["cable_tension_planned"].max()) / 1e3],
-            "cable_feedback_max_mm": 1e3 * float(np.abs(s["cable_length_feedback"]).max()),
+            # The winch commands less the unstretched lengths the plan implies: the feedback.
+            "cable_feedback_max_mm": 1e3 * float(np.abs(s["cable_unstretched"] - s["cable_unstretched_planned"]).max()),
             "ab_error_max_arcsec": ab_error.round(2).tolist(),
             "stewart_leg_max_mm": 1e3 * float(np.abs(s["stewart_leg"]).max()),
-        }
+        })
         if self.loads.mean_speed > 0:
             wind = self.loads.speed[:n]
             metrics.update({"wind_speed_std_m_s": float(np.std(wind)),
@@ -371,8 +381,9 @@ class FastEvaluation:
             "cable_unstretched": s["cable_unstretched"],
             "ab_planned": s["ab_planned"],
             "ab_actual": s["ab_actual"],
+            "feed_pos_goal": s["feed_goal"],
             "stewart_leg": s["stewart_leg"],
-            "stewart_command": s["stewart_command"],
+            "stewart_setpoint": s["stewart_setpoint"],
             "stewart_force_demanded": s["stewart_force_demanded"],
             "observing": s["observing"],
         }
@@ -387,14 +398,13 @@ class FastEvaluation:
         fast_report(self.timeseries(log), log.t, checks, path, fast.FAST_LIMITS.tension_min)
 
 
-#: Doubles per tick that a FAST run preallocates besides the runner's log: the plan's state at
-#: every tick (FastPlanSample less its t: segment, feed, its velocity and acceleration, axis,
-#: 7 angles, cabin rotation, A-B point, cabin origin, cable lengths, tensions, Stewart legs:
-#: 1 + 3 * 4 + 7 + 9 + 3 + 3 + 6 * 3 = 53); the controller's winch feed-forward (6), platform
-#: rotation and position (9 + 3), true cabin pose (3 + 9), the noise of its two measurements
-#: (2 x (3 + 9)), cable-length feedback and Stewart command (6 + 6), A-B reference and
-#: set-point (2 + 2): 70; the plant's wind speed, wind force and catenary tensions (1 + 3 + 6).
-PER_TICK_FLOATS = 53 + 70 + 10
+#: Doubles per tick that a FAST run preallocates besides the runner's log: the controller's
+#: plan state at every tick (FastPlanSample less its t: 53, of which the feed, its velocity
+#: and acceleration and the multi-feed angle, 10, are views of the reference: 43), its winch
+#: feed-forward (6), platform rotation and position (9 + 3), A-B reference and set-point
+#: (2 + 2): 65; the sensors' true cabin pose (3 + 9) and the noise of their two measurements
+#: (2 x (3 + 9)): 36; the plant's wind speed, wind force and catenary tensions (1 + 3 + 6).
+PER_TICK_FLOATS = 65 + 36 + 10
 
 
 def log_bytes_per_tick(cable_segments: int = 0) -> float:
@@ -433,44 +443,62 @@ def validate(options, default_duration: float | None = None) -> None:
     run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
 
 
-def build(plan: fp.FastPlan, options, controller_options: ControllerOptions | None = None,
-          cable_segments: int | None = None) -> Setup:
-    """A run of ``plan``: the physics at the plan's first pose (at rest, in equilibrium), the
-    cables and wind (``options.wind``, default DEFAULT_WIND_M_S), and the controller
-    (``options.stewart``: None or True for the stabilizer on). ``cable_segments`` >= 2: the
-    discretized cables (sims.fast_physics.discretized_spec) instead of the lumped ones; None:
+def problem(plan: fp.FastPlan) -> fp.FastProblem:
+    """The session whose goal is ``plan``: its observing windows are the segments named
+    OBSERVING_PREFIXES (observations, scan legs and their transitions)."""
+    return fp.problem_of(plan, OBSERVING_PREFIXES)
+
+
+def build(plan: fp.FastPlan | fp.FastProblem, options, controller_options: ControllerOptions | None = None,
+          cable_segments: int | None = None, planner=None, controller=None,
+          sensor_options: SensorOptions = SensorOptions()) -> Setup:
+    """A run of a session (``plan``: its goal plan, or the problem): ``planner`` (default the
+    paper's, whose plan is the goal) plans it, ``controller`` (default ``FastController`` with
+    ``controller_options``; ``options.stewart``: None or True for the stabilizer on) follows
+    it, with the physics at the trajectory's first pose (at rest, in equilibrium), the
+    cables and wind (``options.wind``, default DEFAULT_WIND_M_S) and the sensors
+    (``sensor_options``). ``cable_segments`` >= 2: the discretized cables
+    (sims.fast_physics.discretized_spec) instead of the lumped ones; None:
     ``options.cable_segments``."""
+    session = plan if isinstance(plan, fp.FastProblem) else problem(plan)
     if cable_segments is None:
         cable_segments = getattr(options, "cable_segments", None) or 0
-    duration = plan.duration if options.duration is None else options.duration
+    planner = fp.PaperPlanner() if planner is None else planner
+    trajectory = plan_checked(planner, session, fp.PLAN_LABELS)
+    duration = trajectory.duration if options.duration is None else options.duration
     validate(options, duration)
     check_cable_segments(cable_segments)
     physics = FastPhysics.load(cable_segments)
-    s0 = plan.state(np.array([0.0]))
+    s0 = fp.reference_state(trajectory.sample(np.array([0.0])))
     physics.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
                               s0.multifeed[0])
-    if controller_options is None:
-        stewart = True if getattr(options, "stewart", None) is None else bool(options.stewart)
-        controller_options = ControllerOptions(stewart=stewart)
-    controller = FastController(plan, controller_options, seed=options.seed)
+    physics.data.ctrl[:] = parked_command(physics, s0)  # parked: the winches hold the start
+    description = {}
+    if controller is None:
+        if controller_options is None:
+            stewart = True if getattr(options, "stewart", None) is None else bool(options.stewart)
+            controller_options = ControllerOptions(stewart=stewart)
+        controller = FastController(controller_options)
+        description["stewart"] = "on" if controller_options.stewart else "off"
     wind = DEFAULT_WIND_M_S if options.wind is None else options.wind
     direction = getattr(options, "wind_direction", None)
     loads = (ChainCableLoads if cable_segments else CableLoads)(
         wind, WIND_AZIMUTH_DEG if direction is None else direction)
-    evaluation = FastEvaluation(physics, plan, controller, loads)
-    return Setup(physics=physics, trajectory=plan, controller=controller, control_dt=CONTROL_DT,
-                 duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
+    evaluation = FastEvaluation(physics, session, loads, description)
+    return Setup(physics=physics, trajectory=trajectory, controller=controller,
+                 sensors=FastSensors(physics, sensor_options, CONTROL_DT), problem=session, planner=planner,
+                 control_dt=CONTROL_DT, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
                  report=evaluation.report, disturbance=loads, video_speed=1.0, seed=options.seed,
                  output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1)
 
 
-def build_tracking(options) -> Setup:
-    return build(tracking_plan(), options)
+def build_tracking(options, planner=None, controller=None) -> Setup:
+    return build(tracking_plan(), options, planner=planner, controller=controller)
 
 
-def build_ra_scan(options) -> Setup:
-    return build(ra_scan_plan(), options)
+def build_ra_scan(options, planner=None, controller=None) -> Setup:
+    return build(ra_scan_plan(), options, planner=planner, controller=controller)
 
 
-def build_source_switch(options) -> Setup:
-    return build(source_switch_plan(), options)
+def build_source_switch(options, planner=None, controller=None) -> Setup:
+    return build(source_switch_plan(), options, planner=planner, controller=controller)

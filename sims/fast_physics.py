@@ -41,10 +41,12 @@ from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import fast
+from planners import fast_plan
 from planners.errors import LimitError
 from planners.legs import leg_lengths, structure_matrix
 from planners.rotations import rot_y, rot_z, skew, vee, wxyz
 from planners.trajectory import TrajectorySample
+from sims.task import Sensors, SensorSpec
 from sims.wind import AIR_DENSITY, check_mean_speed, wind_speed_series
 
 CONTROL_DT = 0.01  # s: the runner's tick, the Stewart stabilizer's 100 Hz
@@ -632,11 +634,11 @@ class ChainCableLoads(CableLoads):
 
 
 @dataclass(frozen=True)
-class ControllerOptions:
-    """The FAST controller's settings.
+class SensorOptions:
+    """FAST's sensors of the cabin pose (the task's, not the controller's: a user's controller
+    gets the same readings).
 
     Attributes:
-      stewart: the Stewart stabilizer corrects the feed (False: its legs hold nominal).
       pose_rate_hz, pose_latency_s: the cabin pose measurement of the cable loop (total
         stations: 10 Hz, 150 ms; the issue's values).
       pose_noise_m, pose_noise_rad: its white noise, 1-sigma per axis (assumed: 1 mm and
@@ -644,11 +646,47 @@ class ControllerOptions:
       stewart_latency_s, stewart_noise_m, stewart_noise_rad: the 100 Hz measurement of the
         cabin pose that the stabilizer corrects with (assumed: IMU-aided, 10 ms, 0.5 mm,
         10 urad white).
+    """
+
+    pose_rate_hz: float = 10.0
+    pose_latency_s: float = 0.15
+    pose_noise_m: float = 1e-3
+    pose_noise_rad: float = 20e-6
+    stewart_latency_s: float = 0.01
+    stewart_noise_m: float = 0.5e-3
+    stewart_noise_rad: float = 10e-6
+
+    def __post_init__(self):
+        _check_options(self, positive=("pose_rate_hz",),
+                       non_negative=("pose_latency_s", "pose_noise_m", "pose_noise_rad", "stewart_latency_s",
+                                     "stewart_noise_m", "stewart_noise_rad"), what="sensor option")
+        if self.pose_rate_hz > 1.0 / CONTROL_DT:
+            raise ValueError(f"pose_rate_hz = {self.pose_rate_hz} must be <= {1.0 / CONTROL_DT:g} Hz "
+                             f"(the {1.0 / CONTROL_DT:g} Hz control tick)")
+
+
+def _check_options(options, positive, non_negative, what: str) -> None:
+    for name in positive:
+        value = getattr(options, name)
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{what} {name} = {value!r} must be finite and > 0")
+    for name in non_negative:
+        value = getattr(options, name)
+        if not (math.isfinite(value) and value >= 0):
+            raise ValueError(f"{what} {name} = {value!r} must be finite and >= 0")
+
+
+@dataclass(frozen=True)
+class ControllerOptions:
+    """The FAST controller's settings.
+
+    Attributes:
+      stewart: the Stewart stabilizer corrects the feed (False: its legs hold nominal).
       stewart_bandwidth_hz: bandwidth of the estimator (an alpha-beta tracker, critically
-        damped) of that measurement's deviation from the planned pose and of its rate; the
-        command leads by the latency plus the leg servo's lag kv/kp. Unfiltered, the white
-        noise moves the 2 t platform every tick and its reaction shakes the cabin's lightly
-        damped 0.3-0.65 Hz modes until the legs reach their stroke.
+        damped) of the 100 Hz cabin pose measurement's deviation from the planned pose and of
+        its rate; the command leads by the latency plus the leg servo's lag kv/kp. Unfiltered,
+        the white noise moves the 2 t platform every tick and its reaction shakes the cabin's
+        lightly damped 0.3-0.65 Hz modes until the legs reach their stroke.
       kp, kd, ki: cable-loop PID on the cabin pose error (1, s, 1/s): the commanded pose
         correction is kp e + kd de/dt + ki int e, mapped to cable lengths by the Jacobian.
         Integral only by default: with the 150 ms latency, proportional and derivative action
@@ -663,13 +701,6 @@ class ControllerOptions:
     """
 
     stewart: bool = True
-    pose_rate_hz: float = 10.0
-    pose_latency_s: float = 0.15
-    pose_noise_m: float = 1e-3
-    pose_noise_rad: float = 20e-6
-    stewart_latency_s: float = 0.01
-    stewart_noise_m: float = 0.5e-3
-    stewart_noise_rad: float = 10e-6
     stewart_bandwidth_hz: float = 3.0
     kp: float = 0.0
     kd: float = 0.0
@@ -679,20 +710,101 @@ class ControllerOptions:
     leg_integral_s: float = 0.2
 
     def __post_init__(self):
-        positive = ("pose_rate_hz", "stewart_bandwidth_hz", "ab_integral_s", "leg_integral_s")
-        for name in positive:
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"controller option {name} = {value!r} must be finite and > 0")
-        for name in ("pose_latency_s", "pose_noise_m", "pose_noise_rad", "stewart_latency_s", "stewart_noise_m",
-                     "stewart_noise_rad", "kp", "kd", "ki", "derivative_filter_s"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"controller option {name} = {value!r} must be finite and >= 0")
-        if self.pose_rate_hz > 1.0 / CONTROL_DT or self.stewart_bandwidth_hz >= 0.5 / CONTROL_DT:
-            raise ValueError(f"pose_rate_hz = {self.pose_rate_hz} must be <= {1.0 / CONTROL_DT:g} Hz and "
-                             f"stewart_bandwidth_hz = {self.stewart_bandwidth_hz} < {0.5 / CONTROL_DT:g} Hz "
-                             f"(the {1.0 / CONTROL_DT:g} Hz control tick)")
+        _check_options(self, positive=("stewart_bandwidth_hz", "ab_integral_s", "leg_integral_s"),
+                       non_negative=("kp", "kd", "ki", "derivative_filter_s"), what="controller option")
+        if self.stewart_bandwidth_hz >= 0.5 / CONTROL_DT:
+            raise ValueError(f"stewart_bandwidth_hz = {self.stewart_bandwidth_hz} must be < {0.5 / CONTROL_DT:g} Hz "
+                             f"(half the {1.0 / CONTROL_DT:g} Hz control tick)")
+
+
+class FastSensors(Sensors):
+    """FAST's sensors (``SensorOptions``): two measurements of the cabin pose, and encoders.
+
+    The true cabin pose is recorded every tick; a measurement reports the pose of ``latency``
+    ticks ago with its own white noise (position, and a small rotation I + [w]x), seeded from
+    the run's seed.
+
+    Observation keys:
+      cabin_pose_ts_position (3,) m, cabin_pose_ts_rotation (3, 3), cabin_pose_ts_time (1,) s,
+        cabin_pose_ts_count (1,): the total stations' fix (every 1 / pose_rate_hz, a new one
+        when the count changes), for the cable loop.
+      cabin_pose_position (3,), cabin_pose_rotation (3, 3), cabin_pose_time (1,): the 100 Hz
+        measurement (IMU-aided), for the stabilizer.
+      ab_angles (2,) rad and ab_rotation (3, 3): the A-B rotator's encoders and the B frame's
+        orientation in the cabin frame that they give (exact).
+      leg_positions (6,) m and leg_setpoints (6,) m: the Stewart legs' encoders (exact) and
+        their drives' set-points.
+    """
+
+    def __init__(self, physics: "FastPhysics", options: SensorOptions = SensorOptions(),
+                 control_dt: float = CONTROL_DT):
+        super().__init__()
+        o = self.options = options
+        self.dt = control_dt
+        self.every = max(1, int(round(1.0 / (o.pose_rate_hz * control_dt))))
+        self.pose_lag = int(round(o.pose_latency_s / control_dt))
+        self.stewart_lag = int(round(o.stewart_latency_s / control_dt))
+        rate = 1.0 / control_dt
+        self.specs = [
+            SensorSpec("cabin_pose_ts", "cabin pose by the total stations (position and attitude)", "m|rad",
+                       o.pose_rate_hz, o.pose_latency_s,
+                       f"white, {1e3 * o.pose_noise_m:g} mm and {1e6 * o.pose_noise_rad:g} urad 1-sigma per axis"),
+            SensorSpec("cabin_pose", "cabin pose for the stabilizer (IMU-aided)", "m|rad", rate, o.stewart_latency_s,
+                       f"white, {1e3 * o.stewart_noise_m:g} mm and {1e6 * o.stewart_noise_rad:g} urad 1-sigma per axis"),
+            SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate),
+            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate),
+            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate),
+        ]
+
+    def reset(self, physics, times: np.ndarray, seed: int) -> dict:
+        o = self.options
+        n = times.size
+        self._data = data = physics.data.ptr
+        self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
+        rng = np.random.default_rng([seed, 0xFA57])
+        self.true_pos = np.empty((n, 3))
+        self.true_rot = np.empty((n, 3, 3))
+        # Noise of each measurement: position (n, 3) and a small rotation I + [w]x (n, 3, 3).
+        self.pose_noise = (rng.normal(0.0, o.pose_noise_m, (n, 3)),
+                           np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
+        self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
+                              np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
+        self._ab_qpos, self._leg_qpos, self._leg_act = physics.ab_qpos, physics.leg_qpos, physics.leg_act
+        self.observation = obs = {
+            "cabin_pose_ts_position": np.zeros(3), "cabin_pose_ts_rotation": np.eye(3),
+            "cabin_pose_ts_time": np.zeros(1), "cabin_pose_ts_count": np.zeros(1, dtype=int),
+            "cabin_pose_position": np.zeros(3), "cabin_pose_rotation": np.eye(3), "cabin_pose_time": np.zeros(1),
+            "ab_angles": np.zeros(2), "ab_rotation": np.eye(3), "leg_positions": np.zeros(6),
+            "leg_setpoints": np.zeros(6),
+        }
+        self._views = (obs["ab_angles"], obs["leg_positions"], obs["leg_setpoints"])
+        self(0, physics)
+        return obs
+
+    def _measured(self, tick: int, lag: int, noise, position: np.ndarray, rotation: np.ndarray) -> int:
+        j = max(0, tick - lag)
+        np.add(self.true_pos[j], noise[0][j], out=position)
+        np.matmul(noise[1][j], self.true_rot[j], out=rotation)
+        return j
+
+    def __call__(self, tick: int, physics) -> None:
+        data, obs = self._data, self.observation
+        self.true_pos[tick] = data.xpos[self._cabin]
+        cabin = data.xmat[self._cabin].reshape(3, 3)
+        self.true_rot[tick] = cabin
+        if tick % self.every == 0:
+            j = self._measured(tick, self.pose_lag, self.pose_noise, obs["cabin_pose_ts_position"],
+                               obs["cabin_pose_ts_rotation"])
+            obs["cabin_pose_ts_time"][0] = j * self.dt
+            obs["cabin_pose_ts_count"][0] += 1
+        j = self._measured(tick, self.stewart_lag, self.stewart_noise, obs["cabin_pose_position"],
+                           obs["cabin_pose_rotation"])
+        obs["cabin_pose_time"][0] = j * self.dt
+        ab, legs, setpoints = self._views
+        np.take(data.qpos, self._ab_qpos, out=ab)
+        np.take(data.qpos, self._leg_qpos, out=legs)
+        np.take(data.act, self._leg_act, out=setpoints)
+        np.matmul(cabin.T, data.xmat[self._ab_b].reshape(3, 3), out=obs["ab_rotation"])
 
 
 def ab_gravity_torque(state, geometry: fast.FastGeometry = fast.FAST) -> np.ndarray:
@@ -714,52 +826,63 @@ def ab_gravity_torque(state, geometry: fast.FastGeometry = fast.FAST) -> np.ndar
     return np.column_stack([np.einsum("ni,ni->n", axis_a, moment), np.einsum("ni,ni->n", axis_b, moment)])
 
 
+def winch_feedforward(state, tower_tops: np.ndarray, geometry: fast.FastGeometry = fast.FAST) -> np.ndarray:
+    """(n, 6) the winches' unstretched lengths that give a plan's chords under its tensions
+    (elastic stretch and sag, ``unstretched_length``), m; ``state``: a FastPlanSample,
+    ``tower_tops``: (6, 3) the cables' exits, m."""
+    anchors = state.cabin_origin[:, None, :] + np.einsum("nij,kj->nki", state.cabin_rotation, geometry.cabin_anchors)
+    vectors = anchors - tower_tops
+    span = np.hypot(vectors[..., 0], vectors[..., 1])
+    return unstretched_length(state.cable_length, state.tension, span)
+
+
+def parked_command(physics: "FastPhysics", state) -> np.ndarray:
+    """(nu,) the actuator commands that hold the feed support at rest at the first row of
+    ``state`` (a FastPlanSample): the winches' lengths (``winch_feedforward``), the A-B
+    set-points less their gravity droop, the legs still, the multi-beam angle. The task's
+    initial commands, which a controller may change in its reset."""
+    command = np.zeros(physics.model.nu)
+    command[physics.cable_ids] = winch_feedforward(state, physics.tower_tops)[0]
+    kp_ab, _ = physics.drive_gains(physics.ab_ids)
+    command[physics.ab_ids] = np.array([state.theta_a[0], state.theta_b[0]]) - ab_gravity_torque(state)[0] / kp_ab
+    command[physics.multifeed_id] = state.multifeed[0]
+    return command
+
+
 class FastController:
     """Winches, A-B rotator, multi-beam rotation and Stewart stabilizer (see the module doc).
 
+    It follows the reference's feed and multi-beam channels (planners.fast_plan.PLAN_LABELS);
+    the cabin pose, the A-B angles, the cable lengths and the tensions that go with them come
+    from the planners' kinematics and statics (``planners.fast_plan.reference_state``), so
+    any FAST trajectory can be followed. It reads the task's observation (``FastSensors``):
+    the total stations' fix for the cable loop, the 100 Hz pose for the stabilizer, the
+    encoders; rates and latencies from the sensors' specs.
+
     Args:
-      plan: the planners.fast_plan.FastPlan being followed (the reference's channels are its
-        feed, tilt, A-B and multi-beam angles and cable lengths; the rest comes from
-        ``plan.state``).
       options: ControllerOptions.
-      seed: seed of the measurement noise.
     """
 
-    def __init__(self, plan, options: ControllerOptions = ControllerOptions(), seed: int = 0):
-        self.plan = plan
+    def __init__(self, options: ControllerOptions = ControllerOptions()):
         self.options = options
-        self.seed = seed
 
-    def reset(self, physics: FastPhysics, reference: TrajectorySample, control_dt: float) -> None:
+    def reset(self, context) -> None:
         o = self.options
         g = fast.FAST
-        self.physics = physics
-        self._data = physics.data.ptr
-        n = reference.t.size
-        state = self.plan.state(reference.t)
-        self.state = state
+        control_dt = context.control_dt
+        nominal = context.nominal_physics()
+        self.state = state = fast_plan.reference_state(context.reference)
+        specs = {s.name: s for s in context.sensors}
         # Winch feed-forward: the unstretched lengths that give the planned chords under the
-        # planned tensions (stretch and sag, ``unstretched_length``).
-        anchors = state.cabin_origin[:, None, :] + np.einsum("nij,kj->nki", state.cabin_rotation, g.cabin_anchors)
-        vectors = anchors - physics.tower_tops
-        span = np.hypot(vectors[..., 0], vectors[..., 1])
-        self.l0_ff = unstretched_length(state.cable_length, state.tension, span)
+        # planned tensions (stretch and sag).
+        self.l0_ff = winch_feedforward(state, nominal.tower_tops)
         self.r_platform = np.einsum("nij,njk->nik", state.cabin_rotation,
                                     fast.ab_rotation(state.theta_a, state.theta_b, g.alpha))
         self.p_platform = state.feed - np.einsum("nij,j->ni", self.r_platform, g.r_s_feed)
         self.nominal_legs = fast.stewart_leg_lengths()
-        # Measurements: the true cabin pose is recorded every tick; the loops read it late.
-        rng = np.random.default_rng([self.seed, 0xFA57])
-        self.pose_every = max(1, int(round(1.0 / (o.pose_rate_hz * control_dt))))
-        self.pose_lag = int(round(o.pose_latency_s / control_dt))
-        self.stewart_lag = int(round(o.stewart_latency_s / control_dt))
-        self.true_pos = np.empty((n, 3))
-        self.true_rot = np.empty((n, 3, 3))
-        # Noise of each measurement: position (n, 3) and a small rotation I + [w]x (n, 3, 3).
-        self.pose_noise = (rng.normal(0.0, o.pose_noise_m, (n, 3)),
-                           np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
-        self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
-                              np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
+        # s between two total-station fixes (a whole number of ticks)
+        self.pose_dt = max(1, int(round(1.0 / (specs["cabin_pose_ts"].rate_hz * control_dt)))) * control_dt
+        self.seen = -1
         self.correction = np.zeros(6)  # commanded pose correction, m and rad
         self.length_correction = np.zeros(6)  # its cable lengths, m
         self.integral = np.zeros(6)
@@ -771,37 +894,32 @@ class FastController:
         self._tracker_gains = (1.0 - r * r, (1.0 - r) ** 2 / control_dt)
         self.stewart_deviation = np.zeros(6)
         self.stewart_rate = np.zeros(6)
-        kp_leg, kv_leg = physics.drive_gains(physics.leg_ids)
-        self.stewart_lead = o.stewart_latency_s + float(np.mean(kv_leg / kp_leg))
+        self.cable_ids, self.ab_ids = nominal.cable_ids, nominal.ab_ids
+        self.leg_ids, self.multifeed_id = nominal.leg_ids, nominal.multifeed_id
+        kp_leg, kv_leg = nominal.drive_gains(self.leg_ids)
+        self.stewart_lead = specs["cabin_pose"].latency_s + float(np.mean(kv_leg / kp_leg))
         self.ab_integral = np.zeros(2)
         self._ab_gain = control_dt / o.ab_integral_s
         self.leg_integral = np.zeros(6)
         self._leg_gain = control_dt / o.leg_integral_s
         self._leg_target = np.zeros(6)
         self.dt = control_dt
-        self.cable_length_correction = np.zeros((n, 6))  # logged: feedback part of L0, m
-        self.stewart_command = np.zeros((n, 6))
         self.ab_reference = np.column_stack([state.theta_a, state.theta_b])
-        kp_ab, _ = physics.drive_gains(physics.ab_ids)
+        kp_ab, _ = nominal.drive_gains(self.ab_ids)
         self.ab_setpoint = self.ab_reference - ab_gravity_torque(state) / kp_ab
-        data = self._data
-        data.ctrl[physics.cable_ids] = self.l0_ff[0]
-        data.ctrl[physics.ab_ids] = self.ab_setpoint[0]
-        data.ctrl[physics.leg_ids] = 0.0
-        data.ctrl[physics.multifeed_id] = state.multifeed[0]
+        self.command = command = context.command
+        command[self.cable_ids] = self.l0_ff[0]
+        command[self.ab_ids] = self.ab_setpoint[0]
+        command[self.leg_ids] = 0.0
+        command[self.multifeed_id] = state.multifeed[0]
 
-    def _measured(self, tick: int, lag: int, noise):
-        """(tick measured, position, rotation) of the cabin as a sensor ``lag`` ticks late
-        reports it, with its ``noise`` (position, rotation) of that tick."""
-        j = max(0, tick - lag)
-        return j, self.true_pos[j] + noise[0][j], noise[1][j] @ self.true_rot[j]
-
-    def _cable_feedback(self, tick: int) -> None:
+    def _cable_feedback(self, obs) -> None:
         o, s = self.options, self.state
-        j, pos, rot = self._measured(tick, self.pose_lag, self.pose_noise)
+        j = int(round(obs["cabin_pose_ts_time"][0] / self.dt))
+        pos, rot = obs["cabin_pose_ts_position"], obs["cabin_pose_ts_rotation"]
         # Rotation error: the small rotation that turns the measured attitude to the planned one.
         error = np.concatenate([s.cabin_origin[j] - pos, vee(s.cabin_rotation[j] @ rot.T)])
-        dt = self.pose_every * self.dt
+        dt = self.pose_dt
         if self.last_error is not None:
             alpha = dt / (o.derivative_filter_s + dt)
             self.derivative += alpha * ((error - self.last_error) / dt - self.derivative)
@@ -809,41 +927,38 @@ class FastController:
         self.integral += error * dt
         self.correction = o.kp * error + o.kd * self.derivative + o.ki * self.integral
 
-    def __call__(self, tick: int, physics) -> None:
-        data, p, s = self._data, self.physics, self.state
-        b = p.cabin_body
-        self.true_pos[tick] = data.xpos[b]
-        self.true_rot[tick] = data.xmat[b].reshape(3, 3)
+    def __call__(self, tick: int, obs) -> None:
+        s, command = self.state, self.command
         nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
-        if tick % self.pose_every == 0:
-            self._cable_feedback(tick)
+        count = int(obs["cabin_pose_ts_count"][0])
+        if count != self.seen:
+            self.seen = count
+            self._cable_feedback(obs)
             # Cable lengths for the pose correction dx: dL = -A^T dx (planners.legs), at the
             # planned pose (it moves by millimetres between two updates).
             a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[tick],
                                  s.cabin_rotation[tick])
             self.length_correction = -a.T @ self.correction
-        self.cable_length_correction[tick] = self.length_correction
-        data.ctrl[p.cable_ids] = self.l0_ff[nxt] + self.length_correction
+        command[self.cable_ids] = self.l0_ff[nxt] + self.length_correction
         # A-B rotator: position servo with integral action on the encoder error.
-        ab = data.qpos[p.ab_qpos]
-        self.ab_integral += self._ab_gain * (self.ab_reference[tick] - ab)
-        data.ctrl[p.ab_ids] = self.ab_setpoint[nxt] + self.ab_integral
-        data.ctrl[p.multifeed_id] = s.multifeed[nxt]
-        legs = self._stewart_legs(tick, nxt) if self.options.stewart else self._leg_target
-        self.stewart_command[tick] = legs
+        self.ab_integral += self._ab_gain * (self.ab_reference[tick] - obs["ab_angles"])
+        command[self.ab_ids] = self.ab_setpoint[nxt] + self.ab_integral
+        command[self.multifeed_id] = s.multifeed[nxt]
+        legs = self._stewart_legs(obs, nxt) if self.options.stewart else self._leg_target
         # Leg servos: integral action on the encoders toward the last commanded lengths,
         # bounded by 5 % of the stroke (anti-windup); off, the legs hold nominal the same way.
-        self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (self._leg_target - data.qpos[p.leg_qpos]),
+        self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (self._leg_target - obs["leg_positions"]),
                                     -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
         self._leg_target = legs
         setpoint = legs + self.leg_integral
-        data.ctrl[p.leg_ids] = (setpoint - data.act[p.leg_act]) / self.dt  # ramp over the tick
+        command[self.leg_ids] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
 
-    def _stewart_legs(self, tick: int, nxt: int) -> np.ndarray:
+    def _stewart_legs(self, obs, nxt: int) -> np.ndarray:
         """Leg length changes (6,) that put the feed platform at its planned pose for the end of
         the tick, from the estimated cabin pose and the A-B encoders (inverse kinematics)."""
-        data, p, s = self._data, self.physics, self.state
-        j, pos, rot = self._measured(tick, self.stewart_lag, self.stewart_noise)
+        s = self.state
+        j = int(round(obs["cabin_pose_time"][0] / self.dt))
+        pos, rot = obs["cabin_pose_position"], obs["cabin_pose_rotation"]
         deviation = np.concatenate([pos - s.cabin_origin[j], vee(rot @ s.cabin_rotation[j].T)])
         alpha, beta = self._tracker_gains
         predicted = self.stewart_deviation + self.stewart_rate * self.dt
@@ -854,10 +969,8 @@ class FastController:
         ahead = self.stewart_deviation + self.stewart_lead * self.stewart_rate
         pos = s.cabin_origin[nxt] + ahead[:3]
         rot = (np.eye(3) + skew(ahead[3:])) @ s.cabin_rotation[nxt]
-        # R_AB from the encoders: the B frame relative to the cabin, as the model's kinematics
-        # has it (the encoders are exact here).
-        r_ab = data.xmat[p.cabin_body].reshape(3, 3).T @ data.xmat[p.ab_b_body].reshape(3, 3)
-        r_base = rot @ r_ab
+        # R_AB from the encoders: the B frame relative to the cabin.
+        r_base = rot @ obs["ab_rotation"]
         p_base = pos + rot @ fast.FAST.ab_center
         # The platform's planned pose in the measured base (AB) frame, and its leg lengths;
         # beyond the stroke the actuators' ctrlrange clamps (the log keeps the demand).

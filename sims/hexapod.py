@@ -31,6 +31,7 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
+from sims.task import JointEncoders, plan_checked
 from sims.wind import BodyWindDrag, check_mean_speed
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
@@ -268,7 +269,8 @@ class HexapodController(ServoFeedforwardController):
     that hold the payload in static equilibrium at the reference pose, what a real hexapod's
     gravity table supplies (``static_drive_forces``). The integral action takes what the
     model leaves out (wind, the constraint compliance, the payload's tiny inertial forces).
-    Gains and force limits are read from the compiled model in ``reset``.
+    Gains and force limits are read from the nominal model in ``reset``; the statics use the
+    nominal model at the start pose (``ControlContext.nominal_physics``).
 
     Args:
       feedforward: include f_ff (False: PD + integral only).
@@ -276,7 +278,7 @@ class HexapodController(ServoFeedforwardController):
     """
 
     def __init__(self, feedforward: bool = True, integral_time: float | None = INTEGRAL_TIME_S):
-        super().__init__(None, None, None, feedforward, integral_time)
+        super().__init__(None, None, feedforward, integral_time)
 
     @property
     def f_ff(self) -> np.ndarray:
@@ -319,13 +321,8 @@ class HexapodController(ServoFeedforwardController):
         rod_weight = model.body_mass[rod] * (units @ gravity)
         return -tension - rod_weight
 
-    def feedforward_forces(self, physics, reference: TrajectorySample) -> np.ndarray:
-        return self.static_drive_forces(physics, reference.position)
-
-    def reset(self, physics, reference: TrajectorySample, control_dt: float) -> None:
-        self.kp, self.kv, self.force_limit = physics.kp, physics.kv, physics.force_limit
-        self.dofs, self.qpos_adr = physics.strut_dofs, physics.strut_qpos
-        super().reset(physics, reference, control_dt)
+    def feedforward_forces(self, context) -> np.ndarray:
+        return self.static_drive_forces(context.nominal_physics(), context.reference.position)
 
 
 # ----------------------------------------------------------------------------- evaluation
@@ -343,11 +340,14 @@ def arrival_times(reference: TrajectorySample, tolerance: float = 0.0) -> np.nda
 class HexapodEvaluation:
     """Checks and outputs of a hexapod run."""
 
-    def __init__(self, physics: HexapodPhysics, move, synchronous: bool, wind: BodyWindDrag | None):
+    def __init__(self, physics: HexapodPhysics, problem: hexapod_planner.MoveProblem, duration: float,
+                 wind: BodyWindDrag | None):
         self.physics = physics
-        self.move = move
-        self.synchronous = synchronous
+        self.problem = problem
+        self.synchronous = problem.synchronous
+        self.planned_duration = float(duration)  # of the trajectory the planner returned
         self.wind = wind
+        self.own_times = hexapod_planner.own_move_times(problem)
 
     def _strut_log(self, log: RunLog):
         p = self.physics
@@ -380,7 +380,7 @@ class HexapodEvaluation:
         during = log.t <= move_end + 1e-9
         following = 1e6 * np.abs(q - ref.position)[during].max()
         window = log.t >= log.t[-1] - SETTLE_WINDOW_S - 1e-9
-        target_pose = self.move.target_pose
+        target_pose = self.problem.target_pose
         pose_err = self.pivot_errors_um(log, target_pose)
         demanded = demanded_force(p.kp, p.kv, log.act[:, :6], q, qd)
         force = np.abs(demanded).max()
@@ -393,14 +393,14 @@ class HexapodEvaluation:
         # arrival); the settling window only comes after them.
         arrived = not np.any(ref.velocity[-1] != 0.0)
         short = (f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion "
-                 f"(planned to t = {float(self.move.duration):.3f} s) came to rest")
+                 f"(planned to t = {self.planned_duration:.3f} s) came to rest")
         if self.synchronous:
             checks.append(Check("arrival_spread", spread, ARRIVAL_SPREAD_LIMIT_S, "s",
                                 note="last minus first strut arrival of the commanded motion")
                           if arrived else
                           Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=short))
         else:
-            own = 2.0 * np.asarray(self.move.profiles.half_time)
+            own = self.own_times
             late = float(np.abs(arrivals - own)[moving].max()) if moving.any() else 0.0
             checks.append(Check("arrival_vs_own_time", late, 2 * CONTROL_DT, "s",
                                 note=f"each strut ends within two ticks of its own time 2 T_i; "
@@ -408,7 +408,7 @@ class HexapodEvaluation:
                           if arrived else
                           Check.not_evaluated("arrival_vs_own_time", 2 * CONTROL_DT, "s", reason=short))
         ended = arrived and log.t[-1] >= move_end + SETTLE_S - 1e-9
-        settled_at = (move_end if arrived else float(self.move.duration)) + SETTLE_S
+        settled_at = (move_end if arrived else self.planned_duration) + SETTLE_S
         checks += [
             Check("strut_velocity", 1e6 * v_cmd, 1e6 * limits.strut_speed, "um/s",
                   note="commanded; measured peak "
@@ -464,8 +464,8 @@ class HexapodEvaluation:
             "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, :6], q, qd),
             "drive_force_limit": p.force_limit,
             "pose_actual": p.poses_from_qpos(log.qpos),
-            "target_pose": np.asarray(self.move.target_pose),
-            "pivot_error_um": self.pivot_errors_um(log, self.move.target_pose),
+            "target_pose": np.asarray(self.problem.target_pose),
+            "pivot_error_um": self.pivot_errors_um(log, self.problem.target_pose),
         }
         if self.wind is not None and self.wind.speed is not None:
             out["wind_speed"] = self.wind.speed[: log.t.size]
@@ -498,9 +498,15 @@ def camera_area(physics: HexapodPhysics):
     return area
 
 
-def plan(synchronous: bool):
+def problem(synchronous: bool) -> hexapod_planner.MoveProblem:
+    """The scenario's move: from the zero pose to SYNC_TARGET (or ASYNC_TARGET)."""
     target = SYNC_TARGET if synchronous else ASYNC_TARGET
-    return hexapod_planner.plan_move(np.zeros(6), target, synchronous=synchronous)
+    return hexapod_planner.MoveProblem(np.zeros(6), target, synchronous)
+
+
+def plan(synchronous: bool):
+    """The scenario's move as the paper's generator plans it (``planbench plan``)."""
+    return hexapod_planner.PaperMovePlanner().plan(problem(synchronous))
 
 
 def log_bytes_per_tick(wind: bool = True) -> float:
@@ -524,9 +530,22 @@ def validate(options, default_duration: float | None = None) -> None:
     run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(wind > 0))
 
 
-def _setup(synchronous: bool, options, controller=None) -> Setup:
-    move = plan(synchronous)
-    duration = options.duration if options.duration is not None else move.duration + SETTLE_S
+def sensors(physics: HexapodPhysics) -> JointEncoders:
+    """The hexapod's sensors: the six strut encoders (length change from the zero pose),
+    exact, every tick (Rubin's encoders resolve far below the 1 um check; README.md)."""
+    model = physics.model.ptr
+    acts = [model.actuator(j).actadr[0] for j in range(6)]
+    return JointEncoders(physics.strut_qpos, physics.strut_dofs, acts,
+                         "strut encoders (length change from the zero pose)", "m", CONTROL_DT)
+
+
+def build(move: hexapod_planner.MoveProblem, options, planner=None, controller=None) -> Setup:
+    """A hexapod run of ``move``: ``planner`` (default the paper's generator) plans it,
+    ``controller`` (default ``HexapodController()``) follows it; the checks judge the target
+    pose and the limits on the trajectory the planner returned."""
+    planner = hexapod_planner.PaperMovePlanner() if planner is None else planner
+    trajectory = plan_checked(planner, move, STRUT_LABELS)
+    duration = options.duration if options.duration is not None else trajectory.duration + SETTLE_S
     validate(options, duration)
     elevation = DEFAULT_ELEVATION_DEG if options.elevation is None else options.elevation
     physics = HexapodPhysics.load(elevation)
@@ -536,11 +555,14 @@ def _setup(synchronous: bool, options, controller=None) -> Setup:
     if wind_speed > 0:
         wind = BodyWindDrag("camera", wind_speed, camera_area(physics), CAMERA_DRAG_COEFFICIENT,
                             WIND_AZIMUTH_DEG)
-    evaluation = HexapodEvaluation(physics, move, synchronous, wind)
+    evaluation = HexapodEvaluation(physics, move, trajectory.duration, wind)
     return Setup(
         physics=physics,
-        trajectory=move,
+        trajectory=trajectory,
         controller=controller if controller is not None else HexapodController(),
+        sensors=sensors(physics),
+        problem=move,
+        planner=planner,
         control_dt=CONTROL_DT,
         duration=duration,
         evaluate=evaluation,
@@ -554,12 +576,12 @@ def _setup(synchronous: bool, options, controller=None) -> Setup:
     )
 
 
-def build_sync(options) -> Setup:
-    return _setup(True, options)
+def build_sync(options, planner=None, controller=None) -> Setup:
+    return build(problem(True), options, planner, controller)
 
 
-def build_async(options) -> Setup:
-    return _setup(False, options)
+def build_async(options, planner=None, controller=None) -> Setup:
+    return build(problem(False), options, planner, controller)
 
 
 def strut_kinds() -> list[str]:

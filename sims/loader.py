@@ -16,12 +16,12 @@ from dm_control import mujoco as dm_mujoco
 import models
 from planners import loader as loader_planner
 from planners.loader import forward_kinematics
-from planners.trajectory import Trajectory
 from sims import run_limits
 from sims.checks import Check
 from sims.collision import clearance, geoms_by_contype, obstacle_contact_pairs
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
+from sims.task import JointEncoders, plan_checked
 
 #: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
 ROBOT_CONTYPE = 1
@@ -213,17 +213,40 @@ def validate(options, default_duration: float | None = None) -> None:
     run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
 
 
-def _setup(trajectory: Trajectory, key_times, key_points, options) -> Setup:
+def sensors(physics: LoaderPhysics) -> JointEncoders:
+    """The loader's sensors: the drives' encoders on theta1 ... theta6, exact, every tick
+    (no encoder figures are published for it; an assumption, README.md)."""
+    model = physics.model.ptr
+    joints = [model.joint(n) for n in physics.joint_names]
+    return JointEncoders([j.qposadr[0] for j in joints], [j.dofadr[0] for j in joints],
+                         [model.actuator(n).actadr[0] for n in physics.joint_names],
+                         "encoders of theta1 (m) ... theta6 (rad)", "m|rad", CONTROL_DT)
+
+
+def reference_controller() -> ServoFeedforwardController:
+    """Our controller: the drives' PD with the nominal model's inverse dynamics as
+    feed-forward (``ServoFeedforwardController``)."""
+    spec = models.loader_spec()
+    return ServoFeedforwardController(spec.kp, spec.kv)
+
+
+def build(problem: loader_planner.LoaderProblem, options, planner=None, controller=None) -> Setup:
+    """A loader run: ``planner`` (default the paper's cubic B-spline) plans ``problem``,
+    ``controller`` (default ``reference_controller()``) follows it; the checks judge the
+    problem's key points, the obstacles and the drive limits."""
+    planner = loader_planner.CubicBSplinePlanner() if planner is None else planner
+    trajectory = plan_checked(planner, problem, problem.labels)
     duration = options.duration if options.duration is not None else trajectory.duration + SETTLE_S
     validate(options, duration)
     physics = LoaderPhysics.load()
-    spec = models.loader_spec()
-    controller = ServoFeedforwardController(spec.kp, spec.kv, _joint_dofs(physics))
-    evaluation = LoaderEvaluation(physics, key_times, key_points)
+    evaluation = LoaderEvaluation(physics, problem.key_times, problem.key_points)
     return Setup(
         physics=physics,
         trajectory=trajectory,
-        controller=controller,
+        controller=reference_controller() if controller is None else controller,
+        sensors=sensors(physics),
+        problem=problem,
+        planner=planner,
         control_dt=CONTROL_DT,
         duration=duration,
         evaluate=evaluation,
@@ -234,12 +257,10 @@ def _setup(trajectory: Trajectory, key_times, key_points, options) -> Setup:
     )
 
 
-def build_supply(options) -> Setup:
-    plan = loader_planner.supply_plan()
-    return _setup(plan, plan.key_times, plan.key_points, options)
+def build_supply(options, planner=None, controller=None) -> Setup:
+    return build(loader_planner.supply_problem(), options, planner, controller)
 
 
-def build_direct(options) -> Setup:
-    plan = loader_planner.direct_plan()
-    # The key points checked are the endpoints; M1 ... M4 are not on this path.
-    return _setup(plan, plan.key_times, plan.key_points, options)
+def build_direct(options, planner=None, controller=None) -> Setup:
+    # The key points checked are the endpoints; M1 ... M4 are not in this problem.
+    return build(loader_planner.direct_problem(), options, planner, controller)

@@ -652,6 +652,8 @@ def summary_dict(result) -> dict:
         "wall_time_s": round(result.wall_time_s, 4),
         "realtime_factor": round(result.sim_time_s / result.wall_time_s, 3) if result.wall_time_s > 0 else None,
         "components": result.components,
+        "plugins": result.plugins,
+        "sensors": result.sensors,
         "checks": [c.to_json() for c in result.checks],
         "metrics": result.metrics,
     }

@@ -1,8 +1,10 @@
 """The runner: the control loop around MuJoCo, shared by every mechanism.
 
-Per control tick it calls the controller once (it writes ``data.ctrl``), applies the
-disturbance, lets MuJoCo take ``k`` physics steps with ``mj_step(model, data, nstep=k)`` and
-copies the state into preallocated logs. Everything else (the planned motion, checks,
+Per control tick it updates the task's sensors (``sims.task.Sensors``: the observation),
+calls the controller once with that observation (it writes or returns the actuator commands;
+it never gets the physics, ``sims.task``), applies the disturbance, lets MuJoCo take ``k``
+physics steps with ``mj_step(model, data, nstep=k)`` and copies the state into preallocated
+logs. Everything else (the planned motion, checks,
 rendering) works on whole arrays before or after the loop.
 
 Divergence (a NaN in the state, or any MuJoCo warning such as the bad-qacc reset) ends the
@@ -26,6 +28,8 @@ from tqdm import tqdm
 
 from planners.trajectory import Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, controller_check, divergence_check
+from sims.task import (ControlContext, Controller, PluginError, Sensors, check_controller,
+                       check_first_command, nominal_copy)
 
 #: How often (in control ticks) the loop scans for divergence: NaN or inf in the logged
 #: state since the last scan, and MuJoCo's warning counters (its bad-qacc detection resets the
@@ -33,21 +37,9 @@ from sims.checks import Check, controller_check, divergence_check
 SCAN_TICKS = 10
 
 
-class Controller(Protocol):
-    """A controller plugged into the runner.
-
-    ``reset`` is called once with the physics at its initial state and the reference
-    sampled at every control tick; ``__call__`` once per tick, before the physics steps of
-    that tick, and writes ``physics.data.ctrl`` (and may read sensors).
-    """
-
-    def reset(self, physics, reference: TrajectorySample, control_dt: float) -> None: ...
-
-    def __call__(self, tick: int, physics) -> None: ...
-
-
 class Disturbance(Protocol):
-    """Wind, ship motion, payload forces...: applied once per control tick."""
+    """Wind, ship motion, payload forces...: applied once per control tick. Part of the
+    plant, so it may read and write the physics."""
 
     def reset(self, physics, times: np.ndarray, rng: np.random.Generator) -> None: ...
 
@@ -60,8 +52,13 @@ class Setup:
 
     Attributes:
       physics: a ``dm_control.mujoco.Physics`` of the scene, at its initial state.
-      trajectory: the planned motion.
-      controller: see ``Controller``.
+      trajectory: the planned motion (what the planner returned; for the antenna, the ideal
+        joint path for the true sea, a reference for plots).
+      controller: see ``sims.task.Controller``.
+      sensors: the task's ``sims.task.Sensors`` (the controller's observation).
+      problem: the task's planning problem (typed, per mechanism).
+      planner: the planner that ran (its class is recorded in summary.json); for the
+        antenna the task's ``RecordingPlanner`` around the online planner.
       control_dt: control period, s; a multiple of the model timestep.
       duration: simulated time, s.
       evaluate: (RunLog) -> (checks, metrics) for this mechanism.
@@ -74,11 +71,18 @@ class Setup:
       video_note: what the video shows, written to summary.json (e.g. the magnification).
       output_stride: timeseries.npz keeps every this-many-th tick (the checks use them all):
         long runs at a high control rate would otherwise write hundreds of MB.
+      nominal_physics: () -> the controller's nominal model at the initial state
+        (``ControlContext.nominal_physics``); default: a copy of ``physics`` as it is now.
+      controlled: indices of the actuators a controller drives (the dm_control action), None
+        for all (the antenna's deck drives are the sea's).
     """
 
     physics: object
     trajectory: Trajectory
     controller: Controller
+    sensors: Sensors
+    problem: object
+    planner: object
     control_dt: float
     duration: float
     evaluate: Callable
@@ -90,6 +94,12 @@ class Setup:
     video_qpos: Callable | None = None
     video_note: str = ""
     output_stride: int = 1
+    nominal_physics: Callable | None = None
+    controlled: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.nominal_physics is None:
+            self.nominal_physics = nominal_copy(self.physics)
 
 
 @dataclass
@@ -125,8 +135,10 @@ class RunLog:
 
 @dataclass
 class RunResult:
-    """A finished run. ``components``: what ran, by class (``module.QualName``): the planned
-    ``trajectory``, the ``controller`` and the ``disturbance`` (None when there is none)."""
+    """A finished run. ``components``: what ran, by class (``module.QualName``): the
+    ``planner``, the ``trajectory`` it returned, the ``controller``, the ``sensors`` and the
+    ``disturbance`` (None when there is none). ``plugins``: the ``MODULE:FACTORY`` of a user's
+    planner or controller given on the command line. ``sensors``: each sensor's SensorSpec."""
 
     scenario: str
     seed: int
@@ -136,6 +148,8 @@ class RunResult:
     sim_time_s: float
     wall_time_s: float
     components: dict = field(default_factory=dict)
+    plugins: dict = field(default_factory=dict)
+    sensors: list = field(default_factory=list)
 
     @property
     def passed(self) -> bool:
@@ -190,6 +204,15 @@ def _exception_text(e: BaseException) -> str:
     return text if len(text) <= 300 else text[:297] + "..."
 
 
+def _raised_in(e: BaseException, obj) -> bool:
+    """Whether the innermost frames of ``e``'s traceback belong to ``obj``'s module."""
+    module = getattr(getattr(obj, "planner", obj), "__module__", None)
+    tb, last = e.__traceback__, None
+    while tb is not None:
+        last, tb = tb, tb.tb_next
+    return last is not None and last.tb_frame.f_globals.get("__name__") == module
+
+
 def _bad_command(model, ctrl: np.ndarray, t: float) -> str:
     """What is wrong with a command vector that is not finite, for the check's note."""
     j = int(np.argmax(~np.isfinite(ctrl)))
@@ -197,18 +220,63 @@ def _bad_command(model, ctrl: np.ndarray, t: float) -> str:
     return f"the controller wrote ctrl[{j}] ({name}) = {ctrl[j]} at t = {t:.4f} s"
 
 
-def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) -> RunLog:
-    """Run the control loop of ``setup`` and return its log."""
+@dataclass
+class Episode:
+    """A run's start, shared by ``simulate`` and the dm_control environments (``sims.envs``):
+    the control ticks, the reference sampled at them, the observation and the controller's
+    context. ``start_episode`` makes it."""
+
+    times: np.ndarray
+    reference: TrajectorySample
+    observation: dict
+    context: ControlContext
+    steps_per_tick: int
+
+
+def start_episode(setup: Setup, controller=None) -> Episode:
+    """Put ``setup`` at the start of its run: reset the sensors (seeded from ``setup.seed``),
+    the online planner, ``controller`` (default ``setup.controller``: its ``reset`` with the
+    ControlContext, the drives' initial set-points it chose) and the disturbance (seeded
+    from ``setup.seed``), and evaluate the physics."""
     physics = setup.physics
     model, data = physics.model.ptr, physics.data.ptr
     k = steps_per_tick(model, setup.control_dt)
     times = control_ticks(setup.duration, setup.control_dt)
-    n = times.size
     reference = setup.trajectory.sample(times)
-    setup.controller.reset(physics, reference, setup.control_dt)
-    rng = np.random.default_rng(setup.seed)
+    controller = setup.controller if controller is None else controller
+    check_controller(controller)
+    observation = setup.sensors.reset(physics, times, setup.seed)
+    context = ControlContext(
+        model=setup.nominal_physics().model.ptr, nominal_physics=setup.nominal_physics,
+        problem=setup.problem, trajectory=setup.trajectory, reference=reference,
+        control_dt=setup.control_dt, command=data.ctrl, setpoint=data.act.copy(),
+        actuators=tuple(model.actuator(j).name for j in range(model.nu)), observation=observation,
+        sensors=tuple(setup.sensors.specs),
+        planner=setup.planner if hasattr(setup.planner, "step") else None)
+    try:  # before the first tick: a plug-in that cannot start is bad input, not a failed run
+        if context.planner is not None:  # an online planner starts from the problem
+            context.planner.reset(setup.problem)
+        controller.reset(context)
+    except PluginError:
+        raise
+    except Exception as e:
+        role = "planner" if context.planner is not None and _raised_in(e, context.planner) else "controller"
+        raise PluginError(f"the {role}'s reset raised {_exception_text(e)}") from None
+    data.act[:] = context.setpoint
     if setup.disturbance is not None:
-        setup.disturbance.reset(physics, times, rng)
+        setup.disturbance.reset(physics, times, np.random.default_rng(setup.seed))
+    mujoco.mj_forward(model, data)
+    return Episode(times, reference, observation, context, k)
+
+
+def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) -> RunLog:
+    """Run the control loop of ``setup`` and return its log."""
+    physics = setup.physics
+    model, data = physics.model.ptr, physics.data.ptr
+    episode = start_episode(setup)
+    times, reference, observation, context = episode.times, episode.reference, episode.observation, episode.context
+    k, n = episode.steps_per_tick, episode.times.size
+    controller = setup.controller
 
     log = RunLog(
         t=times,
@@ -225,7 +293,6 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
     qpos, qvel, act, ctrl = log.qpos, log.qvel, log.act, log.ctrl
     frc, sens, mpos, mquat = log.actuator_force, log.sensordata, log.mocap_pos, log.mocap_quat
     has_mocap = model.nmocap > 0
-    mujoco.mj_forward(model, data)
 
     def record(i: int) -> None:
         qpos[i] = data.qpos
@@ -239,7 +306,8 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
 
     record(0)
     initial_ctrl = data.ctrl.copy()
-    controller, disturbance = setup.controller, setup.disturbance
+    sensors, disturbance = setup.sensors, setup.disturbance
+    ctrl_now = data.ctrl
     contacts = log.contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
                desc="simulating")
@@ -247,13 +315,22 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0) ->
     last = n - 1
     start = time.perf_counter()
     for i in range(n - 1):
+        sensors(i, physics)
         try:
-            controller(i, physics)
+            command = controller(i, observation)
+            if command is not None:
+                # At the first call a wrong shape is a broken contract (bad input), not a fault.
+                ctrl_now[:] = command if i else check_first_command(command, model.nu, context.actuators)
+        except PluginError:
+            raise
         except Exception as e:  # a controller's fault ends the run as a failed check
             log.controller_error = (float(times[i]), _exception_text(e))
             last = i
             break
         if not isfinite(data.ctrl.sum()):  # ~1 us: no NaN command ever reaches MuJoCo
+            if i == 0:
+                raise PluginError(_bad_command(model, data.ctrl, times[i]) + ", its first command "
+                                  "(before any physics step)")
             log.controller_error = (float(times[i]), _bad_command(model, data.ctrl, times[i]))
             last = i
             break
@@ -307,7 +384,10 @@ def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
     metrics = dict(metrics)
     metrics["physics_steps"] = log.physics_steps
     metrics["loop_wall_s"] = log.loop_wall_s
+    planner = getattr(setup.planner, "planner", setup.planner)  # the one a RecordingPlanner holds
     components = {role: None if obj is None else f"{type(obj).__module__}.{type(obj).__qualname__}"
-                  for role, obj in (("trajectory", setup.trajectory), ("controller", setup.controller),
+                  for role, obj in (("planner", planner), ("trajectory", setup.trajectory),
+                                    ("controller", setup.controller), ("sensors", setup.sensors),
                                     ("disturbance", setup.disturbance))}
-    return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall, components)
+    return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall, components,
+                     sensors=setup.sensors.describe())

@@ -50,7 +50,8 @@ class Scenario:
     Attributes:
       name: CLI name.
       summary: one line for ``planbench list``.
-      build: (RunOptions) -> runner.Setup.
+      build: (RunOptions, planner=None, controller=None) -> runner.Setup; None for the
+        defaults (the paper's planner, our reference controller).
       plan: () -> the planned trajectory (``planbench plan``), no physics.
       options: the RunOptions fields beyond seed and duration that it uses (e.g. {"wind"}).
       expect_pass: False for a scenario that demonstrates a failure (loader-direct).
@@ -65,6 +66,8 @@ class Scenario:
         whose log would not fit in memory, a sea state no sea has, an angle beyond a turn...).
         Cheap: nothing is built. ``planbench run`` calls it while it reads its options, and
         ``build`` calls it again (the Python API).
+      online_planner: the scenario's planner is an online one (the antenna's: ``reset`` and
+        ``step``, sims.task.OnlinePlanner), not a ``plan(problem)`` that returns a Trajectory.
     """
 
     name: str
@@ -79,6 +82,7 @@ class Scenario:
     demo_cameras: tuple = ()
     control_dt: float | None = None
     validate: Callable = lambda options: None
+    online_planner: bool = False
 
 
 #: What the FAST runs share: options, plan plots and the paper's figures.
@@ -130,6 +134,7 @@ SCENARIOS: dict[str, Scenario] = {
             plan_extras=antenna.write_method_comparison,
             control_dt=antenna.CONTROL_DT,
             validate=antenna.validate_paper_motion,
+            online_planner=True,
         ),
         Scenario(
             "antenna-sea-state",
@@ -140,6 +145,7 @@ SCENARIOS: dict[str, Scenario] = {
             kinds=antenna.joint_kinds,
             control_dt=antenna.CONTROL_DT,
             validate=antenna.validate_sea_state,
+            online_planner=True,
         ),
         Scenario(
             "fast-tracking",

@@ -138,7 +138,7 @@ def test_bad_imu_settings_are_named():
     with pytest.raises(PlanningError, match="latency 0.012 s"):
         antenna.ImuModel(latency_s=0.012).ticks(antenna.CONTROL_DT)
     with pytest.raises(PlanningError, match="method 'pinv'"):
-        antenna.AntennaController(np.eye(3), method="pinv")
+        ant.CrrPlanner(method="pinv")
 
 
 def test_bad_sea_state_is_named():
@@ -151,16 +151,16 @@ def test_dm_control_environment_with_a_reference_following_controller():
 
     env = antenna_environment(duration=2.0)
     step = env.reset()
-    assert {"imu_quat", "imu_gyro", "joint_positions", "reference_positions"} <= set(step.observation)
-    physics = env.physics
-    kp, kv = physics.drive_gains()
+    assert {"imu_attitude", "imu_gyro", "joint_positions", "setpoints", "reference_positions"} <= set(step.observation)
+    kp, kv = env.physics.drive_gains()  # the datasheet's gains
+    reference = env.task.reference
     rewards = []
     while not step.last():
-        # A user's controller: set-point = reference + velocity lead, as a rate command.
-        t = physics.data.time + 0.005
-        ref = env.task._trajectory.sample(t)
-        target = ref.position[0] + kv / kp * ref.velocity[0]
-        action = (target - physics.data.act[physics.antenna_actuators]) / 0.005
+        # A user's controller on the observation: set-point = the next tick's reference plus
+        # the velocity lead, as a rate command.
+        k = min(env.task.tick + 1, reference.t.size - 1)
+        target = reference.position[k] + kv / kp * reference.velocity[k]
+        action = (target - step.observation["setpoints"]) / 0.005
         spec = env.action_spec()
         step = env.step(np.clip(action, spec.minimum, spec.maximum))
         rewards.append(step.reward)

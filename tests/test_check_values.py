@@ -720,9 +720,11 @@ def test_fast_cable_tension_max(fast_run):
 
 def test_fast_stewart_stroke(fast_run):
     """Largest Stewart leg change (mm), measured (the leg joints in the logged qpos) or
-    commanded (the controller's stewart_command, written to timeseries.npz)."""
+    commanded (the legs' drive set-points, their activations in the logged act)."""
     w = fast_run
-    stroke = max(np.abs(w.qpos_of(LEGS)).max(), np.abs(w.ts["stewart_command"]).max())
+    model = w.model
+    setpoints = w.ts["act"][:, [model.actuator(f"leg{i}").actadr[0] for i in range(1, 7)]]
+    stroke = max(np.abs(w.qpos_of(LEGS)).max(), np.abs(setpoints).max())
     assert_value(w, "stewart_stroke", 1e3 * float(stroke), EXACT)
 
 
@@ -758,13 +760,13 @@ def faulty_loader(tmp_path_factory):
     inner = setup.controller
 
     class RaisingController:
-        def reset(self, physics, reference, control_dt):
-            inner.reset(physics, reference, control_dt)
+        def reset(self, context):
+            inner.reset(context)
 
-        def __call__(self, tick, physics):
+        def __call__(self, tick, observation):
             if tick == FAULT_TICK:
                 raise ZeroDivisionError("gain schedule hit 0")
-            inner(tick, physics)
+            inner(tick, observation)
 
     setup.controller = RaisingController()
     return write(tmp_path_factory, "loader-faulty", setup, setup.duration, scenarios.get("loader-supply").plan())
@@ -872,16 +874,16 @@ def _paper_step():
 def test_planner_and_controller_solve_with_the_paper_weights():
     """The joint rates of eq. (7) at the paper's Theta0 for its first angular velocity, and
     the direction of one CRR step (eq. 12-14: the RK4 average of those rates), equal the
-    hand solution with the paper's W, from the planner's defaults and with the antenna
-    controller's weights; the weights [10, 5, 1, 2] would give other ones."""
+    hand solution with the paper's W, from the planner's defaults and with the weights of the
+    antenna task's planning problem; the weights [10, 5, 1, 2] would give other ones."""
     theta0, attitudes, dt = _paper_step()
     omega = ant.angular_velocity_eq6(attitudes[0], attitudes[1], dt)
     hand = _least_norm_rates(ant.jacobian(theta0), omega, PAPER_W)
     permuted = _least_norm_rates(ant.jacobian(theta0), omega, np.array([10.0, 5.0, 1.0, 2.0]))
     assert np.abs(permuted - hand).max() > 0.05 * np.abs(hand).max()  # the test can tell
     np.testing.assert_allclose(ant.joint_rates(theta0, omega)[0], hand, rtol=1e-10, atol=1e-14)
-    controller = antenna_sim.AntennaController(np.eye(3))
-    np.testing.assert_allclose(ant.joint_rates(theta0, omega, controller.weights)[0], hand,
+    problem = scenarios.get("antenna-paper-motion").build(RunOptions(duration=0.1)).problem  # what the controller gets
+    np.testing.assert_allclose(ant.joint_rates(theta0, omega, problem.weights)[0], hand,
                                rtol=1e-10, atol=1e-14)
 
     def rk4_direction(weights):

@@ -11,7 +11,8 @@ from planners import fast
 from planners import fast_plan as fplan
 from sims import fast as fast_sim
 from sims import runner
-from sims.fast_physics import CableLoads, ControllerOptions, FastController, FastPhysics, tangent_stiffness
+from sims.fast_physics import (CableLoads, ControllerOptions, FastController, FastPhysics, SensorOptions,
+                               tangent_stiffness, winch_feedforward)
 from sims.scenarios import RunOptions
 
 #: The measured lowest cabin-cable mode (REFERENCE.md: Universe 10:450, 2024).
@@ -139,17 +140,15 @@ def test_wind_load_matches_the_drag_formula():
 class PayOutCable(FastController):
     """Pays out cable 1 by 12 m over 10 s from t = 5 s: the winch runs the wrong way."""
 
-    def __call__(self, tick, physics):
-        super().__call__(tick, physics)
+    def __call__(self, tick, observation):
+        super().__call__(tick, observation)
         extra = 12.0 * np.clip((tick * self.dt - 5.0) / 10.0, 0.0, 1.0)
-        physics.data.ctrl[physics.cable_ids[0]] += extra
+        self.command[self.cable_ids[0]] += extra
 
 
 def test_a_slack_cable_fails_and_no_cable_ever_pushes():
     plan = fast_sim.observation_plan(30.0)
-    setup = fast_sim.build(plan, RunOptions(wind=0.0))
-    setup.controller = PayOutCable(plan, ControllerOptions(stewart=False))
-    setup.evaluate.controller = setup.controller
+    setup = fast_sim.build(plan, RunOptions(wind=0.0), controller=PayOutCable(ControllerOptions(stewart=False)))
     result = runner.run("slack", setup)
     low = check(result, "cable_tension_min")
     assert not low.passed and low.value < fast.FAST_LIMITS.tension_min / 1e3
@@ -185,39 +184,48 @@ def test_dm_control_environment_with_the_winch_feedforward():
     from sims.envs import fast_environment
 
     env = fast_environment(duration=5.0, wind=0.0)
-    physics = env.physics
-    state = env.task._setup.controller.state
+    reference = env.task.reference
+    state = fplan.reference_state(reference)  # what the plan asks of the cabin, A-B and winches
+    winch = winch_feedforward(state, fast.FAST.tower_anchors)
+    names = env.task.setup.physics.model.actuator
+
+    def index(name):
+        return names(name).id
+
+    cables = [index(f"cable{i}") for i in range(1, 7)]
 
     def run(extra_length: float):
         step = env.reset()
-        assert {"cabin_position", "feed_position", "cable_tensions", "reference_feed"} <= set(step.observation)
+        assert {"cabin_pose_position", "cabin_pose_ts_position", "ab_angles", "leg_positions",
+                "reference_positions"} <= set(step.observation)
         rewards = []
+        action = env.physics.data.ctrl.copy()  # the parked commands
         while not step.last():
-            action = physics.data.ctrl.copy()
-            k = env.task.tick(physics)
-            action[physics.cable_ids] = step.observation["reference_unstretched_lengths"] + extra_length
-            action[physics.ab_ids] = state.theta_a[k], state.theta_b[k]
-            action[physics.leg_ids] = 0.0
+            k = min(env.task.tick + 1, reference.t.size - 1)
+            action[cables] = winch[k] + extra_length
+            action[[index("ab_a"), index("ab_b")]] = state.theta_a[k], state.theta_b[k]
+            action[[index(f"leg{i}") for i in range(1, 7)]] = 0.0
             step = env.step(action)
             rewards.append(step.reward)
         return np.array(rewards)
 
     held = run(0.0)
-    assert abs(held.size - env.task._setup.trajectory.duration / 0.01) <= 1  # 10 ms steps
+    assert abs(held.size - env.task.setup.trajectory.duration / 0.01) <= 1  # 10 ms steps
     assert held.min() > math.exp(-1.0)  # feed error below 10 mm throughout
     assert run(1.0).min() < 0.05  # 1 m of cable paid out: the feed drops by metres
 
 
-@pytest.mark.parametrize("option, value, words", [
-    ("pose_rate_hz", 0.0, "pose_rate_hz = 0.0 must be finite and > 0"),
-    ("pose_rate_hz", 400.0, "must be <= 100 Hz"),
-    ("pose_latency_s", -0.1, "pose_latency_s = -0.1 must be finite and >= 0"),
-    ("stewart_noise_m", float("nan"), "stewart_noise_m = nan"),
-    ("stewart_bandwidth_hz", 60.0, "< 50 Hz"),
+@pytest.mark.parametrize("options, option, value, words", [
+    (SensorOptions, "pose_rate_hz", 0.0, "sensor option pose_rate_hz = 0.0 must be finite and > 0"),
+    (SensorOptions, "pose_rate_hz", 400.0, "must be <= 100 Hz"),
+    (SensorOptions, "pose_latency_s", -0.1, "pose_latency_s = -0.1 must be finite and >= 0"),
+    (SensorOptions, "stewart_noise_m", float("nan"), "stewart_noise_m = nan"),
+    (ControllerOptions, "stewart_bandwidth_hz", 60.0, "< 50 Hz"),
+    (ControllerOptions, "ki", -1.0, "controller option ki = -1.0 must be finite and >= 0"),
 ])
-def test_bad_controller_options_are_named(option, value, words):
+def test_bad_controller_and_sensor_options_are_named(options, option, value, words):
     with pytest.raises(ValueError, match=words):
-        ControllerOptions(**{option: value})
+        options(**{option: value})
     with pytest.raises(ValueError, match="mean wind speed -2"):
         CableLoads(-2.0)
 
@@ -250,14 +258,12 @@ SEGMENTS = 10
 def settled_chain(elevation_deg: float, segments: int = SEGMENTS):
     """The discretized model at rest at the planner's pose for a source at 30 deg azimuth:
     the winches at the planned unstretched lengths, 6 s of heavy damping, then released."""
-    from planners.trajectory import control_ticks
 
     plan = hold_plan(30.0, elevation_deg, 1.0)
     setup = fast_sim.build(plan, RunOptions(wind=0.0), cable_segments=segments)
     physics, model, data = setup.physics, setup.physics.model.ptr, setup.physics.data.ptr
-    setup.controller.reset(physics, plan.sample(control_ticks(1.0, 0.01)), 0.01)
+    runner.start_episode(setup)  # the controller's and the plant's start, as a run's
     data.ctrl[physics.leg_ids] = 0.0
-    setup.disturbance.reset(physics, control_ticks(1.0, 0.01), np.random.default_rng(0))
     damping = model.dof_damping.copy()
     model.dof_damping[:] = np.maximum(damping, 2e3)
     model.dof_damping[:6] = 2e5

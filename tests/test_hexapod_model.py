@@ -72,16 +72,30 @@ def test_planner_strut_lengths_equal_mujoco_lengths(seed, elevation):
                                RUBIN_CAMERA.rotation_pivot + pose[:3], atol=1e-12)
 
 
+class _Still:
+    """A trajectory that holds the struts at ``start`` (6,) for ``duration`` s."""
+
+    labels = STRUT_LABELS
+
+    def __init__(self, start, duration):
+        self.start, self.duration = np.asarray(start), float(duration)
+
+    def sample(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        zeros = np.zeros((t.size, 6))
+        return TrajectorySample(t, np.broadcast_to(self.start, (t.size, 6)).copy(), zeros, zeros)
+
+
 def _hold(physics, seconds):
-    n = int(round(seconds / 0.005)) + 1
-    t = np.arange(n) * 0.005
-    zeros = np.zeros((n, 6))
-    start = np.broadcast_to(physics.strut_positions(), (n, 6)).copy()
+    """HexapodController holding the start for ``seconds``, run by the runner."""
+    from sims import hexapod as hexapod_sim
+    from sims import runner
+
     controller = HexapodController()
-    controller.reset(physics, TrajectorySample(t, start, zeros, zeros), 0.005)
-    for tick in range(n - 1):
-        controller(tick, physics)
-        mujoco.mj_step(physics.model.ptr, physics.data.ptr, nstep=10)
+    setup = runner.Setup(physics=physics, trajectory=_Still(physics.strut_positions(), seconds),
+                         controller=controller, sensors=hexapod_sim.sensors(physics), problem=None, planner=None,
+                         control_dt=0.005, duration=seconds, evaluate=None, timeseries=None, report=None)
+    runner.simulate(setup)
     return controller
 
 

@@ -84,7 +84,7 @@ def test_without_feedforward_tracking_fails():
     """The tracking checks can fail: PD drives alone lag the spline by more than 0.25 deg."""
     setup = build_supply(scenarios.RunOptions())
     c = setup.controller
-    setup.controller = ServoFeedforwardController(c.kp, c.kv, c.dofs, feedforward=False)
+    setup.controller = ServoFeedforwardController(c.kp, c.kv, feedforward=False)
     result = runner.run("loader-supply", setup)
     assert not checks(result)["tracking_error"].passed
 
@@ -132,9 +132,10 @@ def test_dm_control_environment_steps():
 
     env = loader_environment()
     ts = env.reset()
-    assert set(ts.observation) == {"joint_positions", "joint_velocities", "reference_positions",
+    assert set(ts.observation) == {"joint_positions", "joint_velocities", "setpoints", "reference_positions",
                                    "reference_velocities"}
-    np.testing.assert_allclose(ts.observation["joint_positions"], ts.observation["reference_positions"])
+    # The episode starts where a run starts: the model's keyframe, P2 to its 6 digits.
+    np.testing.assert_allclose(ts.observation["joint_positions"], ts.observation["reference_positions"], atol=1e-5)
     spec = env.action_spec()
     for _ in range(20):
         ts = env.step(np.zeros(spec.shape))

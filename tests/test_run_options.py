@@ -212,7 +212,7 @@ def _held_bytes(*objects) -> int:
 ])
 def test_log_estimate_matches_the_arrays_a_run_holds(name, estimate):
     """The per-tick estimate against what two short runs hold after the loop (log,
-    controller, disturbance, trajectory): the difference of their bytes over the difference
+    controller, sensors, planner, disturbance, trajectory): the difference of their bytes over the difference
     of their ticks. Within 10 %, never below."""
     scenario = scenarios.get(name)
     extra = {"hexapod-async-move": {"wind": 0.0}, "antenna-paper-motion": {"imu_rate": 25.0},
@@ -222,7 +222,8 @@ def test_log_estimate_matches_the_arrays_a_run_holds(name, estimate):
         options = RunOptions(duration=ticks * scenario.control_dt, **extra)
         setup = scenario.build(options)
         log = runner.simulate(setup)
-        held.append((log.t.size, _held_bytes(log, setup.controller, setup.disturbance, setup.trajectory)))
+        held.append((log.t.size, _held_bytes(log, setup.controller, setup.sensors, setup.planner, setup.disturbance,
+                                             setup.trajectory)))
     (n1, b1), (n2, b2) = held
     measured = (b2 - b1) / (n2 - n1)
     assert measured <= estimate(None) <= 1.1 * measured, (measured, estimate(None))

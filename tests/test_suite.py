@@ -16,6 +16,7 @@ import pytest
 from sims import outputs, runner, scenarios
 from sims.checks import NOT_EVALUATED
 from sims.scenarios import RunOptions
+from sims.task import PluginError
 
 SHORT_S = 0.25  # s: 25-50 control ticks, enough for every disturbance and sensor to act
 LOGGED = ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata", "mocap_pos", "mocap_quat")
@@ -87,8 +88,11 @@ def test_the_summary_is_strict_json_and_names_what_ran(name, tmp_path):
     summary = json.loads((out / "summary.json").read_text(), parse_constant=no_constants)
     assert summary["scenario"] == name and summary["seed"] == 1
     components = summary["components"]
-    assert set(components) == {"trajectory", "controller", "disturbance"}
-    assert components["trajectory"].startswith("planners.") and components["controller"].startswith("sims.")
+    assert set(components) == {"planner", "trajectory", "controller", "sensors", "disturbance"}
+    assert components["planner"].startswith("planners.") and components["trajectory"].startswith("planners.")
+    assert components["controller"].startswith("sims.") and components["sensors"].startswith("sims.")
+    assert summary["plugins"] == {}
+    assert summary["sensors"] and all(s["rate_hz"] > 0 and s["name"] for s in summary["sensors"])
     assert [c["name"] for c in summary["checks"]] == [c.name for c in result.checks]
     manifest = json.loads((out / outputs.MANIFEST).read_text())
     assert manifest["scenario"] == name and set(manifest["files"]) >= set(outputs.RUN_FILES)
@@ -101,19 +105,19 @@ class FaultyController:
     def __init__(self, inner, tick: int, fault: str):
         self.inner, self.tick, self.fault = inner, tick, fault
 
-    def reset(self, physics, reference, control_dt):
-        self.inner.reset(physics, reference, control_dt)
+    def reset(self, context):
+        self.command = context.command
+        self.inner.reset(context)
 
-    def __call__(self, tick, physics):
-        self.inner(tick, physics)
+    def __call__(self, tick, observation):
+        self.inner(tick, observation)
         if tick == self.tick:
             if self.fault == "raise":
                 raise RuntimeError("observation 'imu' missing\nin my controller")
-            physics.data.ctrl[-1] = np.nan
+            self.command[-1] = np.nan
 
 
-@pytest.mark.parametrize("fault_tick", [0, 7])  # 0: a log of the initial state alone
-@pytest.mark.parametrize("fault", ["raise", "nan"])
+@pytest.mark.parametrize("fault, fault_tick", [("raise", 0), ("raise", 7), ("nan", 7)])  # 0: the initial state alone
 @pytest.mark.parametrize("name", NAMES)
 def test_a_controller_fault_ends_the_run_as_a_failed_check(name, fault, fault_tick, tmp_path):
     setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=1))
@@ -131,3 +135,42 @@ def test_a_controller_fault_ends_the_run_as_a_failed_check(name, fault, fault_ti
     outputs.write_run(result, setup, tmp_path / "out")  # outputs still written
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["passed"] is False
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_nan_first_command_is_bad_input_before_any_step(name):
+    """A non-finite command at the first tick is a broken contract, found before MuJoCo
+    steps: a PluginError (the CLI's exit 2) naming the actuator, not a run."""
+    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=1))
+    setup.controller = FaultyController(setup.controller, 0, "nan")
+    last = setup.physics.model.actuator(setup.physics.model.nu - 1).name
+    with pytest.raises(PluginError, match=rf"\({last}\) = nan at t = 0.0000 s, its first command"):
+        runner.run(name, setup)
+    assert setup.physics.data.time == 0.0
+
+
+class HoldStill:
+    """A user's simplest controller: it writes nothing, so the task's initial commands hold
+    (servo set-point rates 0, FAST's winches parked at the start)."""
+
+    def reset(self, context):
+        self.observed = set(context.observation)
+
+    def __call__(self, tick, observation):
+        assert set(observation) == self.observed  # the same readings every tick
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_hold_still_plugin_controller_runs_and_is_judged(name, tmp_path):
+    """Every scenario runs a user's controller that only holds, through the CLI's plug-in
+    path: every check is evaluated or says why not, and summary.json names the plug-in."""
+    from sims import api
+
+    result = api.run(name, controller=HoldStill(), options=RunOptions(duration=SHORT_S, seed=1), out=tmp_path / "out")
+    checks = {c.name: c for c in result.checks}
+    assert checks["controller_errors"].passed and checks["simulation_warnings"].passed, checks
+    assert result.log.t[-1] == pytest.approx(SHORT_S)
+    for c in result.checks:
+        assert c.evaluated or c.note.startswith(NOT_EVALUATED), c
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["components"]["controller"] == f"{__name__}.HoldStill"
