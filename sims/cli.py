@@ -76,8 +76,8 @@ def _seed(text: str) -> int:
 
 
 def _cable_segments(text: str) -> int:
-    """2 ... the model's limit (sims.fast_physics.max_cable_segments: 14 at the 2 ms step)."""
-    from sims.fast_physics import SEGMENT_OMEGA_DT_LIMIT, max_cable_segments
+    """2 ... the model's limit (sims.fast.physics.max_cable_segments: 14 at the 2 ms step)."""
+    from sims.fast.physics import SEGMENT_OMEGA_DT_LIMIT, max_cable_segments
 
     try:
         value = int(text)
@@ -110,7 +110,7 @@ def _checked(kind: str, check, minimum: float | None = None, strict: bool = Fals
 
 def build_parser() -> argparse.ArgumentParser:
     from sims.run_limits import check_angle
-    from sims.ship_motion import check_peak_period, check_wave_height
+    from sims.antenna.ship_motion import check_peak_period, check_wave_height
     from sims.wind import check_mean_speed
 
     parser = _Parser(prog="planbench", description="MuJoCo testbed for motion planners.")
@@ -282,12 +282,9 @@ def cmd_bench(args) -> int:
     from sims import bench
 
     print(bench.format_table(bench.run_all()))
-    print()
-    print(bench.format_planning(bench.planning_throughput()))
-    print()
-    print(bench.format_antenna(bench.antenna_update_rate()))
-    print()
-    print(bench.format_fast(bench.fast_plan_rate()))
+    for text in bench.planner_benchmarks():
+        print()
+        print(text)
     return EXIT_OK
 
 

@@ -110,40 +110,32 @@ def joint_tracking_reward(qpos_index, scale: float):
     return reward
 
 
+def make(scenario: str, **options) -> control.Environment:
+    """The dm_control Environment of the scenario ``scenario`` (any of ``planbench list``):
+    its Setup built with ``RunOptions(**options)`` (e.g. ``duration``, ``seed``, ``wind``), the
+    reward its mechanism declares (``environment_reward`` in sims/<mechanism>/)."""
+    from sims import scenarios
+
+    spec = scenarios.get(scenario)
+    setup = spec.build(scenarios.RunOptions(**options))
+    return environment(setup, scenarios.mechanism_of(scenario).environment_reward(setup))
+
+
 def loader_environment(plan: str = "supply") -> control.Environment:
     """The loader following the supply (or direct) problem's cubic B-spline."""
-    from sims import loader
-    from sims.scenarios import RunOptions
-
-    setup = (loader.build_supply if plan == "supply" else loader.build_direct)(RunOptions())
-    return environment(setup, joint_tracking_reward(setup.sensors.qpos, np.deg2rad(0.1)))
+    return make(f"loader-{plan}")
 
 
 def hexapod_environment(synchronous: bool = True, elevation_deg: float = 45.0) -> control.Environment:
     """The hexapod's sync (or async) move at an elevation; the action is the six drives'
     set-point rates (m/s)."""
-    from sims import hexapod
-    from sims.scenarios import RunOptions
-
-    setup = (hexapod.build_sync if synchronous else hexapod.build_async)(RunOptions(elevation=elevation_deg))
-    return environment(setup, joint_tracking_reward(setup.sensors.qpos, 10e-6))
+    return make(f"hexapod-{'sync' if synchronous else 'async'}-move", elevation=elevation_deg)
 
 
 def antenna_environment(sea_state: bool = True, duration: float = 60.0) -> control.Environment:
     """The ship antenna holding its satellite (default: the default sea state); the action is
     the four antenna drives' set-point rates (rad/s), the deck follows the sea by itself."""
-    from sims import antenna
-    from sims.scenarios import RunOptions
-
-    build = antenna.build_sea_state if sea_state else antenna.build_paper_motion
-    setup = build(RunOptions(duration=duration))
-    satellite = setup.problem.satellite
-
-    def reward(physics, tick, adapter, scale=np.deg2rad(0.1)):
-        pointing, _ = antenna.pointing_errors(physics.dish_rotation(physics.data.qpos), satellite)
-        return float(np.exp(-pointing[0] / scale))
-
-    return environment(setup, reward)
+    return make("antenna-sea-state" if sea_state else "antenna-paper-motion", duration=duration)
 
 
 def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0) -> control.Environment:
@@ -155,10 +147,4 @@ def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0) -
     from sims.scenarios import RunOptions
 
     setup = fast.build(fast.observation_plan(duration), RunOptions(wind=wind, seed=seed))
-    goal = setup.problem.goal
-
-    def reward(physics, tick, adapter, scale=0.01):
-        _, feed, _, _ = goal.feed(np.array([adapter.reference.t[tick]]))
-        return float(np.exp(-np.linalg.norm(physics.feed_position() - feed[0]) / scale))
-
-    return environment(setup, reward)
+    return environment(setup, fast.environment_reward(setup))

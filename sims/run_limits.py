@@ -9,7 +9,7 @@ Duration:
   * its log must fit in memory. The runner preallocates the log (``sims.runner.RunLog``:
     t, qpos, qvel, act, ctrl, actuator_force, sensordata, mocap, the reference sampled at
     every tick) and the controllers and disturbances preallocate their own per-tick arrays;
-    each mechanism states those per tick (``log_bytes_per_tick`` in sims/loader.py,
+    each mechanism states those per tick (``log_bytes_per_tick`` in sims/loader/__init__.py,
     hexapod.py, antenna.py, fast.py; tests/test_run_options.py measures them). A run whose
     estimate exceeds ``log_memory_limit()``, a quarter of the machine's physical memory, is
     refused: evaluating the checks and writing the outputs needs about as much again as the

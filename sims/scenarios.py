@@ -1,11 +1,23 @@
-"""The scenario registry: every runnable scenario of every mechanism, by name."""
+"""The scenario registry: every runnable scenario of every mechanism, by name.
+
+Each mechanism's package ``sims/<mechanism>/`` declares its own scenarios (``SCENARIOS``, a
+tuple of ``Scenario``), plan-only entries (``PLANS``, optional), the scenario that ``planbench
+bench`` times (``BENCHMARK``: name and number of runs) and the reward of its dm_control
+environment (``environment_reward``). The registry imports the packages of the mechanisms
+that ``models.MECHANISMS`` lists (one folder per model, as in MuJoCo Menagerie) the first
+time it is asked, as dm_control's suite builds its registry from its domain modules: a fifth
+mechanism is its own folders plus its name in that tuple. ``planbench list``, ``run``,
+``plan``, ``demo``, ``bench`` and the environments (``sims.envs``) all come from here.
+"""
 
 from __future__ import annotations
 
+import functools
+import importlib
 from dataclasses import dataclass, field
 from typing import Callable
 
-from sims import antenna, fast, hexapod, loader
+import models
 
 
 @dataclass(frozen=True)
@@ -85,125 +97,59 @@ class Scenario:
     online_planner: bool = False
 
 
-#: What the FAST runs share: options, plan plots and the paper's figures.
-FAST_RUN = dict(options=frozenset({"wind", "wind_direction", "stewart", "cables"}), kinds=fast.plan_kinds,
-                plan_extras=fast.write_figures, control_dt=fast.CONTROL_DT, validate=fast.validate)
-LOADER_RUN = dict(kinds=loader.joint_kinds, control_dt=loader.CONTROL_DT, validate=loader.validate)
-HEXAPOD_RUN = dict(options=frozenset({"wind", "elevation"}), kinds=hexapod.strut_kinds,
-                   control_dt=hexapod.CONTROL_DT, validate=hexapod.validate)
+@functools.lru_cache(maxsize=1)
+def mechanisms() -> tuple:
+    """The mechanisms' simulation packages (``sims.<name>`` for each of models.MECHANISMS), in
+    that order."""
+    return tuple(importlib.import_module(f"sims.{name}") for name in models.MECHANISMS)
 
-SCENARIOS: dict[str, Scenario] = {
-    s.name: s
-    for s in (
-        Scenario(
-            "loader-supply",
-            "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the breechblock and seat ring",
-            loader.build_supply,
-            lambda: loader.loader_planner.supply_plan(),
-            **LOADER_RUN,
-        ),
-        Scenario(
-            "loader-direct",
-            "PRR-3R loader: P2 to P3 as a straight joint-space move in the same 2.5 s; strikes the obstacles (expected to fail)",
-            loader.build_direct,
-            lambda: loader.loader_planner.direct_plan(),
-            expect_pass=False,
-            **LOADER_RUN,
-        ),
-        Scenario(
-            "hexapod-sync-move",
-            "Rubin camera hexapod, 3 t camera: synchronous move of ~2 mm and 0.1 deg, all six struts arrive on one tick (--elevation, --wind)",
-            hexapod.build_sync,
-            lambda: hexapod.plan(True),
-            **HEXAPOD_RUN,
-        ),
-        Scenario(
-            "hexapod-async-move",
-            "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at its own minimum time (--elevation, --wind)",
-            hexapod.build_async,
-            lambda: hexapod.plan(False),
-            **HEXAPOD_RUN,
-        ),
-        Scenario(
-            "antenna-paper-motion",
-            "ship antenna, 4 axes: the paper's extreme ship motion (pitch 40 deg/8 s, roll 45 deg/10 s, 1 deg/s turn), IMU at 50 Hz, CRR planner, 60 s (--imu-rate, --imu-latency, --no-prediction)",
-            antenna.build_paper_motion,
-            antenna.plan_paper_motion,
-            options=frozenset({"imu"}),
-            kinds=antenna.joint_kinds,
-            plan_extras=antenna.write_method_comparison,
-            control_dt=antenna.CONTROL_DT,
-            validate=antenna.validate_paper_motion,
-            online_planner=True,
-        ),
-        Scenario(
-            "antenna-sea-state",
-            "ship antenna, 4 axes: JONSWAP sea Hs 5 m, Tp 10 s, waves 135 deg off the bow, holding a GEO satellite at 15 W from 40 N 20 W, 300 s (--hs, --tp, --heading, --imu-rate, --imu-latency, --no-prediction)",
-            antenna.build_sea_state,
-            antenna.plan_sea_state,
-            options=frozenset({"hs", "tp", "heading", "imu"}),
-            kinds=antenna.joint_kinds,
-            control_dt=antenna.CONTROL_DT,
-            validate=antenna.validate_sea_state,
-            online_planner=True,
-        ),
-        Scenario(
-            "fast-tracking",
-            "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
-            fast.build_tracking,
-            fast.tracking_plan,
-            **FAST_RUN,
-            demo_cameras=("closeup",),
-        ),
-        Scenario(
-            "fast-ra-scan",
-            "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
-            fast.build_ra_scan,
-            fast.ra_scan_plan,
-            **FAST_RUN,
-        ),
-        Scenario(
-            "fast-source-switch",
-            "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
-            fast.build_source_switch,
-            fast.source_switch_plan,
-            **FAST_RUN,
-        ),
-    )
-}
+
+@functools.lru_cache(maxsize=1)
+def _registry() -> tuple[dict, dict]:
+    scenarios, plans = {}, {}
+    for package in mechanisms():
+        for table, entries in ((scenarios, getattr(package, "SCENARIOS", ())), (plans, getattr(package, "PLANS", ()))):
+            for entry in entries:
+                if entry.name in scenarios or entry.name in plans:
+                    raise ValueError(f"scenario name {entry.name!r} of {package.__name__} is taken")
+                table[entry.name] = entry
+    return scenarios, plans
+
+
+def mechanism_of(name: str):
+    """The package (``sims.<mechanism>``) that declares the scenario ``name``."""
+    for package in mechanisms():
+        if any(s.name == name for s in (*getattr(package, "SCENARIOS", ()), *getattr(package, "PLANS", ()))):
+            return package
+    raise ValueError(f"unknown scenario {name!r}")
+
+
+def __getattr__(attribute: str):
+    # SCENARIOS and PLANS are built on first use: the mechanisms' packages import this module.
+    if attribute == "SCENARIOS":
+        return _registry()[0]
+    if attribute == "PLANS":
+        return _registry()[1]
+    raise AttributeError(f"module {__name__!r} has no attribute {attribute!r}")
 
 
 def get(name: str) -> Scenario:
     """The scenario called ``name``; a ValueError lists the known names otherwise."""
+    scenarios = _registry()[0]
     try:
-        return SCENARIOS[name]
+        return scenarios[name]
     except KeyError:
         raise ValueError(
-            f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}"
+            f"unknown scenario {name!r}; known: {', '.join(scenarios)}"
         ) from None
-
-
-#: Plans with no run of their own (``planbench plan`` only).
-PLANS: dict[str, Scenario] = {
-    s.name: s
-    for s in (
-        Scenario(
-            "fast-dec-scan",
-            "FAST feed: the paper's motion scan along Dec around 3C 286: 3 legs along RA at 5 deg/h, transitions, beside the paper's eq. 15-20",
-            None,
-            fast.dec_scan_plan,
-            kinds=fast.plan_kinds,
-            plan_extras=fast.write_figures,
-        ),
-    )
-}
 
 
 def get_plan(name: str) -> Scenario:
     """A scenario or a plan-only entry called ``name`` (``planbench plan``)."""
-    if name in PLANS:
-        return PLANS[name]
+    scenarios, plans = _registry()
+    if name in plans:
+        return plans[name]
     try:
         return get(name)
     except ValueError:
-        raise ValueError(f"unknown scenario {name!r}; known: {', '.join([*SCENARIOS, *PLANS])}") from None
+        raise ValueError(f"unknown scenario {name!r}; known: {', '.join([*scenarios, *plans])}") from None

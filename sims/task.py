@@ -280,6 +280,9 @@ class RecordingPlanner:
         self.wall_s = 0.0
 
     def reset(self, problem) -> None:
+        """A new run: the record starts empty, the planner from the problem."""
+        self.count = 0
+        self.wall_s = 0.0
         self.planner.reset(problem)
 
     def step(self, t: float, attitude: np.ndarray) -> np.ndarray:

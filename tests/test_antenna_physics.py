@@ -1,4 +1,4 @@
-"""The ship antenna in MuJoCo (sims/antenna.py): short runs of both scenarios, the IMU and
+"""The ship antenna in MuJoCo (sims/antenna/__init__.py): short runs of both scenarios, the IMU and
 deck against the ship motion, the planner's kinematics against MuJoCo's, the prediction,
 determinism and bad input. The full-length runs belong to ``make demo`` and the benchmark."""
 
@@ -10,7 +10,7 @@ from planners import antenna as ant
 from planners.errors import PlanningError
 from sims import antenna, runner
 from sims.scenarios import RunOptions
-from sims.ship_motion import PaperShipMotion
+from sims.antenna.ship_motion import PaperShipMotion
 
 
 def _run(build, duration, antenna_options=antenna.AntennaOptions(), **options):

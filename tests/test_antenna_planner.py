@@ -1,4 +1,4 @@
-"""The ship antenna planner (planners/antenna.py, planners/geostationary.py) against the
+"""The ship antenna planner (planners/antenna/__init__.py, planners/antenna/geostationary.py) against the
 paper's equations (corrected per REFERENCE.md), scipy/numpy equivalents and its simulation
 conditions (section 5.1: dT = 0.01 s, eq. 15-16)."""
 
@@ -10,8 +10,8 @@ from scipy.spatial.transform import Rotation
 
 from planners import antenna as ant
 from planners.errors import LimitError, PlanningError
-from planners.geostationary import look_angles
-from sims.ship_motion import PaperShipMotion
+from planners.antenna.geostationary import look_angles
+from sims.antenna.ship_motion import PaperShipMotion
 
 DEG = np.pi / 180
 angles = st.floats(-np.pi, np.pi, allow_nan=False)

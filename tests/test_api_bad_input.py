@@ -16,8 +16,10 @@ import pytest
 from hypothesis import example, given, settings, strategies as st
 from scipy.interpolate import CubicSpline
 
-from planners import antenna, fast, fast_plan, hexapod, loader, profiles
-from planners.bspline import CubicBSplineTrajectory
+from planners import antenna, fast, hexapod, loader
+from planners.fast import plan as fast_plan
+from planners.fast import profiles
+from planners.loader.bspline import CubicBSplineTrajectory
 from planners.errors import LimitError, PlanningError
 from planners.trajectory import MAX_MAGNITUDE, sample_times
 

@@ -6,7 +6,7 @@ from hypothesis import given, strategies as st
 from hypothesis.extra import numpy as hnp
 from scipy.interpolate import CubicSpline
 
-from planners.bspline import CubicBSplineTrajectory, solve_control_points
+from planners.loader.bspline import CubicBSplineTrajectory, solve_control_points
 from planners.errors import LimitError, PlanningError
 from planners.loader import TABLE1, TABLE1_TIMES, direct_plan, supply_plan, table1_to_si
 

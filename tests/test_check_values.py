@@ -43,13 +43,13 @@ import pytest
 
 import models
 from planners import antenna as ant
-from planners import fast_plan as fp
-from planners import fast_sky as sky
+from planners.fast import plan as fp
+from planners.fast import sky as sky
 from planners import hexapod as hexapod_planner
-from planners.geostationary import look_angles
+from planners.antenna.geostationary import look_angles
 from sims import antenna as antenna_sim
 from sims import fast as fast_sim
-from sims import fast_physics
+from sims.fast import physics as fast_physics
 from sims import outputs, runner, scenarios
 from sims.scenarios import RunOptions
 
@@ -863,7 +863,7 @@ def test_paper_weights_split_a_shared_axis_by_their_ratio(axis, share):
 
 def _paper_step():
     """Theta0 and the attitudes N(0), N(dT) of the paper's section 5.1 (eq. 15-16)."""
-    from sims.ship_motion import PaperShipMotion
+    from sims.antenna.ship_motion import PaperShipMotion
 
     ship = PaperShipMotion().sample(np.array([0.0, 0.01]))
     az, el, pol = np.radians([223.49, 60.0, -28.8])

@@ -1,17 +1,20 @@
-"""dm_env's own conformance suite (``dm_env.test_utils.EnvironmentTestMixin``) for every
-mechanism's dm_control Environment, with an action sequence that holds the actuators where
+"""dm_env's own conformance suite (``dm_env.test_utils.EnvironmentTestMixin``) for the
+dm_control Environment of every registered scenario (``sims.envs.make``), with an action sequence that holds the actuators where
 the episode starts and runs to the end of the episode, so the contract around LAST and the
 next FIRST is checked too."""
 
 from __future__ import annotations
 
+import copy
+import functools
 import unittest
 
 import dm_env
 import numpy as np
 from dm_env import test_utils
 
-from sims import envs
+from sims import envs, scenarios
+from sims.scenarios import RunOptions
 
 
 class _Conformance(test_utils.EnvironmentTestMixin):
@@ -45,20 +48,35 @@ class _Conformance(test_utils.EnvironmentTestMixin):
         assert types[last + 1] is dm_env.StepType.FIRST and dm_env.StepType.LAST not in types[:last]
 
 
-class LoaderEnvironmentTest(_Conformance, unittest.TestCase):
-    make = staticmethod(envs.loader_environment)
+#: Episodes of this many seconds: 10-20 control ticks, to the end and into the next one.
+EPISODE_S = 0.1
 
 
-class HexapodEnvironmentTest(_Conformance, unittest.TestCase):
-    make = staticmethod(envs.hexapod_environment)
+def _conformance_case(name: str):
+    """A TestCase of dm_env's suite for the environment of the scenario ``name``."""
+    # A Setup is built once per scenario (plans take seconds); each test gets a fresh
+    # Environment over a fresh copy of it.
+    setup = functools.cache(lambda: scenarios.get(name).build(RunOptions(duration=EPISODE_S)))
+
+    def make():
+        built = setup()
+        fresh = copy.copy(built)
+        fresh.physics = built.physics.copy(share_model=False)
+        for attribute in vars(built.physics):
+            if not attribute.startswith("_") and attribute not in vars(fresh.physics):
+                setattr(fresh.physics, attribute, getattr(built.physics, attribute))
+        fresh.sensors, fresh.disturbance, fresh.controller = (copy.deepcopy(built.sensors),
+                                                              copy.deepcopy(built.disturbance),
+                                                              copy.deepcopy(built.controller))
+        return envs.environment(fresh, scenarios.mechanism_of(name).environment_reward(fresh))
+
+    attributes = {"make": staticmethod(make)}
+    if scenarios.get(name).online_planner:  # the antenna: its four drives' set-point rates
+        attributes["hold_action"] = lambda self: np.zeros(self.environment.action_spec().shape)
+    return type(f"EnvironmentTest_{name.replace('-', '_')}", (_Conformance, unittest.TestCase), attributes)
 
 
-class AntennaEnvironmentTest(_Conformance, unittest.TestCase):
-    make = staticmethod(lambda: envs.antenna_environment(duration=1.0))
-
-    def hold_action(self):
-        return np.zeros(self.environment.action_spec().shape)  # the four drives' set-point rates
-
-
-class FastEnvironmentTest(_Conformance, unittest.TestCase):
-    make = staticmethod(lambda: envs.fast_environment(duration=1.0))
+for _name in scenarios.SCENARIOS:  # every registered scenario, no new test code for a new one
+    _case = _conformance_case(_name)
+    globals()[_case.__name__] = _case
+del _case, _name

@@ -86,4 +86,4 @@ def test_fast_straight_switch_keeps_the_observation(tmp_path):
     summary, checks = run(tmp_path, "fast-source-switch", "planner", "fast/straight_switch_planner.py:StraightSwitch",
                           "--duration", "180")
     assert summary["passed"] and summary["metrics"]["observing_s"] > 50.0
-    assert summary["components"]["trajectory"] == "planners.fast_plan.FastPlan"
+    assert summary["components"]["trajectory"] == "planners.fast.plan.FastPlan"

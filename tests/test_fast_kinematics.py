@@ -1,4 +1,4 @@
-"""FAST kinematics and statics (planners/fast.py) against the paper's eq. (1)-(9) (corrected per
+"""FAST kinematics and statics (planners/fast/__init__.py) against the paper's eq. (1)-(9) (corrected per
 REFERENCE.md), hand statics and REFERENCE.md's checked numbers."""
 
 import math

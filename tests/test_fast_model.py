@@ -12,8 +12,8 @@ from scipy.spatial.transform import Rotation
 
 import models
 from planners import fast
-from sims import fast_physics as fp
-from sims.fast_physics import FastPhysics
+from sims.fast import physics as fp
+from sims.fast.physics import FastPhysics
 
 G = fast.FAST
 

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from planners import fast
-from planners import fast_plan as fplan
+from planners.fast import plan as fplan
 from sims import fast as fast_sim
 from sims import runner
-from sims.fast_physics import (CableLoads, ControllerOptions, FastController, FastPhysics, SensorOptions,
+from sims.fast.physics import (CableLoads, ControllerOptions, FastController, FastPhysics, SensorOptions,
                                tangent_stiffness, winch_feedforward)
 from sims.scenarios import RunOptions
 

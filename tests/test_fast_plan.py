@@ -1,4 +1,4 @@
-"""The FAST plan (planners/fast_plan.py, sims/fast.py): source switching (section 3.2, eq. 10),
+"""The FAST plan (planners/fast/plan.py, sims/fast/__init__.py): source switching (section 3.2, eq. 10),
 start and termination (section 3.1), tracking, and a whole plan sampled at 100 Hz."""
 
 import math
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from planners import fast
-from planners import fast_plan as fp
-from planners import profiles as prof
+from planners.fast import plan as fp
+from planners.fast import profiles as prof
 from planners.errors import LimitError
 from sims import fast as fast_sims
 
@@ -169,7 +169,7 @@ def test_shorter_t2_breaks_a_t_max():
 
 
 def test_multifeed_rotation_follows_the_parallactic_angle_and_stays_c1(switch_plan):
-    from planners import fast_sky
+    from planners.fast import sky as fast_sky
 
     plan = switch_plan
     t = np.arange(0.0, plan.duration, 0.01)

@@ -1,4 +1,4 @@
-"""FAST's sky (planners/fast_sky.py): pyerfa's observed az/el against hand spherical
+"""FAST's sky (planners/fast/sky.py): pyerfa's observed az/el against hand spherical
 trigonometry, meridian transits, the 40 deg zenith-angle limit (Table 1), the motion scans'
 geometry (the paper's section 3.3), horizon rates and bad input.
 
@@ -23,7 +23,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from planners import fast_sky as fs
+from planners.fast import sky as fs
 from planners.errors import LimitError, PlanningError
 
 DEG = math.pi / 180

@@ -1,4 +1,4 @@
-"""The Rubin hexapod planner (planners/hexapod.py) against the paper, REFERENCE.md and
+"""The Rubin hexapod planner (planners/hexapod/__init__.py) against the paper, REFERENCE.md and
 independent computations: kinematics, statics, the continuous generator and its tick-grid
 realization.
 

@@ -5,7 +5,7 @@ import pytest
 
 from planners.loader import direct_plan, supply_plan
 from sims import runner, scenarios
-from sims.collision import clearance
+from sims.loader.collision import clearance
 from sims.loader import LoaderPhysics, build_supply
 from sims.controllers import ServoFeedforwardController
 

@@ -2,7 +2,7 @@
 
 Refused up front, before anything is built or written: a duration under one control tick or
 whose log would not fit in memory (sims.run_limits), sea states outside the range of the
-spectrum and the RAOs (sims.ship_motion.check_sea_state), angles beyond one turn, winds
+spectrum and the RAOs (sims.antenna.ship_motion.check_sea_state), angles beyond one turn, winds
 beyond IEC 61400-1's classes, IMU rates and latencies the controller does not model, cable
 segments beyond the timestep's limit. The CLI says so in one line (exit 2); the Python API
 raises a ValueError subclass with the same words. A check that cannot be evaluated fails
@@ -15,10 +15,11 @@ import re
 import numpy as np
 import pytest
 
-from sims import antenna, fast, hexapod, loader, run_limits, runner, scenarios, ship_motion, wind
+from sims import antenna, fast, hexapod, loader, run_limits, runner, scenarios, wind
+from sims.antenna import ship_motion
 from sims.checks import NOT_EVALUATED, Check
 from sims.cli import BadInput, _options, build_parser, format_checks, main
-from sims.fast_physics import CableLoads, max_cable_segments
+from sims.fast.physics import CableLoads, max_cable_segments
 from sims.scenarios import RunOptions
 
 

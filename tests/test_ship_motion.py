@@ -1,4 +1,4 @@
-"""Ship motion (sims/ship_motion.py): attitude kinematics, the paper's motion (ship-antenna paper,
+"""Ship motion (sims/antenna/ship_motion.py): attitude kinematics, the paper's motion (ship-antenna paper,
 eq. 15-16), the JONSWAP spectrum, the RAOs and the sea-state motion."""
 
 import math
@@ -11,7 +11,7 @@ from scipy import integrate
 from scipy.spatial.transform import Rotation
 
 from planners.errors import PlanningError
-from sims.ship_motion import (
+from sims.antenna.ship_motion import (
     AXES,
     HEADING,
     HEAVE,

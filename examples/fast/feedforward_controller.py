@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from planners import fast
-from planners import fast_plan as fp
-from sims.fast_physics import winch_feedforward
+from planners.fast import plan as fp
+from sims.fast.physics import winch_feedforward
 
 
 class FeedforwardOnly:

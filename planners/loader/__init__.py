@@ -15,7 +15,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from models import SerialChainSpec, loader_spec
-from planners.bspline import CubicBSplineTrajectory
+from planners.loader.bspline import CubicBSplineTrajectory
 from planners.errors import PlanningError
 from planners.trajectory import check_values
 

@@ -41,7 +41,7 @@ from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import fast
-from planners import fast_plan
+from planners.fast import plan as fast_plan
 from planners.errors import LimitError
 from planners.legs import leg_lengths, structure_matrix
 from planners.rotations import rot_y, rot_z, skew, vee, wxyz
@@ -852,9 +852,9 @@ def parked_command(physics: "FastPhysics", state) -> np.ndarray:
 class FastController:
     """Winches, A-B rotator, multi-beam rotation and Stewart stabilizer (see the module doc).
 
-    It follows the reference's feed and multi-beam channels (planners.fast_plan.PLAN_LABELS);
+    It follows the reference's feed and multi-beam channels (planners.fast.plan.PLAN_LABELS);
     the cabin pose, the A-B angles, the cable lengths and the tensions that go with them come
-    from the planners' kinematics and statics (``planners.fast_plan.reference_state``), so
+    from the planners' kinematics and statics (``planners.fast.plan.reference_state``), so
     any FAST trajectory can be followed. It reads the task's observation (``FastSensors``):
     the total stations' fix for the cable loop, the 100 Hz pose for the stabilizer, the
     encoders; rates and latencies from the sensors' specs.

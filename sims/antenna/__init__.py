@@ -33,14 +33,14 @@ from dm_control import mujoco as dm_mujoco
 import models
 from planners import antenna as ant
 from planners.errors import PlanningError
-from planners.geostationary import look_angles
+from planners.antenna.geostationary import look_angles
 from planners.trajectory import TrajectorySample
 from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
 from sims.task import ControlContext, JointEncoders, nominal_copy, RecordingPlanner, Sensors, SensorSpec, check_planner
-from sims.ship_motion import PaperShipMotion, SeaStateMotion, check_sea_state, world_from_ship
+from sims.antenna.ship_motion import PaperShipMotion, SeaStateMotion, check_sea_state, world_from_ship
 
 CONTROL_DT = 0.005  # s: the runner's tick; the IMU rate is a whole number of ticks
 DECK_JOINTS = ("heave", "yaw", "pitch", "roll")
@@ -588,7 +588,7 @@ class AntennaEvaluation:
         }
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.report import antenna_report
+        from sims.antenna.report import antenna_report
 
         antenna_report(self.timeseries(log), log.t, checks, path, self.pointing_max_deg)
 
@@ -669,7 +669,7 @@ def validate_paper_motion(options, antenna_options: AntennaOptions | None = None
 
 def validate_sea_state(options, antenna_options: AntennaOptions | None = None) -> None:
     """As ``validate_paper_motion`` for antenna-sea-state, and the sea state: Hs and Tp in
-    their ranges and no steeper than waves can be (``sims.ship_motion.check_sea_state``), the
+    their ranges and no steeper than waves can be (``sims.antenna.ship_motion.check_sea_state``), the
     wave heading within +-360 deg (``sims.run_limits.check_angle``)."""
     hs = SEA_HS_M if options.hs is None else options.hs
     tp = SEA_TP_S if options.tp is None else options.tp
@@ -834,7 +834,7 @@ def write_method_comparison(plan, out_dir) -> None:
     scenario's own plan is not needed: the comparison runs the paper's conditions)."""
     from pathlib import Path
 
-    from sims.report import antenna_methods_plot
+    from sims.antenna.report import antenna_methods_plot
 
     paths = compare_methods()
     arrays = {"t": paths["pinv"].t}
@@ -848,3 +848,47 @@ def write_method_comparison(plan, out_dir) -> None:
 
 def joint_kinds() -> list[str]:
     return ["hinge"] * 4
+
+
+# ----------------------------------------------------------------------------- registry
+
+from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+
+SCENARIOS = (
+    Scenario(
+        "antenna-paper-motion",
+        "ship antenna, 4 axes: the paper's extreme ship motion (pitch 40 deg/8 s, roll 45 deg/10 s, 1 deg/s turn), IMU at 50 Hz, CRR planner, 60 s (--imu-rate, --imu-latency, --no-prediction)",
+        build_paper_motion,
+        plan_paper_motion,
+        options=frozenset({"imu"}),
+        kinds=joint_kinds,
+        plan_extras=write_method_comparison,
+        control_dt=CONTROL_DT,
+        validate=validate_paper_motion,
+        online_planner=True,
+    ),
+    Scenario(
+        "antenna-sea-state",
+        "ship antenna, 4 axes: JONSWAP sea Hs 5 m, Tp 10 s, waves 135 deg off the bow, holding a GEO satellite at 15 W from 40 N 20 W, 300 s (--hs, --tp, --heading, --imu-rate, --imu-latency, --no-prediction)",
+        build_sea_state,
+        plan_sea_state,
+        options=frozenset({"hs", "tp", "heading", "imu"}),
+        kinds=joint_kinds,
+        control_dt=CONTROL_DT,
+        validate=validate_sea_state,
+        online_planner=True,
+    ),
+)
+#: The scenario ``planbench bench`` times, and how many runs it takes the best of.
+BENCHMARK = ("antenna-sea-state", 5)
+
+
+def environment_reward(setup: Setup):
+    """The dm_control reward: exp(-pointing error / 0.1 deg)."""
+    satellite, scale = setup.problem.satellite, np.deg2rad(0.1)
+
+    def reward(physics, tick, adapter):
+        pointing, _ = pointing_errors(physics.dish_rotation(physics.data.qpos), satellite)
+        return float(np.exp(-pointing[0] / scale))
+
+    return reward

@@ -473,7 +473,7 @@ class HexapodEvaluation:
         return out
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.report import hexapod_report
+        from sims.hexapod.report import hexapod_report
 
         hexapod_report(self.timeseries(log), log.t, checks, path)
 
@@ -586,3 +586,36 @@ def build_async(options, planner=None, controller=None) -> Setup:
 
 def strut_kinds() -> list[str]:
     return ["slide"] * 6
+
+
+# ----------------------------------------------------------------------------- registry
+
+from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+
+_RUN = dict(options=frozenset({"wind", "elevation"}), kinds=strut_kinds, control_dt=CONTROL_DT, validate=validate)
+
+SCENARIOS = (
+    Scenario(
+        "hexapod-sync-move",
+        "Rubin camera hexapod, 3 t camera: synchronous move of ~2 mm and 0.1 deg, all six struts arrive on one tick (--elevation, --wind)",
+        build_sync,
+        lambda: plan(True),
+        **_RUN,
+    ),
+    Scenario(
+        "hexapod-async-move",
+        "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at its own minimum time (--elevation, --wind)",
+        build_async,
+        lambda: plan(False),
+        **_RUN,
+    ),
+)
+#: The scenario ``planbench bench`` times, and how many runs it takes the best of.
+BENCHMARK = ("hexapod-sync-move", 5)
+
+
+def environment_reward(setup: Setup):
+    """The dm_control reward: exp(-max strut tracking error / 10 um)."""
+    from sims.envs import joint_tracking_reward
+
+    return joint_tracking_reward(setup.sensors.qpos, 10e-6)

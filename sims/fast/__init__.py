@@ -31,13 +31,13 @@ from __future__ import annotations
 import numpy as np
 
 from planners import fast
-from planners import fast_plan as fp
-from planners import fast_sky as sky
+from planners.fast import plan as fp
+from planners.fast import sky as sky
 from planners.errors import LimitError
 from sims import run_limits
 from sims.checks import Check
 from sims.controllers import demanded_force
-from sims.fast_physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
+from sims.fast.physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
                                FastController, FastPhysics, FastSensors, SensorOptions, _compiled,
                                max_cable_segments, parked_command, winch_feedforward)
 from sims.runner import RunLog, Setup
@@ -122,7 +122,7 @@ def write_figures(plan: fp.FastPlan, out_dir) -> None:
     import json
     from pathlib import Path
 
-    from sims.report import fast_plan_figure
+    from sims.fast.report import fast_plan_figure
 
     t = np.arange(0.0, plan.duration, 0.1)
     fast_plan_figure(plan, t, Path(out_dir) / "figures.png")
@@ -393,7 +393,7 @@ class FastEvaluation:
         return out
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.report import fast_report
+        from sims.fast.report import fast_report
 
         fast_report(self.timeseries(log), log.t, checks, path, fast.FAST_LIMITS.tension_min)
 
@@ -458,7 +458,7 @@ def build(plan: fp.FastPlan | fp.FastProblem, options, controller_options: Contr
     it, with the physics at the trajectory's first pose (at rest, in equilibrium), the
     cables and wind (``options.wind``, default DEFAULT_WIND_M_S) and the sensors
     (``sensor_options``). ``cable_segments`` >= 2: the discretized cables
-    (sims.fast_physics.discretized_spec) instead of the lumped ones; None:
+    (sims.fast.physics.discretized_spec) instead of the lumped ones; None:
     ``options.cable_segments``."""
     session = plan if isinstance(plan, fp.FastProblem) else problem(plan)
     if cable_segments is None:
@@ -502,3 +502,62 @@ def build_ra_scan(options, planner=None, controller=None) -> Setup:
 
 def build_source_switch(options, planner=None, controller=None) -> Setup:
     return build(source_switch_plan(), options, planner=planner, controller=controller)
+
+
+# ----------------------------------------------------------------------------- registry
+
+from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+
+#: What the FAST runs share: options, plan plots and the paper's figures.
+_RUN = dict(options=frozenset({"wind", "wind_direction", "stewart", "cables"}), kinds=plan_kinds,
+            plan_extras=write_figures, control_dt=CONTROL_DT, validate=validate)
+
+SCENARIOS = (
+    Scenario(
+        "fast-tracking",
+        "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
+        build_tracking,
+        tracking_plan,
+        **_RUN,
+        demo_cameras=("closeup",),
+    ),
+    Scenario(
+        "fast-ra-scan",
+        "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
+        build_ra_scan,
+        ra_scan_plan,
+        **_RUN,
+    ),
+    Scenario(
+        "fast-source-switch",
+        "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
+        build_source_switch,
+        source_switch_plan,
+        **_RUN,
+    ),
+)
+#: Plans with no run of their own (``planbench plan`` only).
+PLANS = (
+    Scenario(
+        "fast-dec-scan",
+        "FAST feed: the paper's motion scan along Dec around 3C 286: 3 legs along RA at 5 deg/h, transitions, beside the paper's eq. 15-20",
+        None,
+        dec_scan_plan,
+        kinds=plan_kinds,
+        plan_extras=write_figures,
+    ),
+)
+#: The scenario ``planbench bench`` times, and how many runs it takes the best of (it
+#: simulates 1330 s in ~40-90 s a run).
+BENCHMARK = ("fast-tracking", 2)
+
+
+def environment_reward(setup: Setup):
+    """The dm_control reward: exp(-|feed - its goal path| / 10 mm)."""
+    goal = setup.problem.goal
+
+    def reward(physics, tick, adapter, scale=0.01):
+        _, feed, _, _ = goal.feed(np.array([adapter.reference.t[tick]]))
+        return float(np.exp(-np.linalg.norm(physics.feed_position() - feed[0]) / scale))
+
+    return reward

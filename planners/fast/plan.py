@@ -24,7 +24,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from planners import fast
-from planners import profiles as prof
+from planners.fast import profiles as prof
 from planners.errors import LimitError, PlanningError
 from planners.trajectory import TrajectorySample, check_values, sample_times
 
@@ -621,12 +621,12 @@ class FastPlan:
 def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX):
     """Observation legs and transitions of a motion scan (section 3.3).
 
-    ``scan``: a planners.fast_sky.MotionScan; ``start``: its start UTC. Each leg follows the
+    ``scan``: a planners.fast.sky.MotionScan; ``start``: its start UTC. Each leg follows the
     sky (``observation_segment``); between legs a transition of the scan's t2 joins the end
     state of one leg to the start state of the next (``transition_segment``). Raises
     LimitError when a transition would need more than ``a_limit`` (A_t-max).
     """
-    from planners.fast_sky import parallactic_angle
+    from planners.fast.sky import parallactic_angle
 
     path = scan.path(start, step=step)
     directions = path.directions()

@@ -18,7 +18,7 @@ from planners import loader as loader_planner
 from planners.loader import forward_kinematics
 from sims import run_limits
 from sims.checks import Check
-from sims.collision import clearance, geoms_by_contype, obstacle_contact_pairs
+from sims.loader.collision import clearance, geoms_by_contype, obstacle_contact_pairs
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
 from sims.task import JointEncoders, plan_checked
@@ -190,7 +190,7 @@ class LoaderEvaluation:
         }
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.report import loader_report
+        from sims.loader.report import loader_report
 
         loader_report(self.timeseries(log), log.t, checks, path)
 
@@ -264,3 +264,37 @@ def build_supply(options, planner=None, controller=None) -> Setup:
 def build_direct(options, planner=None, controller=None) -> Setup:
     # The key points checked are the endpoints; M1 ... M4 are not in this problem.
     return build(loader_planner.direct_problem(), options, planner, controller)
+
+
+# ----------------------------------------------------------------------------- registry
+
+from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+
+_RUN = dict(kinds=joint_kinds, control_dt=CONTROL_DT, validate=validate)
+
+SCENARIOS = (
+    Scenario(
+        "loader-supply",
+        "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the breechblock and seat ring",
+        build_supply,
+        lambda: loader_planner.supply_plan(),
+        **_RUN,
+    ),
+    Scenario(
+        "loader-direct",
+        "PRR-3R loader: P2 to P3 as a straight joint-space move in the same 2.5 s; strikes the obstacles (expected to fail)",
+        build_direct,
+        lambda: loader_planner.direct_plan(),
+        expect_pass=False,
+        **_RUN,
+    ),
+)
+#: The scenario ``planbench bench`` times, and how many runs it takes the best of.
+BENCHMARK = ("loader-supply", 5)
+
+
+def environment_reward(setup: Setup):
+    """The dm_control reward: exp(-max joint tracking error / 0.1 deg)."""
+    from sims.envs import joint_tracking_reward
+
+    return joint_tracking_reward(setup.sensors.qpos, np.deg2rad(0.1))
