@@ -5,7 +5,11 @@ For each benchmarked scenario (no video) it reports:
                    loop, checks);
   loop ratio       physics steps per second inside the control loop divided by physics steps
                    per second of one bare ``mj_step(model, data, nstep=N)`` call on the same
-                   model from the same initial state, with the same N, in the same process.
+                   model from the same initial state, with the same N, in the same process;
+  the loop's split one more run with the loop's clocks on (``runner.simulate(profile=True)``):
+                   the share of MuJoCo's steps, of the code under test (the controller's calls
+                   and the online planner inside them) and of the testbed's own cost (sensors,
+                   disturbance, logging, divergence scans).
 The best of several runs is taken for both (REPEATS, or the mechanism's BENCHMARK count), so
 a busy machine affects both sides alike.
 """
@@ -54,6 +58,8 @@ def bench_scenario(name: str, repeats: int = REPEATS) -> dict:
             best_run = result
         loop_rate = result.log.physics_steps / result.log.loop_wall_s
         best_loop = loop_rate if best_loop is None else max(best_loop, loop_rate)
+    # One more run with the loop's clocks on: physics, code under test, the testbed's own cost.
+    profiled = runner.simulate(scenario.build(scenarios.RunOptions()), profile=True)
     setup = scenario.build(scenarios.RunOptions())
     bare = bare_steps_per_second(setup, best_run.log.physics_steps)
     return {
@@ -66,6 +72,8 @@ def bench_scenario(name: str, repeats: int = REPEATS) -> dict:
         "bare_steps_per_s": bare,
         "loop_ratio": best_loop / bare,
         "planner_wall_s": best_run.metrics.get("planner_wall_s"),
+        "physics_share": profiled.physics_wall_s / profiled.loop_wall_s,
+        "code_under_test_share": profiled.controller_wall_s / profiled.loop_wall_s,
         "passed": best_run.passed,
     }
 
@@ -85,6 +93,12 @@ def format_table(rows: list[dict]) -> str:
             f"{r['realtime_factor']:>10.1f} {r['physics_steps']:>8d} {r['loop_steps_per_s']:>13.0f} "
             f"{r['bare_steps_per_s']:>13.0f} {r['loop_ratio']:>9.2f}"
         )
+    lines.append("")
+    lines.append(f"{'the loop, of its wall time':<28} {'physics':>8} {'planner + controller':>21} {'testbed':>8}")
+    for r in rows:
+        testbed = 1.0 - r["physics_share"] - r["code_under_test_share"]
+        lines.append(f"{r['scenario']:<28} {100 * r['physics_share']:>7.0f}% {100 * r['code_under_test_share']:>20.0f}% "
+                     f"{100 * testbed:>7.0f}%")
     for r in rows:
         if r.get("planner_wall_s"):
             loop_wall = r["physics_steps"] / r["loop_steps_per_s"]

@@ -18,7 +18,7 @@ from scipy.interpolate import CubicSpline
 
 from planners import antenna, fast, hexapod, loader
 from planners.fast import plan as fast_plan
-from planners.fast import profiles
+from planners import profiles
 from planners.loader.bspline import CubicBSplineTrajectory
 from planners.errors import LimitError, PlanningError
 from planners.trajectory import MAX_MAGNITUDE, sample_times

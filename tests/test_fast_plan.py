@@ -8,7 +8,7 @@ import pytest
 
 from planners import fast
 from planners.fast import plan as fp
-from planners.fast import profiles as prof
+from planners import profiles as prof
 from planners.errors import LimitError
 from sims import fast as fast_sims
 

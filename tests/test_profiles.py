@@ -1,4 +1,4 @@
-"""1-D motion profiles (planners/fast/profiles.py): the FAST paper's Figure 6 profiles.
+"""1-D motion profiles (planners/profiles.py): the FAST paper's Figure 6 profiles.
 
 Checked against closed forms derived by hand (rest-to-rest in both regimes, the pulse), against
 brute-force searches over the profile family (minimum time, lowest cruise speed), and against
@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from planners.errors import LimitError, PlanningError
-from planners.fast.profiles import (
+from planners.profiles import (
     Profile,
     concatenate,
     cruise,

@@ -15,7 +15,7 @@ import numpy as np
 
 from planners import fast
 from planners.fast import plan as fp
-from planners.fast import profiles
+from planners import profiles
 
 
 class StraightSwitch:

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from planners import fast
-from planners.fast import profiles as prof
+from planners import profiles as prof
 from planners.errors import LimitError, PlanningError
 from planners.trajectory import TrajectorySample, check_values, sample_times
 
