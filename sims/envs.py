@@ -5,10 +5,11 @@ The adapter (``TaskAdapter``) runs a scenario's ``runner.Setup`` the way the run
 the same way, ``steps_per_tick`` physics steps per action. The agent plays the controller:
 its action is the commands of the actuators a controller drives (``Setup.controlled``), its
 observation what the task's sensors report (``sims.task``) plus the reference at the current
-tick, never the physics state. An episode starts as the reference controller's run starts (the
-machine at rest, its drives holding the start), and lasts the scenario's duration. The reward
-is exp(-error / scale) of the task's goal: the joint tracking error (loader, hexapod), the
-pointing error (antenna), the feed's distance from its goal path (FAST).
+tick (not the antenna's: its joint path is the true sea's), never the physics state. An
+episode starts as the reference controller's run starts (the machine at rest, its drives
+holding the start), and lasts the scenario's duration. The reward is exp(-error / scale) of
+the task's goal: the joint tracking error (loader, hexapod), the pointing error (antenna),
+the feed's distance from its goal path (FAST).
 """
 
 from __future__ import annotations
@@ -58,6 +59,7 @@ class TaskAdapter(control.Task):
         setup = self._setup
         model, data = physics.model.ptr, physics.data.ptr
         mujoco.mj_setState(model, data, self._initial, self._state_spec)
+        mujoco.mj_forward(model, data)  # the sensors read sensordata and positions of this state
         self._observation = setup.sensors.reset(physics, self._times, setup.seed)
         if setup.disturbance is not None:
             setup.disturbance.reset(physics, self._times, np.random.default_rng(setup.seed))
@@ -83,8 +85,9 @@ class TaskAdapter(control.Task):
     def get_observation(self, physics):
         k = min(self.tick, self._times.size - 1)
         obs = collections.OrderedDict((name, np.array(value, dtype=float)) for name, value in self._observation.items())
-        obs["reference_positions"] = self._reference.position[k].copy()
-        obs["reference_velocities"] = self._reference.velocity[k].copy()
+        if self._setup.reference_visible:
+            obs["reference_positions"] = self._reference.position[k].copy()
+            obs["reference_velocities"] = self._reference.velocity[k].copy()
         return obs
 
     def get_reward(self, physics):

@@ -75,6 +75,10 @@ class Setup:
         (``ControlContext.nominal_physics``); default: a copy of ``physics`` as it is now.
       controlled: indices of the actuators a controller drives (the dm_control action), None
         for all (the antenna's deck drives are the sea's).
+      reference_visible: False when ``trajectory`` is not a plan but the truth (the antenna's
+        joint path for the true ship motion): the controller then gets no trajectory and no
+        reference (``ControlContext``), nor the environment's agent; the log keeps it for
+        the plots.
     """
 
     physics: object
@@ -96,6 +100,7 @@ class Setup:
     output_stride: int = 1
     nominal_physics: Callable | None = None
     controlled: np.ndarray | None = None
+    reference_visible: bool = True
 
     def __post_init__(self):
         if self.nominal_physics is None:
@@ -250,7 +255,8 @@ def start_episode(setup: Setup, controller=None) -> Episode:
     observation = setup.sensors.reset(physics, times, setup.seed)
     context = ControlContext(
         model=setup.nominal_physics().model.ptr, nominal_physics=setup.nominal_physics,
-        problem=setup.problem, trajectory=setup.trajectory, reference=reference,
+        problem=setup.problem, trajectory=setup.trajectory if setup.reference_visible else None,
+        reference=reference if setup.reference_visible else None,
         control_dt=setup.control_dt, command=data.ctrl, setpoint=data.act.copy(),
         actuators=tuple(model.actuator(j).name for j in range(model.nu)), observation=observation,
         sensors=tuple(setup.sensors.specs),

@@ -198,9 +198,10 @@ class ControlContext:
       nominal_physics: () -> a dm_control Physics of the nominal model at the task's initial
         configuration (the machine at rest at its start), for model-based feed-forward.
       problem: the task's planning problem.
-      trajectory: what the planner returned (loader, hexapod, FAST; for the antenna the ideal
-        joint path, a reference for plots only: a controller may not know the true sea).
-      reference: the trajectory sampled at every control tick.
+      trajectory: what the planner returned (loader, hexapod, FAST); None for the antenna,
+        whose planner is online: its ideal joint path is computed from the true ship motion,
+        which no controller can know.
+      reference: the trajectory sampled at every control tick (None with it).
       control_dt: the control period, s.
       command: the actuators' commands (``ctrl``, in the model's actuator order): write it
         every tick, or return the vector from ``__call__``.

@@ -11,9 +11,10 @@ import unittest
 
 import dm_env
 import numpy as np
+import pytest
 from dm_env import test_utils
 
-from sims import envs, scenarios
+from sims import envs, runner, scenarios
 from sims.scenarios import RunOptions
 
 
@@ -74,6 +75,22 @@ def _conformance_case(name: str):
     if scenarios.get(name).online_planner:  # the antenna: its four drives' set-point rates
         attributes["hold_action"] = lambda self: np.zeros(self.environment.action_spec().shape)
     return type(f"EnvironmentTest_{name.replace('-', '_')}", (_Conformance, unittest.TestCase), attributes)
+
+
+@pytest.mark.parametrize("name", list(scenarios.SCENARIOS))
+def test_an_episode_starts_as_a_run_starts(name):
+    """The same sensors and seeding as the runner: the first observation of an episode, and
+    of the next one, equal the observation a run's controller gets at its reset, bit for bit."""
+    options = RunOptions(duration=EPISODE_S, seed=3)
+    run_start = runner.start_episode(scenarios.get(name).build(options)).observation
+    env = envs.make(name, duration=EPISODE_S, seed=3)
+    for _ in range(2):
+        observation = env.reset().observation
+        for key, value in run_start.items():
+            assert np.asarray(value, dtype=float).tobytes() == observation[key].tobytes(), key
+        for _ in range(3):
+            env.step(np.clip(np.zeros(env.action_spec().shape), env.action_spec().minimum,
+                             env.action_spec().maximum))
 
 
 for _name in scenarios.SCENARIOS:  # every registered scenario, no new test code for a new one

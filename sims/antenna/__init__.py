@@ -725,6 +725,7 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
         problem=problem,
         planner=recorder,
         controlled=physics.antenna_actuators,
+        reference_visible=False,  # the ideal path knows the true sea: plots only
         control_dt=CONTROL_DT,
         duration=duration,
         evaluate=evaluation,
