@@ -17,6 +17,7 @@ a busy machine affects both sides alike.
 from __future__ import annotations
 
 import time
+import timeit
 
 import mujoco
 import numpy as np
@@ -24,6 +25,16 @@ import numpy as np
 from sims import runner, scenarios
 
 REPEATS = 5
+
+
+def best_time(function, repeats: int = REPEATS):
+    """(best wall time in s, the last result) of ``repeats`` calls of ``function()``."""
+    last = [None]
+
+    def call():
+        last[0] = function()
+
+    return min(timeit.repeat(call, number=1, repeat=repeats)), last[0]
 
 
 def benchmarks() -> list[tuple[str, int]]:

@@ -211,13 +211,14 @@ def _exception_text(e: BaseException) -> str:
     return text if len(text) <= 300 else text[:297] + "..."
 
 
-def _raised_in(e: BaseException, obj) -> bool:
-    """Whether the innermost frames of ``e``'s traceback belong to ``obj``'s module."""
-    module = getattr(getattr(obj, "planner", obj), "__module__", None)
-    tb, last = e.__traceback__, None
-    while tb is not None:
-        last, tb = tb, tb.tb_next
-    return last is not None and last.tb_frame.f_globals.get("__name__") == module
+def _start(role: str, reset, argument) -> None:
+    """``reset(argument)``; any exception but a PluginError becomes one naming ``role``."""
+    try:
+        reset(argument)
+    except PluginError:
+        raise
+    except Exception as e:
+        raise PluginError(f"the {role}'s reset raised {_exception_text(e)}") from None
 
 
 def _bad_command(model, ctrl: np.ndarray, t: float) -> str:
@@ -261,15 +262,10 @@ def start_episode(setup: Setup, controller=None) -> Episode:
         actuators=tuple(model.actuator(j).name for j in range(model.nu)), observation=observation,
         sensors=tuple(setup.sensors.specs),
         planner=setup.planner if hasattr(setup.planner, "step") else None)
-    try:  # before the first tick: a plug-in that cannot start is bad input, not a failed run
-        if context.planner is not None:  # an online planner starts from the problem
-            context.planner.reset(setup.problem)
-        controller.reset(context)
-    except PluginError:
-        raise
-    except Exception as e:
-        role = "planner" if context.planner is not None and _raised_in(e, context.planner) else "controller"
-        raise PluginError(f"the {role}'s reset raised {_exception_text(e)}") from None
+    # Before the first tick a plug-in that cannot start is bad input, not a failed run.
+    if context.planner is not None:  # an online planner starts from the problem
+        _start("planner", context.planner.reset, setup.problem)
+    _start("controller", controller.reset, context)
     data.act[:] = context.setpoint
     if setup.disturbance is not None:
         setup.disturbance.reset(physics, times, np.random.default_rng(setup.seed))

@@ -71,14 +71,17 @@ class SensorSpec:
         return asdict(self)
 
 
+def _is_run(index: np.ndarray) -> bool:
+    return index.size > 0 and np.array_equal(index, np.arange(index[0], index[0] + index.size))
+
+
 def readonly_view(array: np.ndarray, index) -> np.ndarray:
     """A read-only view of ``array[index]`` that follows the live buffer (an ideal sensor at
     no cost per tick). ``index`` must be a contiguous, increasing run of indices."""
     index = np.asarray(index, dtype=int).ravel()
-    if index.size and not np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+    if not _is_run(index):
         raise ValueError(f"indices {index.tolist()} are not one contiguous run: no view exists")
-    start = int(index[0]) if index.size else 0
-    view = array[start:start + index.size]
+    view = array[int(index[0]):int(index[0]) + index.size]
     view.flags.writeable = False
     return view
 
@@ -108,10 +111,6 @@ class Sensors:
         return [s.to_json() for s in self.specs]
 
 
-def _is_run(index: np.ndarray) -> bool:
-    return index.size > 0 and np.array_equal(index, np.arange(index[0], index[0] + index.size))
-
-
 class JointEncoders(Sensors):
     """Encoders on actuated joints, read every control tick, and the drives' set-points.
 
@@ -127,11 +126,10 @@ class JointEncoders(Sensors):
         addresses, in the controller's channel order.
       measures: what they read, in words; unit: of the positions.
       noise, bias: per joint (or one for all), in the positions' unit.
-      extra: more named exact readings, as (name, buffer getter, index, measures, unit).
     """
 
     def __init__(self, qpos, dofs, acts, measures: str, unit: str, control_dt: float,
-                 noise=0.0, bias=0.0, extra=()):
+                 noise=0.0, bias=0.0):
         super().__init__()
         self.qpos = np.asarray(qpos, dtype=int)
         self.dofs = np.asarray(dofs, dtype=int)
@@ -141,7 +139,6 @@ class JointEncoders(Sensors):
         if not (np.isfinite(self.noise).all() and np.isfinite(self.bias).all() and (self.noise >= 0).all()):
             raise ValueError(f"encoder noise {self.noise.tolist()} must be finite and >= 0 and bias "
                              f"{self.bias.tolist()} finite")
-        self.extra = tuple(extra)
         rate = 1.0 / control_dt
         ideal = not self.noise.any() and not self.bias.any()
         noise_text = "none" if not self.noise.any() else f"white, {self.noise.tolist()} {unit} 1-sigma"
@@ -150,7 +147,7 @@ class JointEncoders(Sensors):
             SensorSpec("joint_positions", measures, unit, rate, 0.0, noise_text, bias_text),
             SensorSpec("joint_velocities", f"rates of the {measures}", f"{unit}/s", rate),
             SensorSpec("setpoints", "the drives' position set-points (what was commanded)", unit, rate),
-        ] + [SensorSpec(name, what, u, rate) for name, _, _, what, u in self.extra]
+        ]
         self._ideal = ideal
         self._copies = []  # (buffer getter, index, out) read by __call__ every tick
 
@@ -163,7 +160,6 @@ class JointEncoders(Sensors):
         sources = [("joint_positions", lambda d: d.qpos, self.qpos),
                    ("joint_velocities", lambda d: d.qvel, self.dofs),
                    ("setpoints", lambda d: d.act, self.acts)]
-        sources += [(name, getter, np.asarray(index, dtype=int)) for name, getter, index, _, _ in self.extra]
         for name, getter, index in sources:
             buffer = getter(data)
             if _is_run(index) and (self._ideal or name != "joint_positions"):

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
-from sims.bench import REPEATS
+from sims.bench import best_time
 
 def antenna_update_rate(duration: float = 60.0) -> list[dict]:
     """Joint-position updates per second of the antenna planner over the paper's conditions.
@@ -29,11 +27,8 @@ def antenna_update_rate(duration: float = 60.0) -> list[dict]:
     for label, method, lim in (("pinv integration", "pinv", None), ("crr", "crr", None),
                                ("crr + full correction", "crr-full", None),
                                ("crr, safeguards on", "crr", limits)):
-        best = float("inf")
-        for _ in range(REPEATS):
-            t0 = time.perf_counter()
-            path = antenna.solve_joint_path(attitudes, antenna.PAPER_DT, theta0, method, limits=lim)
-            best = min(best, time.perf_counter() - t0)
+        best, path = best_time(lambda: antenna.solve_joint_path(attitudes, antenna.PAPER_DT, theta0, method,
+                                                                 limits=lim))
         updates = t.size - 1
         rows.append({"method": label, "updates": updates, "wall_s": best,
                      "updates_per_s": updates / best, "error_fro_max": float(path.error_fro.max())})

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
-from sims.bench import REPEATS
+from sims.bench import best_time
 
 PLANNING_MOVES = 10_000
 
@@ -25,11 +23,8 @@ def planning_throughput(n_moves: int = PLANNING_MOVES, seed: int = 0) -> list[di
     rows = []
     for synchronous in (True, False):
         for method in ("closed", "iteration"):
-            best = float("inf")
-            for _ in range(REPEATS):
-                t0 = time.perf_counter()
-                moves = hexapod.plan_moves(start, target, synchronous=synchronous, method=method)
-                best = min(best, time.perf_counter() - t0)
+            best, moves = best_time(lambda: hexapod.plan_moves(start, target, synchronous=synchronous,
+                                                                method=method))
             rows.append({"mode": "sync" if synchronous else "async", "method": method,
                          "moves": len(moves), "wall_s": best, "moves_per_s": len(moves) / best})
     return rows
