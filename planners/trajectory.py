@@ -149,3 +149,44 @@ def control_ticks(duration: float, control_dt: float) -> np.ndarray:
         raise ValueError(f"control period {control_dt!r} s must be finite and > 0")
     n = int(np.floor(duration / control_dt + 1e-9))
     return np.arange(n + 1) * control_dt
+
+
+class PiecewiseTrajectory:
+    """Trajectories one after another: piece i runs from ``starts[i]`` for its duration, then
+    holds its end (at rest) until the next starts; the last piece ends the whole.
+
+    For a list of moves (the hexapod's): each piece must start where the one before ended
+    (the pieces are planned that way); the channels are the first piece's.
+    """
+
+    def __init__(self, pieces, starts):
+        self.pieces = list(pieces)
+        self.starts = np.asarray(starts, dtype=float)
+        if not self.pieces or self.starts.shape != (len(self.pieces),) or self.starts[0] != 0.0 \
+                or np.any(np.diff(self.starts) < [p.duration for p in self.pieces[:-1]]):
+            raise ValueError("pieces must start at 0 and each after the one before has ended")
+
+    @property
+    def duration(self) -> float:
+        return float(self.starts[-1] + self.pieces[-1].duration)
+
+    @property
+    def labels(self):
+        return self.pieces[0].labels
+
+    def sample(self, t) -> TrajectorySample:
+        t = sample_times(t)
+        index = np.clip(np.searchsorted(self.starts, t, side="right") - 1, 0, len(self.pieces) - 1)
+        n = len(self.pieces[0].labels)
+        position, velocity, acceleration = (np.zeros((t.size, n)) for _ in range(3))
+        for i, piece in enumerate(self.pieces):
+            rows = np.flatnonzero(index == i)
+            if rows.size == 0:
+                continue
+            local = t[rows] - self.starts[i]
+            moving = local <= piece.duration
+            s = piece.sample(np.minimum(local, piece.duration))
+            position[rows] = s.position
+            velocity[rows] = np.where(moving[:, None], s.velocity, 0.0)
+            acceleration[rows] = np.where(moving[:, None], s.acceleration, 0.0)
+        return TrajectorySample(t, position, velocity, acceleration)

@@ -63,15 +63,15 @@ def bench_scenario(name: str, repeats: int = REPEATS) -> dict:
     scenario = scenarios.get(name)
     best_run, best_loop = None, None
     for _ in range(repeats):
-        setup = scenario.build(scenarios.RunOptions())
+        setup = scenario.build(scenario.params)
         result = runner.run(name, setup)
         if best_run is None or result.wall_time_s < best_run.wall_time_s:
             best_run = result
         loop_rate = result.log.physics_steps / result.log.loop_wall_s
         best_loop = loop_rate if best_loop is None else max(best_loop, loop_rate)
     # One more run with the loop's clocks on: physics, code under test, the testbed's own cost.
-    profiled = runner.simulate(scenario.build(scenarios.RunOptions()), profile=True)
-    setup = scenario.build(scenarios.RunOptions())
+    profiled = runner.simulate(scenario.build(scenario.params), profile=True)
+    setup = scenario.build(scenario.params)
     bare = bare_steps_per_second(setup, best_run.log.physics_steps)
     return {
         "scenario": name,

@@ -1,13 +1,11 @@
 """The ``planbench`` command line (ARCHITECTURE.md, "Contracts").
 
   planbench list
-  planbench run NAME [--out DIR] [--seed N] [--wind M_PER_S] [--elevation DEG]
-                [--hs M] [--tp S] [--heading DEG] [--imu-rate HZ] [--imu-latency S]
-                [--no-prediction] [--wind-direction DEG] [--stewart on|off]
-                [--cable-segments N] [--duration S]
-                [--controller MODULE:FACTORY] [--planner MODULE:FACTORY]
+  planbench run NAME|FILE.toml|DIR/summary.json [--PARAMETER VALUE ...] [--set KEY=VALUE ...]
+                [--out DIR] [--controller MODULE:FACTORY] [--planner MODULE:FACTORY]
                 [--video FILE] [--camera overview|closeup] [--quiet]
-  planbench plan NAME --out DIR
+  planbench run NAME --help      the scenario's parameters: units, defaults, ranges
+  planbench plan NAME|FILE.toml [--PARAMETER VALUE ...] [--set KEY=VALUE ...] --out DIR
   planbench bench
   planbench demo [--out DIR]
 
@@ -18,8 +16,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import functools
-import math
 import os
 import re
 import signal
@@ -48,120 +44,13 @@ class _Parser(argparse.ArgumentParser):
         raise BadInput(message)
 
 
-def _finite(kind: str, minimum: float | None = None, strict: bool = False):
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{kind} {text!r} is not a number") from None
-        if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(f"{kind} {text} is not finite")
-        if minimum is not None and (value <= minimum if strict else value < minimum):
-            raise argparse.ArgumentTypeError(
-                f"{kind} {text} must be {'>' if strict else '>='} {minimum:g}"
-            )
-        return value
-
-    return parse
-
-
-def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"seed {text!r} is not an integer") from None
-    if not 0 <= value < 2**63:
-        raise argparse.ArgumentTypeError(f"seed {value} must be in [0, 2^63)")
-    return value
-
-
-def _cable_segments(text: str) -> int:
-    """2 ... the model's limit (sims.fast.physics.max_cable_segments: 14 at the 2 ms step)."""
-    from sims.fast.physics import SEGMENT_OMEGA_DT_LIMIT, max_cable_segments
-
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"cable segments {text!r} is not an integer") from None
-    most = max_cable_segments()
-    if not 2 <= value <= most:
-        raise argparse.ArgumentTypeError(
-            f"cable segments {value} must be in [2, {most}]: more segments vibrate beyond the "
-            f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most {most} segments")
-    return value
-
-
-def _checked(kind: str, check, minimum: float | None = None, strict: bool = False):
-    """A finite number (``_finite``), then ``check(value)`` of the Python API, whose
-    ValueError (naming the value, the limit and its source) becomes the parse error: the
-    CLI and the API refuse the same values with the same words."""
-    number = _finite(kind, minimum, strict)
-
-    def parse(text: str) -> float:
-        value = number(text)
-        try:
-            check(value)
-        except ValueError as e:
-            raise argparse.ArgumentTypeError(str(e)) from None
-        return value
-
-    return parse
-
-
 def build_parser() -> argparse.ArgumentParser:
-    from sims.run_limits import check_angle
-    from sims.antenna.ship_motion import check_peak_period, check_wave_height
-    from sims.wind import check_mean_speed
-
     parser = _Parser(prog="planbench", description="MuJoCo testbed for motion planners.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sub.add_parser("list", help="list the scenarios")
-    run = sub.add_parser("run", help="simulate a scenario and check it")
-    run.add_argument("name")
-    run.add_argument("--out", help="output directory (default results/NAME); replaced only if "
-                     "planbench wrote it")
-    run.add_argument("--seed", type=_seed, default=0)
-    run.add_argument("--wind", type=_checked("wind speed", check_mean_speed, 0.0),
-                     help="mean wind, m/s (0 ... 50: IEC 61400-1 class I, the Kaimal model's range)")
-    run.add_argument("--elevation", type=_finite("elevation"),
-                     help="telescope elevation, deg (hexapod scenarios: 15 ... 90)")
-    run.add_argument("--hs", type=_checked("significant wave height", check_wave_height, 0.0, strict=True),
-                     help="significant wave height, m (sea-state scenarios; 0 < Hs <= 20, and no steeper "
-                          "than 2 pi Hs / (g Tp^2) = 1/15 at Tp <= 8 s ... 1/25 at Tp >= 15 s, DNV-RP-C205)")
-    run.add_argument("--tp", type=_checked("peak period", check_peak_period, 0.0, strict=True),
-                     help="spectral peak period, s (sea-state scenarios; 1 ... 30, wind seas and swell)")
-    run.add_argument("--heading", type=_checked("wave heading", functools.partial(check_angle, "wave heading")),
-                     help="wave heading off the bow, deg: 180 head seas, 90 beam seas from starboard "
-                          "(sea-state scenarios; -360 ... 360, refused beyond, not wrapped)")
-    run.add_argument("--imu-rate", type=_finite("IMU rate", 0.0, strict=True),
-                     help="antenna IMU samples per second, Hz (200 / a whole number, 1 ... 200: "
-                          "20, 25, 40, 50 are the paper's range)")
-    run.add_argument("--imu-latency", type=_finite("IMU latency", 0.0),
-                     help="antenna IMU latency, s (a multiple of 5 ms, at most 1 s)")
-    run.add_argument("--no-prediction", action="store_true",
-                     help="antenna controller: use each IMU sample as it is, no gyro prediction")
-    run.add_argument("--wind-direction", type=_checked("wind direction", functools.partial(check_angle, "wind direction")),
-                     help="azimuth the wind blows toward, deg from east toward north (FAST scenarios; "
-                          "default 0; -360 ... 360, refused beyond, not wrapped)")
-    run.add_argument("--cable-segments", type=_cable_segments,
-                     help="FAST: each cable as a chain of N elastic segments (2-14 at the 2 ms timestep; "
-                          "default: straight cables with the lumped catenary law)")
-    run.add_argument("--stewart", choices=("on", "off"),
-                     help="FAST's Stewart stabilizer: on (default) or off (FAST scenarios)")
-    run.add_argument("--duration", type=_finite("duration", 0.0, strict=True),
-                     help="simulated time, s (at least one control tick; refused if its log would "
-                          "take more than a quarter of this machine's memory)")
-    run.add_argument("--controller", metavar="MODULE:FACTORY",
-                     help="your controller: FACTORY() in MODULE (an importable module or a .py file) "
-                          "returns it (README, \"Your own planner or controller\")")
-    run.add_argument("--planner", metavar="MODULE:FACTORY",
-                     help="your planner, the same way (the antenna's: an online planner)")
-    run.add_argument("--video", help="write an H.264 video of the run here (.mp4, .m4v, .mov, .mkv)")
-    run.add_argument("--camera", default=None, help="video camera: overview or closeup")
-    run.add_argument("--quiet", action="store_true", help="no progress bars")
-    plan = sub.add_parser("plan", help="write a scenario's planned motion, no physics")
-    plan.add_argument("name")
-    plan.add_argument("--out", required=True, help="output directory; replaced only if planbench wrote it")
+    sub.add_parser("run", help="simulate a scenario and check it (planbench run NAME --help: its parameters)",
+                   add_help=False)
+    sub.add_parser("plan", help="write a scenario's planned motion, no physics", add_help=False)
     sub.add_parser("bench", help="benchmark table: realtime factors and loop/bare-mj_step ratios")
     demo = sub.add_parser("demo", help="run every scenario with a video; one table of checks")
     demo.add_argument("--out", default="results",
@@ -170,39 +59,86 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _options(scenario, args):
-    from sims.scenarios import RunOptions
+#: Options of ``run`` and ``plan`` that are not parameters (no parameter may take these names).
+RUN_OPTIONS = ("out", "video", "camera", "quiet", "planner", "controller", "set", "help")
 
-    if args.wind is not None and "wind" not in scenario.options:
-        raise BadInput(f"scenario {scenario.name} has no wind model; --wind is not accepted")
-    if args.elevation is not None and "elevation" not in scenario.options:
-        raise BadInput(f"scenario {scenario.name} has no elevation; --elevation is not accepted")
-    for option in ("hs", "tp", "heading"):
-        if getattr(args, option) is not None and option not in scenario.options:
-            raise BadInput(f"scenario {scenario.name} has no sea state; --{option} is not accepted")
-    imu_given = args.imu_rate is not None or args.imu_latency is not None or args.no_prediction
-    if imu_given and "imu" not in scenario.options:
-        raise BadInput(f"scenario {scenario.name} has no IMU; --imu-rate, --imu-latency and "
-                       "--no-prediction are not accepted")
-    if args.wind_direction is not None and "wind_direction" not in scenario.options:
-        raise BadInput(f"scenario {scenario.name} has no wind direction; --wind-direction is not accepted")
-    if args.cable_segments is not None and "cables" not in scenario.options:
-        raise BadInput(f"scenario {scenario.name} has no cables; --cable-segments is not accepted")
-    if args.stewart is not None and "stewart" not in scenario.options:
-        raise BadInput(f"scenario {scenario.name} has no Stewart stabilizer; --stewart is not accepted")
-    options = RunOptions(seed=args.seed, duration=args.duration, wind=args.wind,
-                         elevation=args.elevation, hs=args.hs, tp=args.tp, heading=args.heading,
-                         imu_rate=args.imu_rate, imu_latency=args.imu_latency,
-                         predict=not args.no_prediction,
-                         stewart=None if args.stewart is None else args.stewart == "on",
-                         wind_direction=args.wind_direction, cable_segments=args.cable_segments)
-    # Valid numbers that are not a run (a duration under one tick or too long for memory, a
-    # sea no sea has, ...): the scenario's own checks, the ones its build makes again.
+
+def _flag(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def scenario_parser(command: str, scenario, source: str) -> argparse.ArgumentParser:
+    """The parser of ``planbench run|plan SOURCE``: the scenario's own parameters as flags,
+    derived from their declarations (sims.params), and ``--set KEY=VALUE`` for any of them."""
+    from sims.params import describe
+
+    cls = type(scenario.params)
+    scalar = [d for d in cls.declarations() if d[1].scalar]
+    other = [d for d in cls.declarations() if not d[1].scalar]
+    epilog = ""
+    if other:
+        epilog = ("parameters set with --set KEY=VALUE (TOML syntax) or in a scenario file's [parameters]:\n"
+                  + "\n".join(f"  {name}: {describe(name, kind, declared, scenario.params.__dict__[name])}"
+                               for name, kind, declared, _ in other))
+    parser = _Parser(prog=f"planbench {command} {source}", description=f"{scenario.name}: {scenario.summary}",
+                     epilog=epilog, formatter_class=argparse.RawDescriptionHelpFormatter)
+    group = parser.add_argument_group(
+        f"parameters of {scenario.name} (defaults: this scenario's{', or the file' if source != scenario.name else ''})")
+    for name, kind, declared, _ in scalar:
+        if name in RUN_OPTIONS:
+            raise TypeError(f"parameter {name!r} of {cls.__name__} takes the name of an option")
+        metavar = {"bool": "on|off", "int": "N", "float": "X", "str": "NAME"}[kind.kind]
+        if declared.choices:
+            metavar = "|".join(declared.choices)
+        group.add_argument(_flag(name), dest=f"param_{name}", metavar=metavar,
+                           help=describe(name, kind, declared, scenario.params.__dict__[name]).replace("%", "%%"))
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="set any parameter (TOML value syntax: --set 'moves=[{target=[1,0,0,0,0,0]}]')")
+    if command == "run":
+        parser.add_argument("--out", help="output directory (default results/NAME); replaced only if "
+                            "planbench wrote it")
+        parser.add_argument("--controller", metavar="MODULE:FACTORY",
+                            help="your controller: FACTORY() in MODULE (an importable module or a .py file) "
+                                 "returns it (README, \"Your own planner or controller\")")
+        parser.add_argument("--planner", metavar="MODULE:FACTORY",
+                            help="your planner, the same way (the antenna's: an online planner)")
+        parser.add_argument("--video", help="write an H.264 video of the run here (.mp4, .m4v, .mov, .mkv)")
+        parser.add_argument("--camera", default=None, help="video camera: overview or closeup")
+        parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    else:
+        parser.add_argument("--out", required=True, help="output directory; replaced only if planbench wrote it")
+    return parser
+
+
+SCENARIO_USAGE = """usage: planbench {command} NAME|FILE.toml{rerun} [--set KEY=VALUE ...] [--PARAMETER VALUE ...] {more}
+
+NAME is a scenario of `planbench list`; FILE.toml a scenario file (scenario = NAME, [parameters]).
+`planbench {command} NAME --help` lists that scenario's parameters with units, defaults and ranges.
+"""
+
+
+def _resolve_source(command: str, argv: list[str]):
+    """(Source, parsed options, resolved params) of ``planbench run|plan SOURCE ...``."""
+    from sims import scenarios, scenario_files
+    from sims.params import ParamError
+
+    get = scenarios.get if command == "run" else scenarios.get_plan
     try:
-        scenario.validate(options)
+        source = scenario_files.resolve(argv[0], get)
+    except ParamError as e:
+        raise BadInput(str(e)) from None
     except ValueError as e:
         raise BadInput(str(e)) from None
-    return options
+    scenario = source.scenario
+    args = scenario_parser(command, scenario, argv[0]).parse_args(argv[1:])
+    flags = {k[len("param_"):]: v for k, v in vars(args).items() if k.startswith("param_") and v is not None}
+    cls = type(scenario.params)
+    try:
+        overrides = scenario_files.overrides_from_flags(cls, flags, args.set)
+        params = cls.from_mapping(overrides, base=source.params)
+    except ParamError as e:
+        raise BadInput(str(e)) from None
+    return source, args, params
 
 
 def cmd_list(args) -> int:
@@ -234,29 +170,52 @@ def _camera(scenario, requested: str | None) -> str:
     return camera
 
 
-def cmd_run(args) -> int:
-    from sims import outputs, runner, scenarios
+def _scenario_help(command: str, argv: list[str]) -> int | None:
+    """Usage of ``planbench run|plan`` without a scenario; None when a scenario is given."""
+    if argv and not argv[0].startswith("-"):
+        return None
+    if argv and argv[0] not in ("-h", "--help"):
+        raise BadInput(f"{command}: give a scenario NAME or FILE.toml first, not {argv[0]!r}")
+    more = ("[--out DIR] [--video FILE] [--camera overview|closeup] [--quiet] [--controller MODULE:FACTORY] "
+            "[--planner MODULE:FACTORY]" if command == "run" else "--out DIR")
+    print(SCENARIO_USAGE.format(command=command, rerun="|DIR/summary.json" if command == "run" else "", more=more))
+    if not argv:
+        raise BadInput(f"{command}: give a scenario NAME or FILE.toml (planbench list)")
+    return EXIT_OK
+
+
+def cmd_run(argv: list[str]) -> int:
+    from sims import outputs, runner
     from sims import plugins as plugins_module
 
-    try:
-        scenario = scenarios.get(args.name)
-    except ValueError as e:
-        raise BadInput(str(e)) from None
-    options = _options(scenario, args)
+    shown = _scenario_help("run", argv)
+    if shown is not None:
+        return shown
+    source, args, params = _resolve_source("run", argv)
+    scenario = source.scenario
     camera = _camera(scenario, args.camera)
-    plugins = {role: plugin_spec for role, plugin_spec in (("planner", args.planner), ("controller", args.controller))
-               if plugin_spec is not None}
+    plugins = dict(source.plugins)
+    plugins.update({role: spec for role, spec in (("planner", args.planner), ("controller", args.controller))
+                    if spec is not None})
     made = {role: plugins_module.make(plugin_spec, role, online_planner=scenario.online_planner)
             for role, plugin_spec in plugins.items()}
+    if source.recorded_versions:
+        differ = {k: (v, outputs.software_versions().get(k)) for k, v in source.recorded_versions.items()
+                  if outputs.software_versions().get(k) != v}
+        if differ:
+            print("planbench: note: " + source.origin + " was written with "
+                  + ", ".join(f"{k} {old} (now {new})" for k, (old, new) in differ.items())
+                  + "; the rerun may differ", file=sys.stderr)
     out = outputs.OutputDir(Path("results") / scenario.name if args.out is None else args.out)
     video = None if args.video is None else outputs.VideoFile(args.video, out)
     with contextlib.ExitStack() as reserved:  # lock before simulating: a second run is refused
         reserved.enter_context(out.reserved())
         if video is not None:
             reserved.enter_context(video.reserved())
-        setup = scenario.build(options, **made)
+        setup = scenario.build(params, **made)
         result = runner.run(scenario.name, setup, quiet=args.quiet)
         result.plugins = plugins
+        result.parameters = resolved_parameters(params, setup)
         outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
     print(format_checks([(scenario.name, c) for c in result.checks]))
     print(f"{'PASSED' if result.passed else 'FAILED'}: {scenario.name}, "
@@ -264,17 +223,25 @@ def cmd_run(args) -> int:
     return EXIT_OK if result.passed else EXIT_CHECK_FAILED
 
 
-def cmd_plan(args) -> int:
-    from sims import outputs, plans, scenarios
+def resolved_parameters(params, setup) -> dict:
+    """Every parameter of the run as it ran: an unset duration is the one the run took."""
+    values = params.to_dict()
+    if values.get("duration", 0) is None:
+        values["duration"] = float(setup.duration)
+    return values
 
-    try:
-        scenario = scenarios.get_plan(args.name)
-    except ValueError as e:
-        raise BadInput(str(e)) from None
+
+def cmd_plan(argv: list[str]) -> int:
+    from sims import outputs, plans
+
+    shown = _scenario_help("plan", argv)
+    if shown is not None:
+        return shown
+    source, args, params = _resolve_source("plan", argv)
     out = outputs.OutputDir(args.out, kind="plan")
     with out.reserved():
-        plans.write_plan(scenario, out)
-    print(f"plan of {scenario.name} written to {out}")
+        plans.write_plan(source.scenario, out, params)
+    print(f"plan of {source.scenario.name} written to {out}")
     return EXIT_OK
 
 
@@ -313,8 +280,9 @@ def cmd_demo(args) -> int:
             reserved.enter_context(target.reserved())
         for scenario in scenarios.SCENARIOS.values():
             out = targets[scenario.name]
-            setup = scenario.build(scenarios.RunOptions())
+            setup = scenario.build(scenario.params)
             result = runner.run(scenario.name, setup, quiet=args.quiet)
+            result.parameters = resolved_parameters(scenario.params, setup)
             outputs.write_run(result, setup, out, video=outputs.VideoFile(out.path / f"{scenario.name}.mp4", out),
                               camera=scenario.camera, quiet=args.quiet,
                               more_videos=[(f"{scenario.name}-{c}.mp4", c) for c in scenario.demo_cameras])
@@ -372,8 +340,15 @@ def main(argv=None) -> int:
 
     with _Interrupt() as interrupt:
         try:
+            argv = sys.argv[1:] if argv is None else list(argv)
+            if argv and argv[0] in ("run", "plan"):  # their options depend on the scenario
+                return COMMANDS[argv[0]](argv[1:])
             args = build_parser().parse_args(argv)
             return COMMANDS[args.command](args)
+        except SystemExit as e:  # argparse's --help
+            if interrupt.signum is None:
+                return int(e.code or 0)
+            raise
         except BaseException as e:
             # An interrupt also kills ffmpeg (the terminal signals the whole process group),
             # so whatever was raised after it is its consequence: one line, no traceback.

@@ -113,14 +113,15 @@ def joint_tracking_reward(qpos_index, scale: float):
     return reward
 
 
-def make(scenario: str, **options) -> control.Environment:
+def make(scenario: str, **params) -> control.Environment:
     """The dm_control Environment of the scenario ``scenario`` (any of ``planbench list``):
-    its Setup built with ``RunOptions(**options)`` (e.g. ``duration``, ``seed``, ``wind``), the
-    reward its mechanism declares (``environment_reward`` in sims/<mechanism>/)."""
+    its Setup built with its parameters overridden by ``params`` (e.g. ``duration``, ``seed``,
+    ``wind``: ``planbench run NAME --help``), the reward its mechanism declares
+    (``environment_reward`` in sims/<mechanism>/)."""
     from sims import scenarios
 
     spec = scenarios.get(scenario)
-    setup = spec.build(scenarios.RunOptions(**options))
+    setup = spec.build(spec.resolve(params))
     return environment(setup, scenarios.mechanism_of(scenario).environment_reward(setup))
 
 
@@ -147,7 +148,6 @@ def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0) -
     winches' unstretched lengths (m), the A-B set-points (rad), the six Stewart legs'
     set-point rates (m/s) and the multi-beam angle (rad)."""
     from sims import fast
-    from sims.scenarios import RunOptions
 
-    setup = fast.build(fast.observation_plan(duration), RunOptions(wind=wind, seed=seed))
+    setup = fast.build(fast.observation_plan(duration), fast.FastParams(wind=wind, seed=seed))
     return environment(setup, fast.environment_reward(setup))

@@ -643,11 +643,29 @@ def is_planbench_video(path: Path) -> bool:
     return re.search(r"^\s*comment\s*:\s*" + re.escape(VIDEO_TAG), text, re.MULTILINE | re.IGNORECASE) is not None
 
 
+def software_versions() -> dict:
+    """The versions a run's numbers depend on: planbench, Python, mujoco, numpy, scipy."""
+    import importlib.metadata
+    import platform
+
+    import mujoco
+    import scipy
+
+    try:
+        planbench = importlib.metadata.version("planbench")
+    except importlib.metadata.PackageNotFoundError:
+        planbench = "not installed"
+    return {"planbench": planbench, "python": platform.python_version(), "mujoco": mujoco.__version__,
+            "numpy": np.__version__, "scipy": scipy.__version__}
+
+
 def summary_dict(result) -> dict:
     return {
         "scenario": result.scenario,
         "passed": result.passed,
         "seed": result.seed,
+        "parameters": getattr(result, "parameters", None),
+        "versions": software_versions(),
         "sim_time_s": result.sim_time_s,
         "wall_time_s": round(result.wall_time_s, 4),
         "realtime_factor": round(result.sim_time_s / result.wall_time_s, 3) if result.wall_time_s > 0 else None,

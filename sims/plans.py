@@ -14,11 +14,12 @@ PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
 MAX_PLAN_SAMPLES = 60_000  # longer plans are sampled coarser (a 300 s plan at 5 ms)
 
 
-def write_plan(scenario, out_dir) -> Path:
+def write_plan(scenario, out_dir, params=None) -> Path:
     """Write plan.npz (t, position, velocity, acceleration, labels, key points), plan.png and
-    the scenario's extra files into ``out_dir`` (an OutputDir, or a path validated here)."""
+    the scenario's extra files into ``out_dir`` (an OutputDir, or a path validated here), for
+    ``params`` (default the scenario's own)."""
     target = out_dir if isinstance(out_dir, OutputDir) else OutputDir(out_dir, kind="plan")
-    trajectory = scenario.plan()
+    trajectory = scenario.plan(scenario.params if params is None else params)
     dt = max(PLAN_DT, trajectory.duration / MAX_PLAN_SAMPLES)
     sample = trajectory.sample(control_ticks(trajectory.duration, dt))
     kinds = scenario.kinds()

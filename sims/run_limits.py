@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import os
 
-from planners.errors import LimitError
+from sims.params import ParamError
 
 #: The log may take this fraction of physical memory (see the module doc).
 LOG_MEMORY_FRACTION = 0.25
@@ -39,7 +39,7 @@ ANGLE_LIMIT_DEG = 360.0
 _BYTES_PER_FLOAT = 8
 
 
-class RunLimitError(LimitError):
+class RunLimitError(ParamError):
     """A run option that is a valid number but not a run (too short, too long for memory)."""
 
 

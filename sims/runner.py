@@ -145,7 +145,9 @@ class RunResult:
     """A finished run. ``components``: what ran, by class (``module.QualName``): the
     ``planner``, the ``trajectory`` it returned, the ``controller``, the ``sensors`` and the
     ``disturbance`` (None when there is none). ``plugins``: the ``MODULE:FACTORY`` of a user's
-    planner or controller given on the command line. ``sensors``: each sensor's SensorSpec."""
+    planner or controller given on the command line. ``sensors``: each sensor's SensorSpec.
+    ``parameters``: the scenario's parameters, every one resolved (sims.params), that the
+    caller ran it with (written to summary.json; ``planbench run DIR/summary.json`` repeats it)."""
 
     scenario: str
     seed: int
@@ -157,6 +159,7 @@ class RunResult:
     components: dict = field(default_factory=dict)
     plugins: dict = field(default_factory=dict)
     sensors: list = field(default_factory=list)
+    parameters: dict | None = None
 
     @property
     def passed(self) -> bool:

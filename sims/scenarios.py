@@ -14,58 +14,25 @@ from __future__ import annotations
 
 import functools
 import importlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import models
 
 
 @dataclass(frozen=True)
-class RunOptions:
-    """Options of one run, from the CLI or a caller.
-
-    Attributes:
-      seed: seed of every random process of the run (disturbances, noise).
-      duration: simulated time in s, None for the scenario's default.
-      wind: mean wind speed in m/s, None for the scenario's default (wind scenarios only).
-      elevation: telescope elevation in deg, None for the default (hexapod scenarios).
-      hs, tp, heading: significant wave height (m), peak period (s) and wave heading off the
-        bow (deg, 180 head seas), None for the defaults (sea-state scenarios).
-      imu_rate, imu_latency: the antenna IMU's sample rate (Hz) and latency (s), None for the
-        defaults; predict: False to switch the antenna controller's prediction off.
-      stewart: FAST's Stewart stabilizer on (True) or off (False), None for the default (on).
-      wind_direction: the azimuth the wind blows toward, deg from east (+x) toward north, None
-        for the default (FAST scenarios).
-      cable_segments: FAST's cables as chains of this many elastic segments (>= 2), None or 0
-        for the default straight cables with the lumped catenary law.
-    """
-
-    seed: int = 0
-    duration: float | None = None
-    wind: float | None = None
-    elevation: float | None = None
-    hs: float | None = None
-    tp: float | None = None
-    heading: float | None = None
-    imu_rate: float | None = None
-    imu_latency: float | None = None
-    predict: bool = True
-    stewart: bool | None = None
-    wind_direction: float | None = None
-    cable_segments: int | None = None
-
-
-@dataclass(frozen=True)
 class Scenario:
-    """A named run: a mechanism, a planner and its checks.
+    """A named run: a mechanism, its parameters' named defaults, a planner and its checks.
 
     Attributes:
       name: CLI name.
       summary: one line for ``planbench list``.
-      build: (RunOptions, planner=None, controller=None) -> runner.Setup; None for the
-        defaults (the paper's planner, our reference controller).
-      plan: () -> the planned trajectory (``planbench plan``), no physics.
-      options: the RunOptions fields beyond seed and duration that it uses (e.g. {"wind"}).
+      params: the scenario's parameters with its defaults (a ``sims.params.Params``: typed,
+        ranged and validated; ``planbench run NAME --set KEY=VALUE`` and scenario files
+        override them).
+      build: (params, planner=None, controller=None) -> runner.Setup; None for the defaults
+        (the paper's planner, our reference controller).
+      plan: (params) -> the planned trajectory (``planbench plan``), no physics.
       expect_pass: False for a scenario that demonstrates a failure (loader-direct).
       camera: the default camera of its video.
       kinds: () -> "slide" or "hinge" per planned channel (units of plots).
@@ -73,28 +40,27 @@ class Scenario:
         antenna's comparison of the paper's methods, FAST's figures).
       demo_cameras: cameras of further videos that ``planbench demo`` renders (NAME-CAMERA.mp4).
       control_dt: the control period, s (one tick: the shortest run).
-      validate: (RunOptions) -> None, raises a ValueError subclass naming the value and the
-        limit for options that are valid numbers but not a run (a duration under one tick or
-        whose log would not fit in memory, a sea state no sea has, an angle beyond a turn...).
-        Cheap: nothing is built. ``planbench run`` calls it while it reads its options, and
-        ``build`` calls it again (the Python API).
       online_planner: the scenario's planner is an online one (the antenna's: ``reset`` and
         ``step``, sims.task.OnlinePlanner), not a ``plan(problem)`` that returns a Trajectory.
     """
 
     name: str
     summary: str
+    params: object
     build: Callable
     plan: Callable
-    options: frozenset = field(default_factory=frozenset)
     expect_pass: bool = True
     camera: str = "overview"
     kinds: Callable = lambda: ()
     plan_extras: Callable | None = None
     demo_cameras: tuple = ()
     control_dt: float | None = None
-    validate: Callable = lambda options: None
     online_planner: bool = False
+
+    def resolve(self, overrides: dict | None = None, **changes):
+        """The scenario's parameters with ``overrides`` (a mapping, as a scenario file's
+        [parameters]) and ``changes`` applied and validated (a ParamError names a bad key)."""
+        return type(self.params).from_mapping({**(overrides or {}), **changes}, base=self.params)
 
 
 @functools.lru_cache(maxsize=1)

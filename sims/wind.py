@@ -67,7 +67,7 @@ SPECTRA: dict[str, Callable] = {"kaimal": kaimal_spectrum, "davenport": davenpor
 
 def wind_speed_series(times: np.ndarray, mean_speed: float, rng: np.random.Generator,
                       spectrum: str = "kaimal", f_max: float = 10.0,
-                      df: float | None = None) -> np.ndarray:
+                      df: float | None = None, turbulence_intensity: float | None = None) -> np.ndarray:
     """Along-wind speed u(t), m/s, at the given times (s): mean plus turbulence.
 
     Args:
@@ -77,6 +77,9 @@ def wind_speed_series(times: np.ndarray, mean_speed: float, rng: np.random.Gener
       df: frequency step, Hz; default the smaller of 1 / (run length) and 1/600 Hz, so a short
         run still sees the slow part of the turbulence (most of a Kaimal spectrum's energy
         lies below 0.01 Hz) as a slowly drifting speed.
+      turbulence_intensity: sigma_u / U of the series; None: the spectrum's own (Kaimal:
+        IEC 61400-1 class B, I_ref (0.75 U + 5.6) / U). Given, the spectrum's shape is kept
+        and its amplitudes scaled so that the sum's variance sum_k a_k^2 / 2 is (I U)^2.
     """
     check_mean_speed(mean_speed)
     if spectrum not in SPECTRA:
@@ -89,6 +92,9 @@ def wind_speed_series(times: np.ndarray, mean_speed: float, rng: np.random.Gener
         df = min(1.0 / max(span, 1e-9), 1.0 / 600.0)
     freqs = np.arange(1, int(np.floor(f_max / df)) + 1) * df
     amplitude = np.sqrt(2.0 * SPECTRA[spectrum](freqs, mean_speed) * df)
+    if turbulence_intensity is not None:
+        variance = 0.5 * float(np.sum(amplitude**2))
+        amplitude = amplitude * (turbulence_intensity * mean_speed / np.sqrt(variance))
     phases = rng.uniform(0.0, 2.0 * np.pi, freqs.size)
     return mean_speed + _sum_of_cosines(times, freqs, amplitude, phases, df)
 
@@ -172,3 +178,76 @@ class BodyWindDrag:
         row = self.force[tick]
         np.multiply(self.direction, self._half_rho_cd * self.area(physics) * abs(u) * u, out=row)
         self._xfrc[:] = row
+
+
+class WindFileError(ValueError):
+    """A measured wind file that cannot be read or is not a wind record."""
+
+
+class MeasuredWind:
+    """A measured wind record: times (s), speed (m/s) and optionally the direction it blows
+    toward (deg from +x toward +y), from a CSV file of rows ``t, speed[, direction]`` (a header
+    line of names is allowed). Resampled to the control ticks by linear interpolation
+    (``resample``); the direction is interpolated on the unit circle.
+
+    Raises WindFileError naming the file, the row and the reason: fewer than two rows, times
+    not increasing, a speed outside [0, MAX_MEAN_SPEED_M_S], a value that is not a number.
+    """
+
+    def __init__(self, path):
+        from pathlib import Path
+
+        self.path = Path(path)
+        try:
+            text = self.path.read_text()
+        except (OSError, UnicodeDecodeError) as e:
+            raise WindFileError(f"wind file {self.path}: cannot be read ({e.__class__.__name__}: {e})") from None
+        rows, header_seen = [], False
+        for number, line in enumerate(text.splitlines(), start=1):
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            cells = [c.strip() for c in line.split(",")]
+            try:
+                values = [float(c) for c in cells]
+            except ValueError:
+                if not rows and not header_seen:  # one header line of names before the data
+                    header_seen = True
+                    continue
+                raise WindFileError(f"wind file {self.path} line {number}: {line!r} is not numbers t, speed[, direction]") from None
+            if len(values) not in (2, 3):
+                raise WindFileError(f"wind file {self.path} line {number}: {len(values)} columns, not 2 or 3 "
+                                    "(t s, speed m/s[, direction deg])")
+            if rows and len(values) != len(rows[0]):
+                raise WindFileError(f"wind file {self.path} line {number}: {len(values)} columns, the first row has "
+                                    f"{len(rows[0])}")
+            if not all(np.isfinite(values)):
+                raise WindFileError(f"wind file {self.path} line {number}: {line!r} is not finite")
+            if not 0.0 <= values[1] <= MAX_MEAN_SPEED_M_S:
+                raise WindFileError(f"wind file {self.path} line {number}: speed {values[1]:g} m/s is outside "
+                                    f"[0, {MAX_MEAN_SPEED_M_S:g}] m/s (IEC 61400-1 class I)")
+            if rows and values[0] <= rows[-1][0]:
+                raise WindFileError(f"wind file {self.path} line {number}: t = {values[0]:g} s does not increase")
+            rows.append(values)
+        if len(rows) < 2:
+            raise WindFileError(f"wind file {self.path}: {len(rows)} rows of t, speed[, direction]; at least 2")
+        table = np.array(rows)
+        self.t, self.speed = table[:, 0], table[:, 1]
+        self.direction = table[:, 2] if table.shape[1] == 3 else None
+
+    def check_covers(self, duration: float) -> None:
+        """A WindFileError unless the record spans the run, t = 0 ... duration."""
+        if self.t[0] > 0.0 or self.t[-1] < duration:
+            raise WindFileError(f"wind file {self.path} spans t = {self.t[0]:g} ... {self.t[-1]:g} s, not the run's "
+                                f"0 ... {duration:g} s")
+
+    def resample(self, times: np.ndarray):
+        """(speed (n,), unit direction (n, 3) or None) at ``times``."""
+        speed = np.interp(times, self.t, self.speed)
+        if self.direction is None:
+            return speed, None
+        az = np.radians(self.direction)
+        c, s = np.interp(times, self.t, np.cos(az)), np.interp(times, self.t, np.sin(az))
+        norm = np.hypot(c, s)
+        norm[norm == 0.0] = 1.0
+        return speed, np.column_stack([c / norm, s / norm, np.zeros_like(c)])

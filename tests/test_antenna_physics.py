@@ -9,12 +9,11 @@ import pytest
 from planners import antenna as ant
 from planners.errors import PlanningError
 from sims import antenna, runner
-from sims.scenarios import RunOptions
 from sims.antenna.ship_motion import PaperShipMotion
 
 
-def _run(build, duration, antenna_options=antenna.AntennaOptions(), **options):
-    setup = build(RunOptions(duration=duration, **options), antenna_options)
+def _run(params, duration, antenna_options=antenna.AntennaOptions(), **options):
+    setup = antenna.build(params.replace(duration=duration, **options), antenna_options=antenna_options)
     return setup, runner.run("antenna", setup)
 
 
@@ -24,12 +23,12 @@ def _checks(result):
 
 @pytest.fixture(scope="module")
 def paper_run():
-    return _run(antenna.build_paper_motion, 12.0)
+    return _run(antenna.AntennaPaperParams(), 12.0)
 
 
 @pytest.fixture(scope="module")
 def sea_run():
-    return _run(antenna.build_sea_state, 40.0)
+    return _run(antenna.AntennaSeaParams(), 40.0)
 
 
 def test_paper_motion_checks_hold(paper_run):
@@ -54,7 +53,7 @@ def test_without_prediction_the_pointing_error_is_measurably_worse(paper_run):
     """The IMU sample is 20 ms old on arrival and the set-point ramps for another 20 ms; the
     gyro-based prediction removes that lag."""
     _, predicted = paper_run
-    _, lagging = _run(antenna.build_paper_motion, 12.0, antenna.AntennaOptions(predict=False))
+    _, lagging = _run(antenna.AntennaPaperParams(), 12.0, antenna.AntennaOptions(predict=False))
     with_prediction = _checks(predicted)["pointing_error_max"].value
     without = _checks(lagging)["pointing_error_max"].value
     assert without > 5 * with_prediction
@@ -66,9 +65,8 @@ def test_without_prediction_the_pointing_error_is_measurably_worse(paper_run):
 
 def test_a_twice_faster_ship_breaks_the_rate_and_torque_checks():
     """The checks can fail: the paper's motion at twice its speed (periods 4 s and 5 s)."""
-    options = RunOptions(duration=6.0)
     setup = antenna._setup(PaperShipMotion(sample_time=0.005), *np.radians(ant.PAPER_SATELLITE_DEG),
-                           options.duration, 0, antenna.POINTING_MAX_PAPER_DEG, None, {},
+                           6.0, 0, antenna.POINTING_MAX_PAPER_DEG, None, {},
                            antenna.AntennaOptions())
     checks = _checks(runner.run("fast ship", setup))
     assert not checks["joint_torque"].passed
@@ -110,9 +108,9 @@ def test_dish_rotation_of_the_planner_equals_mujoco():
 
 
 def test_same_seed_same_run_and_the_noise_follows_the_seed():
-    _, a = _run(antenna.build_sea_state, 3.0, seed=5)
-    _, b = _run(antenna.build_sea_state, 3.0, seed=5)
-    _, c = _run(antenna.build_sea_state, 3.0, seed=6)
+    _, a = _run(antenna.AntennaSeaParams(), 3.0, seed=5)
+    _, b = _run(antenna.AntennaSeaParams(), 3.0, seed=5)
+    _, c = _run(antenna.AntennaSeaParams(), 3.0, seed=6)
     np.testing.assert_array_equal(a.log.qpos, b.log.qpos)
     np.testing.assert_array_equal(a.log.ctrl, b.log.ctrl)
     assert not np.array_equal(a.log.qpos, c.log.qpos)
@@ -120,14 +118,14 @@ def test_same_seed_same_run_and_the_noise_follows_the_seed():
 
 def test_imu_noise_enters_the_pointing_error():
     quiet = antenna.AntennaOptions(imu=antenna.ImuModel(attitude_noise_deg=0.0, gyro_noise_deg_s=0.0))
-    _, clean = _run(antenna.build_sea_state, 20.0, quiet)
-    _, noisy = _run(antenna.build_sea_state, 20.0)
+    _, clean = _run(antenna.AntennaSeaParams(), 20.0, quiet)
+    _, noisy = _run(antenna.AntennaSeaParams(), 20.0)
     assert noisy.metrics["pointing_error_rms_deg"] > 2 * clean.metrics["pointing_error_rms_deg"]
 
 
 def test_slower_imu_still_holds_the_sea_state():
     options = antenna.AntennaOptions(imu=antenna.ImuModel(rate_hz=20.0, latency_s=0.03))
-    _, result = _run(antenna.build_sea_state, 20.0, options)
+    _, result = _run(antenna.AntennaSeaParams(), 20.0, options)
     assert result.passed, [c for c in result.checks if not c.passed]
     assert result.metrics["planner_updates"] == pytest.approx(20.0 * 20.0, abs=2)
 
@@ -143,7 +141,7 @@ def test_bad_imu_settings_are_named():
 
 def test_bad_sea_state_is_named():
     with pytest.raises(ValueError, match="hs = -1"):
-        antenna.build_sea_state(RunOptions(hs=-1.0))
+        antenna.AntennaSeaParams(hs=-1.0)
 
 
 def test_dm_control_environment_with_an_imu_driven_controller():

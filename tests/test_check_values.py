@@ -2,7 +2,7 @@
 
 A check is only as good as the code computing its value (issue 12, point 7). For each
 registered scenario these tests produce the outputs the public way (the scenario's
-``build(RunOptions(...))``, ``sims.runner.run``, ``sims.outputs.write_run`` into a fresh
+``build(scenario.resolve(...))``, ``sims.runner.run``, ``sims.outputs.write_run`` into a fresh
 directory), then read back ONLY ``summary.json``, ``timeseries.npz`` and the compiled MuJoCo
 model, and recompute each check's value from the logged physics (qpos, qvel, act, ctrl,
 actuator_force, sensordata) with MuJoCo's own kinematics and actuator model
@@ -51,7 +51,6 @@ from sims import antenna as antenna_sim
 from sims import fast as fast_sim
 from sims.fast import physics as fast_physics
 from sims import outputs, runner, scenarios
-from sims.scenarios import RunOptions
 
 EXACT = 1e-9
 KIN = 1e-7
@@ -151,7 +150,7 @@ def write(tmp_path_factory, name: str, setup, duration: float, plan, model=None)
 
 def scenario_run(tmp_path_factory, name: str) -> Written:
     scenario = scenarios.get(name)
-    setup = scenario.build(RunOptions(duration=DURATIONS[name]))
+    setup = scenario.build(scenario.resolve(duration=DURATIONS[name]))
     # FAST's cable actuators are re-linearized in the run's model every tick: read FAST runs
     # with the compiled model (the same sensors, sites and leg drives).
     model = models.load("fast") if name.startswith("fast") else None
@@ -344,7 +343,7 @@ def hexapod_sync_driven_async(tmp_path_factory):
     """hexapod-sync-move with its trajectory replaced by the asynchronous planner's move (a
     user's planner plugged in): the sync scenario's arrival_spread is then not 0 (the struts
     arrive over ~5 s), so a mis-scaled spread shows."""
-    setup = scenarios.get("hexapod-sync-move").build(RunOptions(duration=1.0))
+    setup = scenarios.get("hexapod-sync-move").build(scenarios.get("hexapod-sync-move").resolve(duration=1.0))
     plan = scenarios.get("hexapod-async-move").plan()
     setup.trajectory = plan
     setup.duration = plan.duration + 1.0
@@ -598,7 +597,7 @@ def fast_observation(tmp_path_factory):
     """The tests' short FAST run (tests/test_fast_physics.py): start, 10 s of tracking,
     termination, 4 m/s wind, Stewart on; its observing window is the middle 10 s."""
     plan = fast_sim.observation_plan(10.0)
-    setup = fast_sim.build(plan, RunOptions(wind=4.0))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0))
     return write(tmp_path_factory, "fast-observation", setup, setup.duration, plan, models.load("fast"))
 
 
@@ -606,7 +605,7 @@ def fast_observation(tmp_path_factory):
 def fast_scan(tmp_path_factory):
     """A short motion scan: its observing window is the legs and the transition between."""
     plan = _short_scan_plan()
-    setup = fast_sim.build(plan, RunOptions(wind=4.0, seed=1))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0, seed=1))
     return write(tmp_path_factory, "fast-scan", setup, setup.duration, plan, models.load("fast"))
 
 
@@ -745,7 +744,7 @@ def diverging_loader(tmp_path_factory):
     first step, it warns (bad qacc) and resets, and the runner ends the run at its divergence
     scan. (A non-finite command would be the controller's fault and never reach MuJoCo:
     ``faulty_loader``.)"""
-    setup = scenarios.get("loader-supply").build(RunOptions(duration=0.5))
+    setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").resolve(duration=0.5))
     setup.physics.model.ptr.opt.gravity[:] = [0.0, 0.0, -1e12]
     return write(tmp_path_factory, "loader-diverging", setup, setup.duration, scenarios.get("loader-supply").plan())
 
@@ -756,7 +755,7 @@ FAULT_TICK = 40
 @pytest.fixture(scope="module")
 def faulty_loader(tmp_path_factory):
     """loader-supply with a user's controller that raises at tick FAULT_TICK."""
-    setup = scenarios.get("loader-supply").build(RunOptions(duration=0.5))
+    setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").resolve(duration=0.5))
     inner = setup.controller
 
     class RaisingController:
@@ -882,7 +881,7 @@ def test_planner_and_controller_solve_with_the_paper_weights():
     permuted = _least_norm_rates(ant.jacobian(theta0), omega, np.array([10.0, 5.0, 1.0, 2.0]))
     assert np.abs(permuted - hand).max() > 0.05 * np.abs(hand).max()  # the test can tell
     np.testing.assert_allclose(ant.joint_rates(theta0, omega)[0], hand, rtol=1e-10, atol=1e-14)
-    problem = scenarios.get("antenna-paper-motion").build(RunOptions(duration=0.1)).problem  # what the controller gets
+    problem = scenarios.get("antenna-paper-motion").build(scenarios.get("antenna-paper-motion").resolve(duration=0.1)).problem  # what the controller gets
     np.testing.assert_allclose(ant.joint_rates(theta0, omega, problem.weights)[0], hand,
                                rtol=1e-10, atol=1e-14)
 

@@ -146,7 +146,7 @@ def test_hexapod_plan(tmp_path):
 
 def test_antenna_sea_state_run_with_sea_options(tmp_path):
     out = tmp_path / "sea"
-    proc = planbench("run", "antenna-sea-state", "--hs", "3", "--tp", "8", "--heading", "90",
+    proc = planbench("run", "antenna-sea-state", "--hs", "3", "--tp", "8", "--wave-heading", "90",
                      "--duration", "4", "--out", out, "--video", out / "sea.mp4", "--quiet")
     assert proc.returncode == 0, proc.stdout + proc.stderr
     summary = json.loads((out / "summary.json").read_text())
@@ -163,14 +163,14 @@ def test_antenna_sea_state_run_with_sea_options(tmp_path):
 
 
 @pytest.mark.parametrize("args, words", [
-    (("antenna-sea-state", "--hs", "-2"), ("significant wave height -2", "> 0")),
-    (("antenna-sea-state", "--tp", "nan"), ("peak period nan", "not finite")),
-    (("antenna-paper-motion", "--hs", "4"), ("no sea state", "--hs")),
-    (("hexapod-sync-move", "--heading", "90"), ("no sea state", "--heading")),
-    (("antenna-sea-state", "--wind", "5"), ("no wind model",)),
+    (("antenna-sea-state", "--hs", "-2"), ("hs = -2 m", "[0.001, 20] m")),
+    (("antenna-sea-state", "--tp", "nan"), ("tp = nan", "not finite")),
+    (("antenna-paper-motion", "--hs", "4"), ("unrecognized arguments", "--hs")),
+    (("hexapod-sync-move", "--wave-heading", "90"), ("unrecognized arguments", "--wave-heading")),
+    (("antenna-sea-state", "--wind", "5"), ("unrecognized arguments", "--wind")),
     (("antenna-sea-state", "--imu-rate", "30"), ("IMU rate 30 Hz", "whole number")),
     (("antenna-paper-motion", "--imu-latency", "0.012"), ("IMU latency 0.012 s", "5 ms")),
-    (("loader-supply", "--no-prediction"), ("no IMU",)),
+    (("loader-supply", "--prediction", "off"), ("unrecognized arguments", "--prediction")),
 ])
 def test_antenna_bad_options_exit_2(tmp_path, args, words):
     assert_one_line_error(planbench("run", *args, "--out", tmp_path / "x"), *words)
@@ -191,8 +191,8 @@ def test_antenna_plan(tmp_path):
 
 
 def test_antenna_without_prediction_fails_the_paper_motion(tmp_path):
-    """--no-prediction: the 20 ms IMU latency and the 20 ms update interval become lag."""
-    proc = planbench("run", "antenna-paper-motion", "--no-prediction", "--imu-rate", "25",
+    """--prediction off: the 20 ms IMU latency and the 20 ms update interval become lag."""
+    proc = planbench("run", "antenna-paper-motion", "--prediction", "off", "--imu-rate", "25",
                      "--imu-latency", "0.04", "--duration", "3", "--out", tmp_path / "np", "--quiet")
     assert proc.returncode == 1, proc.stdout + proc.stderr
     summary = json.loads((tmp_path / "np" / "summary.json").read_text())

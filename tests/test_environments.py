@@ -15,7 +15,6 @@ import pytest
 from dm_env import test_utils
 
 from sims import envs, runner, scenarios
-from sims.scenarios import RunOptions
 
 
 class _Conformance(test_utils.EnvironmentTestMixin):
@@ -57,7 +56,7 @@ def _conformance_case(name: str):
     """A TestCase of dm_env's suite for the environment of the scenario ``name``."""
     # A Setup is built once per scenario (plans take seconds); each test gets a fresh
     # Environment over a fresh copy of it.
-    setup = functools.cache(lambda: scenarios.get(name).build(RunOptions(duration=EPISODE_S)))
+    setup = functools.cache(lambda: scenarios.get(name).build(scenarios.get(name).resolve(duration=EPISODE_S)))
 
     def make():
         built = setup()
@@ -81,8 +80,8 @@ def _conformance_case(name: str):
 def test_an_episode_starts_as_a_run_starts(name):
     """The same sensors and seeding as the runner: the first observation of an episode, and
     of the next one, equal the observation a run's controller gets at its reset, bit for bit."""
-    options = RunOptions(duration=EPISODE_S, seed=3)
-    run_start = runner.start_episode(scenarios.get(name).build(options)).observation
+    spec = scenarios.get(name)
+    run_start = runner.start_episode(spec.build(spec.resolve(duration=EPISODE_S, seed=3))).observation
     env = envs.make(name, duration=EPISODE_S, seed=3)
     for _ in range(2):
         observation = env.reset().observation

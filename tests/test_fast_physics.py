@@ -13,7 +13,6 @@ from sims import fast as fast_sim
 from sims import runner
 from sims.fast.physics import (CableLoads, ControllerOptions, FastController, FastPhysics, SensorOptions,
                                tangent_stiffness, winch_feedforward)
-from sims.scenarios import RunOptions
 
 #: The measured lowest cabin-cable mode (REFERENCE.md: Universe 10:450, 2024).
 MEASURED_LOWEST_MODE_HZ = (0.12, 0.2)
@@ -29,7 +28,7 @@ def hold_plan(azimuth_deg: float, elevation_deg: float, duration: float) -> fpla
 @functools.cache
 def observation_run(wind: float, stewart: bool, duration: float = 60.0, seed: int = 0):
     plan = fast_sim.observation_plan(duration)
-    setup = fast_sim.build(plan, RunOptions(wind=wind, seed=seed), ControllerOptions(stewart=stewart))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=wind, seed=seed), ControllerOptions(stewart=stewart))
     return runner.run("fast-observation", setup), setup
 
 
@@ -42,7 +41,7 @@ def test_static_tensions_equal_the_planner(elevation_deg):
     """At rest at the zenith and at zenith angle 40 deg (the planner's tilt split), MuJoCo's
     cable tensions equal the planner's static distribution within 1 %."""
     plan = hold_plan(30.0, elevation_deg, 10.0)
-    setup = fast_sim.build(plan, RunOptions(wind=0.0))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0))
     result = runner.run("hold", setup)
     planned = setup.controller.state.tension[-1]
     measured = -result.log.actuator_force[-1, setup.physics.cable_ids]
@@ -148,7 +147,7 @@ class PayOutCable(FastController):
 
 def test_a_slack_cable_fails_and_no_cable_ever_pushes():
     plan = fast_sim.observation_plan(30.0)
-    setup = fast_sim.build(plan, RunOptions(wind=0.0), controller=PayOutCable(ControllerOptions(stewart=False)))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0), controller=PayOutCable(ControllerOptions(stewart=False)))
     result = runner.run("slack", setup)
     low = check(result, "cable_tension_min")
     assert not low.passed and low.value < fast.FAST_LIMITS.tension_min / 1e3
@@ -161,7 +160,7 @@ def test_a_slack_cable_fails_and_no_cable_ever_pushes():
 def test_same_seed_same_run_other_seed_other_wind():
     a, _ = observation_run(4.0, True, duration=10.0, seed=3)
     plan = fast_sim.observation_plan(10.0)
-    b = runner.run("again", fast_sim.build(plan, RunOptions(wind=4.0, seed=3), ControllerOptions()))
+    b = runner.run("again", fast_sim.build(plan, fast_sim.FastParams(wind=4.0, seed=3), ControllerOptions()))
     np.testing.assert_array_equal(a.log.qpos, b.log.qpos)
     np.testing.assert_array_equal(a.log.actuator_force, b.log.actuator_force)
     c, _ = observation_run(4.0, True, duration=10.0, seed=4)
@@ -172,7 +171,7 @@ def test_winch_feedforward_alone_holds_the_cabin():
     """No feedback, no wind: the stretch-and-sag feed-forward alone keeps the cabin within a
     few mm while tracking (the plan's statics and the model agree)."""
     plan = fast_sim.observation_plan(30.0)
-    setup = fast_sim.build(plan, RunOptions(wind=0.0), ControllerOptions(stewart=False, kp=0, kd=0, ki=0))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0), ControllerOptions(stewart=False, kp=0, kd=0, ki=0))
     result = runner.run("ff", setup)
     assert check(result, "cabin_error_rms").value < 3.0
 
@@ -236,8 +235,8 @@ def test_long_runs_write_every_tenth_tick(tmp_path):
     from sims import outputs
 
     plan = fast_sim.observation_plan(200.0)
-    assert fast_sim.build(plan, RunOptions()).output_stride == fast_sim.OUTPUT_STRIDE  # 204 s > 120 s
-    setup = fast_sim.build(plan, RunOptions(duration=3.0))
+    assert fast_sim.build(plan, fast_sim.FastParams()).output_stride == fast_sim.OUTPUT_STRIDE  # 204 s > 120 s
+    setup = fast_sim.build(plan, fast_sim.FastParams(duration=3.0))
     assert setup.output_stride == 1
     setup.output_stride = 10
     result = runner.run("stride", setup)
@@ -260,7 +259,7 @@ def settled_chain(elevation_deg: float, segments: int = SEGMENTS):
     the winches at the planned unstretched lengths, 6 s of heavy damping, then released."""
 
     plan = hold_plan(30.0, elevation_deg, 1.0)
-    setup = fast_sim.build(plan, RunOptions(wind=0.0), cable_segments=segments)
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0, cable_segments=segments))
     physics, model, data = setup.physics, setup.physics.model.ptr, setup.physics.data.ptr
     runner.start_episode(setup)  # the controller's and the plant's start, as a run's
     data.ctrl[physics.leg_ids] = 0.0
@@ -329,6 +328,6 @@ def test_discretized_cables_bring_a_cabin_mode_into_the_measured_band():
 
 def test_discretized_cables_run_with_the_stabilizer():
     plan = fast_sim.observation_plan(30.0)
-    on = runner.run("chain", fast_sim.build(plan, RunOptions(wind=4.0), cable_segments=SEGMENTS))
+    on = runner.run("chain", fast_sim.build(plan, fast_sim.FastParams(wind=4.0, cable_segments=SEGMENTS)))
     assert on.passed and check(on, "feed_error_rms").value < 2.0
     assert on.metrics["cables"] == f"{SEGMENTS} segments each"

@@ -16,7 +16,7 @@ WIND_M_S = 10.0
 
 def run(name, controller=None, trajectory=None, **options):
     scenario = scenarios.get(name)
-    setup = scenario.build(scenarios.RunOptions(**options))
+    setup = scenario.build(scenario.resolve(**options))
     if controller is not None:
         setup.controller = controller
     if trajectory is not None:
@@ -150,7 +150,7 @@ def test_pose_error_needs_the_settling_time():
 @pytest.mark.parametrize("elevation", [14.9, 90.5, float("nan")])
 def test_elevation_outside_the_range_is_refused(elevation):
     with pytest.raises(ValueError, match="elevation .* outside .*15, 90"):
-        scenarios.get("hexapod-sync-move").build(scenarios.RunOptions(elevation=elevation))
+        scenarios.get("hexapod-sync-move").build(scenarios.get("hexapod-sync-move").resolve(elevation=elevation))
 
 
 def test_dm_control_environment_steps():

@@ -6,13 +6,13 @@ import pytest
 from planners.loader import direct_plan, supply_plan
 from sims import runner, scenarios
 from sims.loader.collision import clearance
-from sims.loader import LoaderPhysics, build_supply
+from sims.loader import LoaderPhysics
 from sims.controllers import ServoFeedforwardController
 
 
 def run(name, **options):
     scenario = scenarios.get(name)
-    setup = scenario.build(scenarios.RunOptions(**options))
+    setup = scenario.build(scenario.resolve(**options))
     return runner.run(name, setup), setup
 
 
@@ -82,7 +82,7 @@ def test_same_seed_same_log():
 
 def test_without_feedforward_tracking_fails():
     """The tracking checks can fail: PD drives alone lag the spline by more than 0.25 deg."""
-    setup = build_supply(scenarios.RunOptions())
+    setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").params)
     c = setup.controller
     setup.controller = ServoFeedforwardController(c.kp, c.kv, feedforward=False)
     result = runner.run("loader-supply", setup)
@@ -110,7 +110,7 @@ class NaNForce:
 
 
 def test_divergence_ends_the_run_as_a_failed_check():
-    setup = build_supply(scenarios.RunOptions())
+    setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").params)
     setup.disturbance = NaNForce(tick=100)
     result = runner.run("loader-supply", setup)
     c = checks(result)["simulation_warnings"]

@@ -14,7 +14,6 @@ import pytest
 
 from sims import api
 from sims.cli import main
-from sims.scenarios import RunOptions
 from sims.task import PluginError
 
 PLUGINS = textwrap.dedent('''
@@ -155,7 +154,7 @@ def test_a_module_plugin_and_the_python_api_run_the_same(plugin_file, monkeypatc
                  "--duration", "0.2", "--quiet"]) in (0, 1)
     import my_plugins
 
-    result = api.run("hexapod-sync-move", controller=my_plugins.Hold(), options=RunOptions(duration=0.2))
+    result = api.run("hexapod-sync-move", controller=my_plugins.Hold(), params=dict(duration=0.2))
     with np.load(out / "timeseries.npz") as ts:
         assert ts["qpos"].tobytes() == result.log.qpos.tobytes()
     summary = json.loads((out / "summary.json").read_text())

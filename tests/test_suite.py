@@ -15,7 +15,6 @@ import pytest
 
 from sims import outputs, runner, scenarios
 from sims.checks import NOT_EVALUATED
-from sims.scenarios import RunOptions
 from sims.task import PluginError
 
 SHORT_S = 0.25  # s: 25-50 control ticks, enough for every disturbance and sensor to act
@@ -25,7 +24,7 @@ NAMES = list(scenarios.SCENARIOS)
 
 @functools.lru_cache(maxsize=None)
 def short_run(name: str, seed: int):
-    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=seed))
+    setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=SHORT_S, seed=seed))
     return setup, runner.run(name, setup)
 
 
@@ -42,7 +41,7 @@ def test_a_short_run_has_no_mujoco_warning(name):
 @pytest.mark.parametrize("name", NAMES)
 def test_the_same_seed_gives_an_identical_log(name):
     _, a = short_run(name, 1)
-    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=1))
+    setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=SHORT_S, seed=1))
     b = runner.run(name, setup)  # a fresh build, not the cached one
     for field in LOGGED:
         x, y = getattr(a.log, field), getattr(b.log, field)
@@ -120,7 +119,7 @@ class FaultyController:
 @pytest.mark.parametrize("fault, fault_tick", [("raise", 0), ("raise", 7), ("nan", 7)])  # 0: the initial state alone
 @pytest.mark.parametrize("name", NAMES)
 def test_a_controller_fault_ends_the_run_as_a_failed_check(name, fault, fault_tick, tmp_path):
-    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=1))
+    setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=SHORT_S, seed=1))
     setup.controller = FaultyController(setup.controller, fault_tick, fault)
     result = runner.run(name, setup)
     checks = {c.name: c for c in result.checks}
@@ -141,7 +140,7 @@ def test_a_controller_fault_ends_the_run_as_a_failed_check(name, fault, fault_ti
 def test_a_nan_first_command_is_bad_input_before_any_step(name):
     """A non-finite command at the first tick is a broken contract, found before MuJoCo
     steps: a PluginError (the CLI's exit 2) naming the actuator, not a run."""
-    setup = scenarios.get(name).build(RunOptions(duration=SHORT_S, seed=1))
+    setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=SHORT_S, seed=1))
     setup.controller = FaultyController(setup.controller, 0, "nan")
     last = setup.physics.model.actuator(setup.physics.model.nu - 1).name
     with pytest.raises(PluginError, match=rf"\({last}\) = nan at t = 0.0000 s, its first command"):
@@ -166,7 +165,7 @@ def test_a_hold_still_plugin_controller_runs_and_is_judged(name, tmp_path):
     path: every check is evaluated or says why not, and summary.json names the plug-in."""
     from sims import api
 
-    result = api.run(name, controller=HoldStill(), options=RunOptions(duration=SHORT_S, seed=1), out=tmp_path / "out")
+    result = api.run(name, controller=HoldStill(), params=dict(duration=SHORT_S, seed=1), out=tmp_path / "out")
     checks = {c.name: c for c in result.checks}
     assert checks["controller_errors"].passed and checks["simulation_warnings"].passed, checks
     assert result.log.t[-1] == pytest.approx(SHORT_S)

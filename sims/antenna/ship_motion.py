@@ -271,19 +271,35 @@ class PaperShipMotion:
     ROLL_AMPLITUDE = math.radians(45.0)
     ROLL_PERIOD_SAMPLES = 1000.0
 
-    def __init__(self, sample_time: float = 0.01):
+    def __init__(self, sample_time: float = 0.01, amplitudes_deg: dict | None = None,
+                 periods_s: dict | None = None, turn_rate_deg_s: float | None = None,
+                 course_deg: float = 0.0):
+        """``amplitudes_deg`` and ``periods_s`` ({"heading", "pitch", "roll"}: deg, s) and
+        ``turn_rate_deg_s`` replace the paper's values (None: eq. 15-16 as printed, at
+        ``sample_time`` per sample); ``course_deg`` is added to the heading (the paper's psi
+        starts at 0)."""
         self.sample_time = _positive("paper sample time", sample_time, " s")
+        amplitudes = {"heading": self.HEADING_AMPLITUDE, "pitch": self.PITCH_AMPLITUDE, "roll": self.ROLL_AMPLITUDE}
+        for name, value in (amplitudes_deg or {}).items():
+            amplitudes[name] = math.radians(_finite(f"{name} amplitude", value, " deg"))
+        periods = {name: samples * self.sample_time for name, samples in
+                   (("heading", self.HEADING_PERIOD_SAMPLES), ("pitch", self.PITCH_PERIOD_SAMPLES),
+                    ("roll", self.ROLL_PERIOD_SAMPLES))}
+        for name, value in (periods_s or {}).items():
+            periods[name] = _positive(f"{name} period", value, " s")
+        self.amplitudes, self._periods = amplitudes, periods
+        self._turn_rate = (self.TURN_PER_SAMPLE / self.sample_time if turn_rate_deg_s is None
+                           else math.radians(_finite("turn rate", turn_rate_deg_s, " deg/s")))
+        self.course = math.radians(_finite("course", course_deg, " deg"))
 
     @property
     def turn_rate(self) -> float:
         """Mean heading rate, rad/s (1 deg/s at 0.01 s per sample)."""
-        return self.TURN_PER_SAMPLE / self.sample_time
+        return self._turn_rate
 
     def periods(self) -> dict[str, float]:
         """Periods of the heading, pitch and roll oscillations, s."""
-        return {name: samples * self.sample_time for name, samples in
-                (("heading", self.HEADING_PERIOD_SAMPLES), ("pitch", self.PITCH_PERIOD_SAMPLES),
-                 ("roll", self.ROLL_PERIOD_SAMPLES))}
+        return dict(self._periods)
 
     def sample(self, t) -> ShipState:
         """ShipState at times t (s, scalar or (n,))."""
@@ -291,15 +307,16 @@ class PaperShipMotion:
         rate = np.zeros((t.size, 4))
         accel = np.zeros((t.size, 4))
         angles = []
-        for col, amp, samples in ((HEADING, self.HEADING_AMPLITUDE, self.HEADING_PERIOD_SAMPLES),
-                                  (PITCH, self.PITCH_AMPLITUDE, self.PITCH_PERIOD_SAMPLES),
-                                  (ROLL, self.ROLL_AMPLITUDE, self.ROLL_PERIOD_SAMPLES)):
-            w = 2.0 * np.pi / (samples * self.sample_time)  # rad/s
+        for col, name in ((HEADING, "heading"), (PITCH, "pitch"), (ROLL, "roll")):
+            amp = self.amplitudes[name]
+            w = 2.0 * np.pi / self._periods[name]  # rad/s
             s, c = np.sin(w * t), np.cos(w * t)
             angles.append(amp * s)
             rate[:, col] = amp * w * c
             accel[:, col] = -amp * w * w * s
         angles[0] = angles[0] + self.turn_rate * t
+        if self.course:
+            angles[0] = angles[0] + self.course
         rate[:, HEADING] += self.turn_rate
         return ShipState(t=t, heave=np.zeros(t.size), heading=angles[0], pitch=angles[1],
                          roll=angles[2], rate=rate, accel=accel)

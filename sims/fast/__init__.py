@@ -28,6 +28,8 @@ slope 0.751 mm/s per unit is r x 1 deg/h = 0.786 mm/s times cos 17 deg, so deg/h
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from planners import fast
@@ -41,67 +43,107 @@ from sims.fast.physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, C
                                FastController, FastPhysics, FastSensors, SensorOptions, _compiled,
                                max_cable_segments, parked_command, winch_feedforward)
 from sims.runner import RunLog, Setup
+from sims.params import ParamError, ScenarioParams, param
 from sims.task import plan_checked
-from sims.wind import check_mean_speed
+from sims.wind import MAX_MEAN_SPEED_M_S, SPECTRA, MeasuredWind, WindFileError
 
-#: Calibrators (J2000, NED): 3C 286 13h31m08.29s +30d30m33.0s; 3C 295 14h11m20.5s +52d12m21s.
+#: The built-in catalogue: ICRS (J2000) RA and Dec, rad, of calibrators and pulsars FAST
+#: observes (NED and ATNF; 3C 286 13h31m08.29s +30d30m33.0s, 3C 295 14h11m20.5s +52d12m21s).
 SOURCES = {
     "3C 286": (np.radians(202.784542), np.radians(30.509167)),
     "3C 295": (np.radians(212.835417), np.radians(52.205833)),
+    "3C 48": (np.radians(24.422083), np.radians(33.159750)),
+    "3C 138": (np.radians(80.291208), np.radians(16.639472)),
+    "3C 147": (np.radians(85.650583), np.radians(49.852000)),
+    "Crab": (np.radians(83.633083), np.radians(22.014500)),
+    "Cyg A": (np.radians(299.868150), np.radians(40.733917)),
+    "PSR B0329+54": (np.radians(53.247375), np.radians(54.578778)),
+    "PSR B1937+21": (np.radians(294.910667), np.radians(21.583083)),
 }
-OBSERVING_NIGHT = "2026-03-01T00:00:00"  # the transit of 3C 286 nearest to it
+OBSERVING_NIGHT = "2026-03-01T00:00:00"  # the transit of each source nearest to it
 #: Where the feed waits between observations: 10 m above the focal point of the zenith
 #: (inside the focal sphere), so a switch starts with the paper's straight line to P_h.
 PARK = np.array([0.0, 0.0, -fast.FOCAL_SURFACE_RADIUS + 10.0])
 TRACK_STEP_S = 1.0  # s between sky samples of an observation (a spline joins them)
 
 
-def _transit(source: str):
-    ra, dec = SOURCES[source]
+def _radec(source) -> tuple[float, float]:
+    """A catalogue name, or (ra, dec) in rad."""
+    return SOURCES[source] if isinstance(source, str) else (float(source[0]), float(source[1]))
+
+
+def source_name(source) -> str:
+    if isinstance(source, str):
+        return source
+    return f"RA {np.degrees(source[0]):.4f} Dec {np.degrees(source[1]):+.4f}"
+
+
+def _transit(source):
+    ra, dec = _radec(source)
     return sky.meridian_transit(ra, dec, OBSERVING_NIGHT)
 
 
-def _observation(source: str, start_jd, duration: float, name: str):
-    ra, dec = SOURCES[source]
+def _start(source, start_utc: str | None, duration: float):
+    """(jd1, jd2) of an observation's start: ``start_utc``, or centred on the transit."""
+    if start_utc is not None:
+        jd1, jd2 = sky.as_utc_jd(start_utc)
+        return float(np.ravel(jd1)[0]), float(np.ravel(jd2)[0])
+    jd1, jd2 = _transit(source)
+    return jd1, jd2 - 0.5 * duration / 86400.0
+
+
+def _observation(source, start_jd, duration: float, name: str):
+    ra, dec = _radec(source)
     path = sky.track(ra, dec, start_jd, duration, step=TRACK_STEP_S)
     angles = sky.parallactic_angle(path.az, path.el)  # the 19-beam rotation follows it
     return fp.observation_segment(path.t, path.directions(), name=name, angles=angles), path
 
 
-def tracking_plan(duration: float = 1200.0, source: str = "3C 286") -> fp.FastPlan:
-    """Park -> source (switch), start, ``duration`` s of tracking centred on the transit,
-    termination."""
-    jd1, jd2 = _transit(source)
-    obs, path = _observation(source, (jd1, jd2 - 0.5 * duration / 86400.0), duration,
-                             f"observation ({source})")
+def tracking_plan(duration: float = 1200.0, source="3C 286", start_utc: str | None = None) -> fp.FastPlan:
+    """Park -> source (switch), start, ``duration`` s of tracking from ``start_utc`` (default
+    centred on the transit), termination. ``source``: a catalogue name or (ra, dec) rad."""
+    obs, path = _observation(source, _start(source, start_utc, duration), duration,
+                             f"observation ({source_name(source)})")
     start, stop = fp.start_segment(obs), fp.termination_segment(obs)
     switch, times = fp.switch_segments(PARK, start.start, multifeed1=fp.start_angle(obs, start))
     return fp.FastPlan(switch + [start, obs, stop], info={
-        "source": source, "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
+        "source": source_name(source), "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
         "switch_times_s": times.__dict__})
 
 
-def source_switch_plan(duration: float = 300.0) -> fp.FastPlan:
-    """Park -> 3C 286, track, stop, switch along the focal surface to 3C 295, track, stop."""
-    jd1, jd2 = _transit("3C 286")
-    obs_a, _ = _observation("3C 286", (jd1, jd2), duration, "observation (3C 286)")
+def source_switch_plan(duration: float = 300.0, sources=("3C 286", "3C 295"),
+                       start_utc: str | None = None) -> fp.FastPlan:
+    """Park -> the first source, track, stop; then for each next source a switch along the
+    focal surface, track, stop. The first observation starts at ``start_utc`` (default the
+    first source's transit), each next one when the switch to it ends."""
+    if start_utc is None:
+        jd1, jd2 = _transit(sources[0])
+    else:
+        jd1, jd2 = _start(sources[0], start_utc, duration)
+    obs_a, _ = _observation(sources[0], (jd1, jd2), duration, f"observation ({source_name(sources[0])})")
     start_a, stop_a = fp.start_segment(obs_a), fp.termination_segment(obs_a)
     switch_a, times_a = fp.switch_segments(PARK, start_a.start, multifeed1=fp.start_angle(obs_a, start_a))
-    # The second observation starts when the first ends plus the switch; plan the switch
-    # toward a first guess of the target, then re-plan it for the actual start point.
-    p0 = stop_a.evaluate(np.array([stop_a.duration]))[0][0]
-    t_end_a = duration + stop_a.duration
-    guess = t_end_a
-    for _ in range(3):
-        obs_b, _ = _observation("3C 295", (jd1, jd2 + (guess + 1.0) / 86400.0), duration,
-                                "observation (3C 295)")
-        start_b = fp.start_segment(obs_b)
-        switch_b, times_b = fp.switch_segments(p0, start_b.start, multifeed0=fp.end_angle(obs_a, stop_a),
-                                               multifeed1=fp.start_angle(obs_b, start_b))
-        guess = t_end_a + sum(s.duration for s in switch_b) + start_b.duration
-    segments = switch_a + [start_a, obs_a, stop_a] + switch_b + [start_b, obs_b, fp.termination_segment(obs_b)]
-    return fp.FastPlan(segments, info={"sources": ["3C 286", "3C 295"],
-                                       "switch_times_s": [times_a.__dict__, times_b.__dict__]})
+    segments, all_times = switch_a + [start_a, obs_a, stop_a], [times_a.__dict__]
+    t_end = duration + stop_a.duration  # of the last observation's stop, from the first's start
+    for source in sources[1:]:
+        # The next observation starts when the last ends plus the switch; plan the switch
+        # toward a first guess of the target, then re-plan it for the actual start point.
+        p0 = stop_a.evaluate(np.array([stop_a.duration]))[0][0]
+        guess = t_end
+        for _ in range(3):
+            offset = guess + 1.0  # s from the first observation's start
+            obs_b, _ = _observation(source, (jd1, jd2 + offset / 86400.0), duration,
+                                    f"observation ({source_name(source)})")
+            start_b = fp.start_segment(obs_b)
+            switch_b, times_b = fp.switch_segments(p0, start_b.start, multifeed0=fp.end_angle(obs_a, stop_a),
+                                                   multifeed1=fp.start_angle(obs_b, start_b))
+            guess = t_end + sum(s.duration for s in switch_b) + start_b.duration
+        stop_b = fp.termination_segment(obs_b)
+        segments += switch_b + [start_b, obs_b, stop_b]
+        all_times.append(times_b.__dict__)
+        obs_a, stop_a = obs_b, stop_b
+        t_end = offset + duration + stop_b.duration
+    return fp.FastPlan(segments, info={"sources": [source_name(s) for s in sources], "switch_times_s": all_times})
 
 
 def observation_plan(duration: float = 60.0, source: str = "3C 286") -> fp.FastPlan:
@@ -140,8 +182,8 @@ RA_SCAN = {"legs_along": "dec", "speed_deg_h": 15.0, "leg_deg": 1.0, "legs": 4, 
 DEC_SCAN = {"legs_along": "ra", "speed_deg_h": 5.0, "leg_deg": 0.5, "legs": 3, "spacing_deg": 0.05}
 
 
-def _scan_factory(spec: dict, source: str = "3C 286"):
-    ra, dec = SOURCES[source]
+def _scan_factory(spec: dict, source="3C 286"):
+    ra, dec = _radec(source)
 
     def make(t2: float):
         return sky.MotionScan(ra, dec, spec["legs_along"], np.radians(spec["leg_deg"]), spec["legs"],
@@ -154,16 +196,17 @@ def _leg_state(segment, at_end: bool):
     return tuple(x[0] for x in segment.evaluate(tau))
 
 
-def scan_plan(spec: dict) -> fp.FastPlan:
-    """Park -> the raster's start (switch), start, legs with transitions, termination.
+def scan_plan(spec: dict, source="3C 286", start_utc: str | None = None) -> fp.FastPlan:
+    """Park -> the raster's start (switch), start, legs with transitions, termination; the
+    raster around ``source`` (a catalogue name or (ra, dec) rad), from ``start_utc`` (default
+    centred on its transit).
 
     t2 is the geometric one (the shortest that keeps every transition under A_t-max);
     ``info`` holds it beside the paper's empirical values (eq. 11-14 or 15-20).
     """
-    make = _scan_factory(spec)
-    jd1, jd2 = _transit("3C 286")
+    make = _scan_factory(spec, source)
     first = make(60.0)
-    start_jd = (jd1, jd2 - 0.5 * first.duration / 86400.0)
+    start_jd = _start(source, start_utc, first.duration)
     t2 = fp.minimum_t2(make, start_jd)
     scan = make(t2)
     segments, path, peaks = fp.scan_segments(scan, start_jd)
@@ -427,48 +470,34 @@ def check_cable_segments(segments) -> int:
     return int(segments)
 
 
-def validate(options, default_duration: float | None = None) -> None:
-    """Bad input of a FAST run as a ValueError subclass naming the value and the limit, before
-    anything is built: the mean wind (sims.wind.check_mean_speed), the wind direction (within
-    +-360 deg), the cable segments (``check_cable_segments``) and the duration (at least one
-    control tick, its log within the memory limit; ``default_duration`` when
-    ``options.duration`` is None, unchecked if both are None)."""
-    if options.wind is not None:
-        check_mean_speed(options.wind)
-    direction = getattr(options, "wind_direction", None)
-    if direction is not None:
-        run_limits.check_angle("wind direction", direction)
-    segments = check_cable_segments(getattr(options, "cable_segments", None) or 0)
-    duration = options.duration if options.duration is not None else default_duration
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
-
-
 def problem(plan: fp.FastPlan) -> fp.FastProblem:
     """The session whose goal is ``plan``: its observing windows are the segments named
     OBSERVING_PREFIXES (observations, scan legs and their transitions)."""
     return fp.problem_of(plan, OBSERVING_PREFIXES)
 
 
-def build(plan: fp.FastPlan | fp.FastProblem, options, controller_options: ControllerOptions | None = None,
-          cable_segments: int | None = None, planner=None, controller=None,
-          sensor_options: SensorOptions = SensorOptions()) -> Setup:
+def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_options: ControllerOptions | None = None,
+          planner=None, controller=None, sensor_options: SensorOptions = SensorOptions()) -> Setup:
     """A run of a session (``plan``: its goal plan, or the problem): ``planner`` (default the
     paper's, whose plan is the goal) plans it, ``controller`` (default ``FastController`` with
-    ``controller_options``; ``options.stewart``: None or True for the stabilizer on) follows
-    it, with the physics at the trajectory's first pose (at rest, in equilibrium), the
-    cables and wind (``options.wind``, default DEFAULT_WIND_M_S) and the sensors
-    (``sensor_options``). ``cable_segments`` >= 2: the discretized cables
-    (sims.fast.physics.discretized_spec) instead of the lumped ones; None:
-    ``options.cable_segments``."""
+    ``controller_options``, else the stabilizer as ``params.stewart`` says) follows it, with
+    the physics at the trajectory's first pose (at rest, in equilibrium), the cables
+    (``params.cable_segments`` >= 2: discretized, sims.fast.physics.discretized_spec), the wind
+    of ``params`` and the sensors (``sensor_options``)."""
     session = plan if isinstance(plan, fp.FastProblem) else problem(plan)
-    if cable_segments is None:
-        cable_segments = getattr(options, "cable_segments", None) or 0
     planner = fp.PaperPlanner() if planner is None else planner
     trajectory = plan_checked(planner, session, fp.PLAN_LABELS)
-    duration = trajectory.duration if options.duration is None else options.duration
-    validate(options, duration)
-    check_cable_segments(cable_segments)
-    physics = FastPhysics.load(cable_segments)
+    duration = trajectory.duration if params.duration is None else params.duration
+    segments = params.cable_segments
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
+    measured = None
+    if params.wind_file is not None:
+        measured = MeasuredWind(params.wind_file)
+        try:
+            measured.check_covers(duration)
+        except WindFileError as e:
+            raise ParamError(f"wind_file: {e}") from None
+    physics = FastPhysics.load(segments)
     s0 = fp.reference_state(trajectory.sample(np.array([0.0])))
     physics.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
                               s0.multifeed[0])
@@ -476,63 +505,181 @@ def build(plan: fp.FastPlan | fp.FastProblem, options, controller_options: Contr
     description = {}
     if controller is None:
         if controller_options is None:
-            stewart = True if getattr(options, "stewart", None) is None else bool(options.stewart)
-            controller_options = ControllerOptions(stewart=stewart)
+            controller_options = ControllerOptions(stewart=params.stewart)
         controller = FastController(controller_options)
         description["stewart"] = "on" if controller_options.stewart else "off"
-    wind = DEFAULT_WIND_M_S if options.wind is None else options.wind
-    direction = getattr(options, "wind_direction", None)
-    loads = (ChainCableLoads if cable_segments else CableLoads)(
-        wind, WIND_AZIMUTH_DEG if direction is None else direction)
+    loads = (ChainCableLoads if segments else CableLoads)(
+        params.wind, params.wind_direction, params.wind_spectrum, params.turbulence_intensity, measured)
     evaluation = FastEvaluation(physics, session, loads, description)
     return Setup(physics=physics, trajectory=trajectory, controller=controller,
                  sensors=FastSensors(physics, sensor_options, CONTROL_DT), problem=session, planner=planner,
                  control_dt=CONTROL_DT, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
-                 report=evaluation.report, disturbance=loads, video_speed=1.0, seed=options.seed,
+                 report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed,
                  output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1)
 
 
-def build_tracking(options, planner=None, controller=None) -> Setup:
-    return build(tracking_plan(), options, planner=planner, controller=controller)
+def goal_plan(params: "FastParams") -> fp.FastPlan:
+    """The session a scenario's parameters describe: tracking, a scan or a switch. A source
+    that leaves FAST's 40 deg zenith-angle range during it is a ParamError naming the keys."""
+    try:
+        if isinstance(params, FastTrackingParams):
+            return tracking_plan(params.tracking, params.source_of(), params.start_utc)
+        if isinstance(params, FastScanParams):
+            spec = {"legs_along": params.legs_along, "speed_deg_h": params.scan_speed, "leg_deg": params.leg_length,
+                    "legs": params.legs, "spacing_deg": params.leg_spacing}
+            return scan_plan(spec, params.source_of(), params.start_utc)
+        if isinstance(params, FastSwitchParams):
+            return source_switch_plan(params.tracking, params.sources, params.start_utc)
+    except LimitError as e:
+        keys = "sources, start_utc" if isinstance(params, FastSwitchParams) else "source, start_utc"
+        raise ParamError(f"{keys}: {e} (FAST observes within 40 deg of the zenith, Table 1)") from None
+    raise TypeError(f"no session for {type(params).__name__}")
 
 
-def build_ra_scan(options, planner=None, controller=None) -> Setup:
-    return build(ra_scan_plan(), options, planner=planner, controller=controller)
+def build_scenario(params: "FastParams", planner=None, controller=None) -> Setup:
+    return build(goal_plan(params), params, planner=planner, controller=controller)
 
 
-def build_source_switch(options, planner=None, controller=None) -> Setup:
-    return build(source_switch_plan(), options, planner=planner, controller=controller)
-
-
-# ----------------------------------------------------------------------------- registry
+# ----------------------------------------------------------------------------- parameters
 
 from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
 
-#: What the FAST runs share: options, plan plots and the paper's figures.
-_RUN = dict(options=frozenset({"wind", "wind_direction", "stewart", "cables"}), kinds=plan_kinds,
-            plan_extras=write_figures, control_dt=CONTROL_DT, validate=validate)
+_ANGLE = dict(unit="deg", low=-360.0, high=360.0, reason="one turn either way; angles are not wrapped")
+_UTC = dict(unit="UTC", reason="ISO 8601, e.g. 2026-03-01T14:30:00; years 1972-2099, where UTC has its leap seconds")
+
+
+@dataclass(frozen=True)
+class FastParams(ScenarioParams):
+    """What every FAST run shares: the wind, the cables, the stabilizer."""
+
+    wind: float = param(DEFAULT_WIND_M_S, "mean wind at the cabin", "m/s", low=0.0, high=MAX_MEAN_SPEED_M_S,
+                        reason="IEC 61400-1 class I reference speed, the Kaimal model's range")
+    wind_direction: float = param(WIND_AZIMUTH_DEG, "azimuth the wind blows toward, from east toward north", **_ANGLE)
+    turbulence_intensity: float | None = param(
+        None, "sigma_u / U of the turbulence; none: the spectrum's own (Kaimal: IEC class B)", "", low=0.0, high=0.5,
+        reason="beyond 0.5 a one-point Gaussian turbulence model does not hold")
+    wind_spectrum: str = param("kaimal", "turbulence spectrum", choices=tuple(SPECTRA))
+    wind_file: str | None = param(
+        None, "measured wind instead of the model: CSV rows t (s), speed (m/s)[, direction (deg)], covering the "
+        "run; resampled to the 10 ms control ticks (a relative path is the scenario file's directory's)", path=True)
+    stewart: bool = param(True, "the Stewart stabilizer in the cabin on (off: the feed rides the A-B rotator)")
+    cable_segments: int = param(0, "each cable as a chain of this many elastic segments; 0: straight cables with "
+                                "the lumped catenary law", low=0, high=max_cable_segments(),
+                                reason="more segments vibrate beyond the 2 ms timestep's limit omega dt <= "
+                                       f"{SEGMENT_OMEGA_DT_LIMIT:g}")
+    duration: float | None = param(None, "simulated time; none: the whole session", "s", low=CONTROL_DT,
+                                   reason="at least one control tick (10 ms)")
+
+    def check(self) -> None:
+        if self.cable_segments == 1:
+            raise ParamError("cable_segments = 1 is not a chain: 0 (lumped cables) or 2 ... "
+                             f"{max_cable_segments()}")
+        if self.wind_file is not None:
+            try:
+                MeasuredWind(self.wind_file)
+            except WindFileError as e:
+                raise ParamError(f"wind_file: {e}") from None
+        if self.duration is not None:
+            run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.cable_segments))
+        start = getattr(self, "start_utc", None)
+        if start is not None:
+            try:
+                jd1, jd2 = sky.as_utc_jd(start)
+                year = int(sky.jd_to_iso(np.ravel(jd1)[0], np.ravel(jd2)[0])[:4])
+            except (ValueError, TypeError) as e:
+                raise ParamError(f"start_utc = {start!r} is not a UTC time ({_UTC['reason']}): {e}") from None
+            if not 1972 <= year <= 2099:
+                raise ParamError(f"start_utc = {start!r} is outside the years 1972-2099, where UTC has its leap seconds")
+
+
+@dataclass(frozen=True)
+class FastSourceParams(FastParams):
+    """A session on one source: by catalogue name or by RA/Dec, from a start time."""
+
+    source: str | None = param("3C 286", "the source, from the built-in catalogue (sims.fast.SOURCES); none: "
+                               "source_radec", choices=tuple(SOURCES), excludes=("source_radec",))
+    source_radec: tuple[float, ...] | None = param(
+        None, "the source's ICRS (J2000) right ascension and declination; none: source", unit=("deg", "deg"),
+        low=(0.0, -90.0), high=(360.0, 90.0), reason="RA and Dec", length=2, excludes=("source",))
+    start_utc: str | None = param(None, "the observation's start; none: centred on the source's transit nearest "
+                                  f"{OBSERVING_NIGHT}", **_UTC)
+
+    def source_of(self):
+        """A catalogue name, or (ra, dec) in rad."""
+        return self.source if self.source is not None else tuple(np.radians(self.source_radec))
+
+    def check(self) -> None:
+        super().check()
+        if (self.source is None) == (self.source_radec is None):
+            raise ParamError("give source or source_radec, one of them")
+
+
+@dataclass(frozen=True)
+class FastTrackingParams(FastSourceParams):
+    """Park -> the source, start, tracking, termination."""
+
+    tracking: float = param(1200.0, "time on the source", "s", low=10.0, high=6 * 3600.0,
+                            reason="10 s to 6 h (a source stays within 40 deg of FAST's zenith for at most ~5.3 h)")
+
+    def check(self) -> None:
+        super().check()
+        ra, dec = _radec(self.source_of())
+        start = _start(self.source_of(), self.start_utc, self.tracking)
+        try:
+            sky.track(ra, dec, start, self.tracking, step=max(self.tracking / 100.0, 1.0))
+        except LimitError as e:
+            raise ParamError(f"source, start_utc, tracking: {e} (FAST observes within 40 deg of the zenith, "
+                             "Table 1)") from None
+
+
+@dataclass(frozen=True)
+class FastScanParams(FastSourceParams):
+    """The paper's motion scan: legs along RA or Dec around the source, with transitions."""
+
+    legs_along: str = param("dec", "the legs run along Dec (the paper's scan along RA, Fig. 8) or along RA "
+                            "(Fig. 11)", choices=("dec", "ra"))
+    legs: int = param(RA_SCAN["legs"], "number of legs", low=1, high=50, reason="a raster of 1 to 50 legs")
+    leg_length: float = param(RA_SCAN["leg_deg"], "length of a leg on the sky", "deg", low=0.01, high=10.0,
+                              reason="36 arcsec to 10 deg")
+    scan_speed: float = param(RA_SCAN["speed_deg_h"], "scan speed along a leg", "deg/h", low=0.1, high=60.0,
+                              reason="the paper's 5-15 deg/h; 60 deg/h is FAST's fastest scan")
+    leg_spacing: float = param(RA_SCAN["spacing_deg"], "spacing of the legs", "deg", low=0.001, high=1.0,
+                               reason="3.6 arcsec to 1 deg (the paper: 3 arcmin)")
+
+
+@dataclass(frozen=True)
+class FastSwitchParams(FastParams):
+    """Tracking one source after another, with focal-surface switches between."""
+
+    sources: tuple[str, ...] = param(("3C 286", "3C 295"), "the sources, in order, from the catalogue",
+                                     choices=tuple(SOURCES), min_items=2, max_items=10,
+                                     reason="a switch needs two; ten fill a night")
+    tracking: float = param(300.0, "time on each source", "s", low=10.0, high=3600.0, reason="10 s to an hour")
+    start_utc: str | None = param(None, "the first observation's start; none: the first source's transit "
+                                  f"nearest {OBSERVING_NIGHT}", **_UTC)
+
+
+#: What the FAST runs share: plan plots and the paper's figures.
+_RUN = dict(build=build_scenario, plan=goal_plan, kinds=plan_kinds, plan_extras=write_figures, control_dt=CONTROL_DT)
 
 SCENARIOS = (
     Scenario(
         "fast-tracking",
-        "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
-        build_tracking,
-        tracking_plan,
+        "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind",
+        FastTrackingParams(),
         **_RUN,
         demo_cameras=("closeup",),
     ),
     Scenario(
         "fast-ra-scan",
-        "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
-        build_ra_scan,
-        ra_scan_plan,
+        "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind",
+        FastScanParams(),
         **_RUN,
     ),
     Scenario(
         "fast-source-switch",
-        "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind (--wind, --wind-direction, --stewart on|off, --cable-segments)",
-        build_source_switch,
-        source_switch_plan,
+        "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind",
+        FastSwitchParams(),
         **_RUN,
     ),
 )
@@ -541,8 +688,10 @@ PLANS = (
     Scenario(
         "fast-dec-scan",
         "FAST feed: the paper's motion scan along Dec around 3C 286: 3 legs along RA at 5 deg/h, transitions, beside the paper's eq. 15-20",
+        FastScanParams(legs_along="ra", legs=DEC_SCAN["legs"], leg_length=DEC_SCAN["leg_deg"],
+                       scan_speed=DEC_SCAN["speed_deg_h"], leg_spacing=DEC_SCAN["spacing_deg"]),
         None,
-        dec_scan_plan,
+        goal_plan,
         kinds=plan_kinds,
         plan_extras=write_figures,
     ),

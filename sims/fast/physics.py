@@ -473,20 +473,33 @@ class CableLoads:
       wind_speed: mean wind, m/s (0: none).
       wind_azimuth_deg: the direction the wind blows toward, deg from +x (east) toward +y.
       spectrum: "kaimal" or "davenport" (sims.wind).
+      turbulence_intensity: sigma_u / U; None: the spectrum's own (sims.wind.wind_speed_series).
+      measured: a sims.wind.MeasuredWind record instead of the model (its speed, and its
+        direction where it has one), resampled to the ticks.
     """
 
-    def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal"):
-        self.mean_speed = check_mean_speed(wind_speed)
+    def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal",
+                 turbulence_intensity: float | None = None, measured=None):
+        self.mean_speed = check_mean_speed(wind_speed) if measured is None else float(np.mean(measured.speed))
         az = math.radians(wind_azimuth_deg)
         self.direction = np.array([math.cos(az), math.sin(az), 0.0])
         self.spectrum = spectrum
+        self.turbulence_intensity = turbulence_intensity
+        self.measured = measured
+        self._directions = None
         self.speed = None
         self.force = None  # (n, 3) wind force on cabin and cables, N (logged)
         self.tension = None  # (6,) the catenary tensions of the current tick, N
         self.tension_log = None  # (n, 6) per tick, before the actuator's force clamp
 
     def reset(self, physics: FastPhysics, times: np.ndarray, rng: np.random.Generator) -> None:
-        self.speed = wind_speed_series(times, self.mean_speed, rng, self.spectrum)
+        if self.measured is None:
+            self.speed = wind_speed_series(times, self.mean_speed, rng, self.spectrum,
+                                           turbulence_intensity=self.turbulence_intensity)
+        else:
+            self.speed, self._directions = self.measured.resample(times)
+            if self._directions is not None:
+                self.direction = self._directions[0]
         self.force = np.zeros((times.size, 3))
         self.tension_log = np.zeros((times.size, 6))
         model, data = physics.model.ptr, physics.data.ptr
@@ -555,6 +568,8 @@ class CableLoads:
         return drag, _moment(centre[None], drag[None])
 
     def __call__(self, tick: int, physics) -> None:
+        if self._directions is not None:
+            self.direction = self._directions[tick]
         self.apply(physics, tick)
 
 

@@ -3,8 +3,9 @@
 Scenarios:
   hexapod-sync-move   a move of a few mm and ~0.1 deg, every strut arriving on the same tick
   hexapod-async-move  another such move, each strut at its own minimum time
-both with ``--elevation`` (telescope elevation, 15 ... 90 deg: gravity's direction in the
-hexapod frame) and ``--wind`` (turbulent drag on the camera).
+both named defaults of ``HexapodParams``: a start pose and a list of moves, each synchronous
+or not, the telescope's elevation (15 ... 90 deg: gravity's direction in the hexapod frame) and
+the wind (turbulent drag on the camera).
 
 The hexapod frame is the model's body ``top_end`` (models/hexapod/hexapod.xml); the model is
 recompiled per elevation with the top end tilted (MjSpec), so gravity stays the world's -z.
@@ -15,6 +16,7 @@ from __future__ import annotations
 import copy
 import functools
 import math
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -26,13 +28,14 @@ from planners import hexapod as hexapod_planner
 from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
 from planners.rotations import wxyz
-from planners.trajectory import TrajectorySample
+from planners.trajectory import PiecewiseTrajectory, TrajectorySample
 from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
+from sims.params import Params, ParamError, ScenarioParams, param
 from sims.task import JointEncoders, plan_checked
-from sims.wind import BodyWindDrag, check_mean_speed
+from sims.wind import MAX_MEAN_SPEED_M_S, BodyWindDrag
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
 SETTLE_S = 1.0  # s simulated after the move: the integral action settles in ~0.5 s
@@ -48,8 +51,9 @@ POSE_FINAL_LIMIT_UM = 1.0
 ARRIVAL_SPREAD_LIMIT_S = CONTROL_DT
 
 #: The moves: a few mm and ~0.1 deg, inside the pose limits and the stroke (m, rad).
-SYNC_TARGET = np.array([1.5e-3, -1.0e-3, 0.8e-3, np.radians(0.10), np.radians(-0.05), np.radians(0.03)])
-ASYNC_TARGET = np.array([-2.0e-3, 1.5e-3, -1.0e-3, np.radians(-0.05), np.radians(0.10), np.radians(-0.05)])
+#: In the parameters' units, x, y, z mm and rx, ry, rz deg.
+SYNC_TARGET_MM_DEG = (1.5, -1.0, 0.8, 0.10, -0.05, 0.03)
+ASYNC_TARGET_MM_DEG = (-2.0, 1.5, -1.0, -0.05, 0.10, -0.05)
 
 #: Drag of the camera (a cylinder, 1.65 m x 3 m): Cd = 1.0 for a circular cylinder in cross
 #: flow (subcritical, ~1.0-1.2), applied to its silhouette across the wind (README.md).
@@ -338,16 +342,26 @@ def arrival_times(reference: TrajectorySample, tolerance: float = 0.0) -> np.nda
 
 
 class HexapodEvaluation:
-    """Checks and outputs of a hexapod run."""
+    """Checks and outputs of a hexapod run: one move, or a list of moves one after another.
 
-    def __init__(self, physics: HexapodPhysics, problem: hexapod_planner.MoveProblem, duration: float,
-                 wind: BodyWindDrag | None):
+    Move i runs from ``starts[i]``; its window of the log runs from there to the next move's
+    start (inclusive: at that tick the next move has not acted yet), the last one's to the end.
+    Each move's arrival is judged in its window (synchronous: the arrival spread;
+    asynchronous: each strut against its own time); its pose error over the window's last
+    SETTLE_WINDOW_S, after SETTLE_S of settling. A check reports the worst move.
+    """
+
+    def __init__(self, physics: HexapodPhysics, moves, starts, durations, wind: BodyWindDrag | None):
         self.physics = physics
-        self.problem = problem
-        self.synchronous = problem.synchronous
-        self.planned_duration = float(duration)  # of the trajectory the planner returned
+        self.moves = list(moves)
+        self.starts = np.asarray(starts, dtype=float)
+        self.planned = np.asarray(durations, dtype=float)  # of each trajectory the planner returned
         self.wind = wind
-        self.own_times = hexapod_planner.own_move_times(problem)
+        self.own_times = [hexapod_planner.own_move_times(m) for m in self.moves]
+
+    @property
+    def problem(self) -> hexapod_planner.MoveProblem:
+        return self.moves[-1]
 
     def _strut_log(self, log: RunLog):
         p = self.physics
@@ -368,80 +382,148 @@ class HexapodEvaluation:
         wanted = hexapod_planner.pivot_positions(np.asarray(target_pose))
         return 1e6 * np.linalg.norm(actual - wanted, axis=-1).max(axis=-1)
 
+    def move_index(self, t: np.ndarray) -> np.ndarray:
+        """(n,) the move whose window each time lies in."""
+        return np.clip(np.searchsorted(self.starts, t + 1e-9, side="right") - 1, 0, len(self.moves) - 1)
+
+    def targets(self, t: np.ndarray) -> np.ndarray:
+        """(n, 6) the target pose of the move each time belongs to."""
+        return np.array([m.target_pose for m in self.moves])[self.move_index(t)]
+
+    def _window(self, log: RunLog, i: int) -> np.ndarray:
+        lo = self.starts[i] - 1e-9
+        hi = self.starts[i + 1] + 1e-9 if i + 1 < len(self.moves) else np.inf
+        return np.flatnonzero((log.t >= lo) & (log.t <= hi))
+
+    def _judge_move(self, log: RunLog, i: int, q, poses) -> dict:
+        """One move's arrival, following error and settled pose error."""
+        rows = self._window(log, i)
+        if rows.size == 0:
+            return {"arrived": False, "ended": False}
+        ref = log.reference
+        t = log.t[rows] - self.starts[i]
+        window_ref = TrajectorySample(t, ref.position[rows], ref.velocity[rows], ref.acceleration[rows])
+        moving = np.abs(window_ref.position[-1] - window_ref.position[0]) > 0
+        arrivals = arrival_times(window_ref)
+        spread = float(arrivals[moving].max() - arrivals[moving].min()) if moving.any() else 0.0
+        move_end = float(arrivals.max())
+        during = rows[t <= move_end + 1e-9]
+        settled = rows[t >= t[-1] - SETTLE_WINDOW_S - 1e-9]
+        # Against this move's own target (the window's last tick is the next move's first).
+        wanted = hexapod_planner.pivot_positions(np.asarray(self.moves[i].target_pose))
+        pivots = 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(poses[settled]) - wanted, axis=-1).max(axis=-1)
+        arrived = not np.any(window_ref.velocity[-1] != 0.0)
+        own = self.own_times[i]
+        return {
+            "arrived": arrived,
+            "ended": arrived and t[-1] >= move_end + SETTLE_S - 1e-9,
+            "moving": moving,
+            "arrivals": arrivals,
+            "spread": spread,
+            "late": float(np.abs(arrivals - own)[moving].max()) if moving.any() else 0.0,
+            "move_end": move_end,
+            "during": during,
+            "following": 1e6 * np.abs(q - ref.position)[during].max(axis=0) if during.size else np.zeros(6),
+            "pose_error": float(pivots.max()),
+            "settled_at": self.starts[i] + (move_end if arrived else self.planned[i]) + SETTLE_S,
+        }
+
     def __call__(self, log: RunLog):
         p = self.physics
         ref = log.reference
         q, qd = self._strut_log(log)
         limits = RUBIN_LIMITS
-        moving = np.abs(ref.position[-1] - ref.position[0]) > 0
-        arrivals = arrival_times(ref)
-        spread = float(arrivals[moving].max() - arrivals[moving].min()) if moving.any() else 0.0
-        move_end = float(arrivals.max())
-        during = log.t <= move_end + 1e-9
-        following = 1e6 * np.abs(q - ref.position)[during].max()
-        window = log.t >= log.t[-1] - SETTLE_WINDOW_S - 1e-9
-        target_pose = self.problem.target_pose
-        pose_err = self.pivot_errors_um(log, target_pose)
+        poses = p.poses_from_qpos(log.qpos)
+        judged = [self._judge_move(log, i, q, poses) for i in range(len(self.moves))]
+        several = len(self.moves) > 1
         demanded = demanded_force(p.kp, p.kv, log.act[:, :6], q, qd)
         force = np.abs(demanded).max()
         stroke = np.abs(q).max()
         v_cmd = np.abs(ref.velocity).max()
         a_cmd = np.abs(ref.acceleration).max()
         checks = []
-        # Arrivals exist only if the run saw the whole commanded motion, i.e. its reference
-        # rests at the last tick (a short run's last tick would pass for every strut's
-        # arrival); the settling window only comes after them.
-        arrived = not np.any(ref.velocity[-1] != 0.0)
+
+        def per_move(key, scale=1.0, fmt=".3g"):
+            return "; per move " + ", ".join(f"{scale * j[key]:{fmt}}" for j in judged) if several else ""
+
+        # Arrivals exist only if the run saw the whole commanded motion of a move, i.e. its
+        # reference rests at the window's last tick (a short run's last tick would pass for
+        # every strut's arrival); the settling window only comes after them.
+        late_move = next((i for i, j in enumerate(judged) if not j["arrived"]), None)
+        arrived = late_move is None
         short = (f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion "
-                 f"(planned to t = {self.planned_duration:.3f} s) came to rest")
-        if self.synchronous:
-            checks.append(Check("arrival_spread", spread, ARRIVAL_SPREAD_LIMIT_S, "s",
-                                note="last minus first strut arrival of the commanded motion")
+                 + (f"of move {late_move} " if several and not arrived else "")
+                 + f"(planned to t = {self.starts[-1] + self.planned[-1] if arrived else self.starts[late_move] + self.planned[late_move]:.3f} s) came to rest")
+        sync = [i for i, m in enumerate(self.moves) if m.synchronous]
+        asyn = [i for i, m in enumerate(self.moves) if not m.synchronous]
+        if sync:
+            checks.append(Check("arrival_spread", max(judged[i]["spread"] for i in sync), ARRIVAL_SPREAD_LIMIT_S, "s",
+                                note="last minus first strut arrival of the commanded motion"
+                                     + (per_move("spread") if several else ""))
                           if arrived else
                           Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=short))
-        else:
-            own = self.own_times
-            late = float(np.abs(arrivals - own)[moving].max()) if moving.any() else 0.0
-            checks.append(Check("arrival_vs_own_time", late, 2 * CONTROL_DT, "s",
+        if asyn:
+            spread_text = ", ".join(f"{judged[i]['spread']:.3f}" for i in asyn)
+            checks.append(Check("arrival_vs_own_time", max(judged[i]["late"] for i in asyn), 2 * CONTROL_DT, "s",
                                 note=f"each strut ends within two ticks of its own time 2 T_i; "
-                                     f"arrival spread {spread:.3f} s")
+                                     f"arrival spread {spread_text} s")
                           if arrived else
                           Check.not_evaluated("arrival_vs_own_time", 2 * CONTROL_DT, "s", reason=short))
-        ended = arrived and log.t[-1] >= move_end + SETTLE_S - 1e-9
-        settled_at = (move_end if arrived else self.planned_duration) + SETTLE_S
+        ended_all = all(j["ended"] for j in judged)
+        unsettled = next((i for i, j in enumerate(judged) if not j["ended"]), len(judged) - 1)
+        settled_at = judged[unsettled].get("settled_at", self.starts[unsettled] + self.planned[unsettled] + SETTLE_S)
+        last = judged[-1]
+        move_end = last.get("move_end", self.planned[-1])
+        following = max(float(j["following"].max()) for j in judged if j["arrived"] or "during" in j)
         checks += [
             Check("strut_velocity", 1e6 * v_cmd, 1e6 * limits.strut_speed, "um/s",
                   note="commanded; measured peak "
                        f"{1e6 * np.abs(qd).max():.1f} um/s"),
             Check("strut_accel", 1e6 * a_cmd, 1e6 * limits.strut_accel, "um/s2",
                   note="commanded by the generator, per tick"),
-            Check("following_error", float(following), FOLLOWING_LIMIT_UM, "um",
-                  note=f"encoder minus reference, t <= {move_end:.3f} s"),
-            Check("pose_error_final", float(pose_err[window].max()), POSE_FINAL_LIMIT_UM, "um",
-                  note=f"largest mirror-side pivot displacement over the last {SETTLE_WINDOW_S} s")
-            if ended else
+            Check("following_error", following, FOLLOWING_LIMIT_UM, "um",
+                  note=(f"encoder minus reference, t <= {move_end:.3f} s" if not several else
+                        "encoder minus reference during each move" + per_move("move_end", fmt=".3f") + " s")),
+            Check("pose_error_final", max(j["pose_error"] for j in judged), POSE_FINAL_LIMIT_UM, "um",
+                  note=(f"largest mirror-side pivot displacement over the last {SETTLE_WINDOW_S} s"
+                        + (" before each next move and of the run" + per_move("pose_error") if several else "")))
+            if ended_all else
             Check.not_evaluated("pose_error_final", POSE_FINAL_LIMIT_UM, "um",
-                                reason=f"the run ended at t = {log.t[-1]:.3f} s, before the move plus "
+                                reason=f"the run ended at t = {log.t[-1]:.3f} s, before the move"
+                                       + (f" {unsettled}" if several else "") + " plus "
                                        f"{SETTLE_S:g} s of settling (t = {settled_at:.3f} s)"),
             Check("strut_force", float(force), float(p.force_limit.min()), "N",
                   note=f"demanded, peak on {STRUT_LABELS[int(np.argmax(np.abs(demanded).max(0)))]}"),
             Check("stroke", 1e3 * float(stroke), 1e3 * limits.stroke, "mm"),
         ]
-        final_pose = p.poses_from_qpos(log.qpos[-1])[0]
-        pose_diff = final_pose - np.asarray(target_pose)
+        final_pose = poses[-1]
+        pose_diff = final_pose - np.asarray(self.moves[-1].target_pose)
+        arrivals = last.get("arrivals", np.zeros(6))
+        during = last.get("during", np.arange(0))
+        window = log.t >= log.t[-1] - SETTLE_WINDOW_S - 1e-9
         metrics = {
             "elevation_deg": p.elevation_deg,
             "move_duration_s": move_end,
             "arrival_times_s": dict(zip(STRUT_LABELS, arrivals.round(4).tolist())),
-            "arrival_spread_s": spread,
+            "arrival_spread_s": last.get("spread", 0.0),
             "final_translation_error_um": (1e6 * pose_diff[:3]).round(4).tolist(),
             "final_rotation_error_urad": (1e6 * pose_diff[3:]).round(4).tolist(),
-            "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist())),
+            "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist() if during.size else [0.0] * 6)),
             "peak_drive_force_N": dict(zip(STRUT_LABELS, np.abs(demanded).max(0).round(1).tolist())),
             "static_drive_force_start_N": dict(zip(STRUT_LABELS, demanded[0].round(1).tolist())),
             "measured_peak_strut_speed_um_s": float(1e6 * np.abs(qd).max()),
             "loop_closure_um": float(1e6 * self.closure_mismatch(log)[window].max()),
         }
+        if several:
+            metrics["moves"] = [{
+                "start_s": float(self.starts[i]), "synchronous": bool(m.synchronous),
+                "target_pose_mm_deg": [*(1e3 * m.target_pose[:3]).round(6).tolist(), *np.degrees(m.target_pose[3:]).round(6).tolist()],
+                "arrived": j["arrived"],
+                "move_duration_s": j.get("move_end"), "arrival_spread_s": j.get("spread"),
+                "arrival_vs_own_time_s": None if m.synchronous else j.get("late"),
+                "following_error_um": float(j["following"].max()) if "following" in j else None,
+                "pose_error_um": j.get("pose_error") if j["ended"] else None,
+            } for i, (m, j) in enumerate(zip(self.moves, judged))]
         if self.wind is not None and self.wind.speed is not None:
             n = log.t.size
             metrics["wind_mean_m_s"] = self.wind.mean_speed
@@ -464,13 +546,22 @@ class HexapodEvaluation:
             "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, :6], q, qd),
             "drive_force_limit": p.force_limit,
             "pose_actual": p.poses_from_qpos(log.qpos),
-            "target_pose": np.asarray(self.problem.target_pose),
-            "pivot_error_um": self.pivot_errors_um(log, self.problem.target_pose),
+            "target_pose": (np.asarray(self.moves[0].target_pose) if len(self.moves) == 1
+                            else np.array([m.target_pose for m in self.moves])),
+            "move_start": self.starts,
+            "pivot_error_um": self._pivot_errors_per_move(log),
         }
         if self.wind is not None and self.wind.speed is not None:
             out["wind_speed"] = self.wind.speed[: log.t.size]
             out["wind_force"] = self.wind.force[: log.t.size]
         return out
+
+    def _pivot_errors_per_move(self, log: RunLog) -> np.ndarray:
+        if len(self.moves) == 1:
+            return self.pivot_errors_um(log, self.moves[0].target_pose)
+        poses = self.physics.poses_from_qpos(log.qpos)
+        wanted = hexapod_planner.pivot_positions(self.targets(log.t))
+        return 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(poses) - wanted, axis=-1).max(axis=-1)
 
     def report(self, log: RunLog, checks, path) -> None:
         from sims.hexapod.report import hexapod_report
@@ -498,15 +589,47 @@ def camera_area(physics: HexapodPhysics):
     return area
 
 
-def problem(synchronous: bool) -> hexapod_planner.MoveProblem:
-    """The scenario's move: from the zero pose to SYNC_TARGET (or ASYNC_TARGET)."""
-    target = SYNC_TARGET if synchronous else ASYNC_TARGET
-    return hexapod_planner.MoveProblem(np.zeros(6), target, synchronous)
+def pose_si(pose_mm_deg) -> np.ndarray:
+    """A pose in the parameters' units (x, y, z mm; rx, ry, rz deg) in m and rad."""
+    pose = np.asarray(pose_mm_deg, dtype=float)
+    return np.concatenate([pose[:3] / 1000.0, np.radians(pose[3:])])
 
 
-def plan(synchronous: bool):
-    """The scenario's move as the paper's generator plans it (``planbench plan``)."""
-    return hexapod_planner.PaperMovePlanner().plan(problem(synchronous))
+SYNC_TARGET = pose_si(SYNC_TARGET_MM_DEG)
+ASYNC_TARGET = pose_si(ASYNC_TARGET_MM_DEG)
+
+
+def pose_mm_deg(pose_si) -> tuple:
+    pose = np.asarray(pose_si, dtype=float)
+    return tuple(float(v) for v in np.concatenate([pose[:3] * 1000.0, np.degrees(pose[3:])]))
+
+
+def problems(params: "HexapodParams") -> list[hexapod_planner.MoveProblem]:
+    """The run's moves, each from the pose the one before reached (the first from the start)."""
+    out, pose = [], pose_si(params.start_pose)
+    for move in params.moves:
+        target = pose_si(move.target)
+        out.append(hexapod_planner.MoveProblem(pose, target, move.synchronous))
+        pose = target
+    return out
+
+
+def plan_moves(params: "HexapodParams", planner=None):
+    """(trajectory, moves, starts, durations): every move planned by ``planner`` (default the
+    paper's generator), each starting ``params.dwell`` s after the one before ended; one move
+    is its own trajectory."""
+    planner = hexapod_planner.PaperMovePlanner() if planner is None else planner
+    moves = problems(params)
+    pieces = [plan_checked(planner, move, STRUT_LABELS) for move in moves]
+    durations = [piece.duration for piece in pieces]
+    starts = np.concatenate([[0.0], np.cumsum([d + params.dwell for d in durations[:-1]])])
+    trajectory = pieces[0] if len(pieces) == 1 else PiecewiseTrajectory(pieces, starts)
+    return trajectory, moves, starts, durations
+
+
+def plan(params: "HexapodParams"):
+    """The run's moves as the paper's generator plans them (``planbench plan``)."""
+    return plan_moves(params)[0]
 
 
 def log_bytes_per_tick(wind: bool = True) -> float:
@@ -515,19 +638,6 @@ def log_bytes_per_tick(wind: bool = True) -> float:
     doubles) and, with wind, its speed and force (1 + 3)."""
     model = _compiled(DEFAULT_ELEVATION_DEG)  # every elevation has the same sizes
     return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6 + (4 if wind else 0))
-
-
-def validate(options, default_duration: float | None = None) -> None:
-    """Bad input of a hexapod run as a ValueError subclass naming the value and the limit,
-    before anything is built: the elevation (ELEVATION_RANGE_DEG), the mean wind
-    (sims.wind.check_mean_speed) and the duration (at least one control tick, its log within
-    the memory limit; ``default_duration`` when ``options.duration`` is None, unchecked if
-    both are None)."""
-    if options.elevation is not None:
-        check_elevation(options.elevation)
-    wind = DEFAULT_WIND_M_S if options.wind is None else check_mean_speed(options.wind)
-    duration = options.duration if options.duration is not None else default_duration
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(wind > 0))
 
 
 def sensors(physics: HexapodPhysics) -> JointEncoders:
@@ -539,30 +649,28 @@ def sensors(physics: HexapodPhysics) -> JointEncoders:
                          "strut encoders (length change from the zero pose)", "m", CONTROL_DT)
 
 
-def build(move: hexapod_planner.MoveProblem, options, planner=None, controller=None) -> Setup:
-    """A hexapod run of ``move``: ``planner`` (default the paper's generator) plans it,
-    ``controller`` (default ``HexapodController()``) follows it; the checks judge the target
-    pose and the limits on the trajectory the planner returned."""
-    planner = hexapod_planner.PaperMovePlanner() if planner is None else planner
-    trajectory = plan_checked(planner, move, STRUT_LABELS)
-    duration = options.duration if options.duration is not None else trajectory.duration + SETTLE_S
-    validate(options, duration)
-    elevation = DEFAULT_ELEVATION_DEG if options.elevation is None else options.elevation
-    physics = HexapodPhysics.load(elevation)
-    physics.set_pose(move.start_pose)
-    wind_speed = DEFAULT_WIND_M_S if options.wind is None else options.wind
+def build(params: "HexapodParams", planner=None, controller=None) -> Setup:
+    """A hexapod run of the moves: ``planner`` (default the paper's generator) plans each,
+    ``controller`` (default ``HexapodController()``) follows them from the start pose at rest;
+    the checks judge every move's arrival and target pose and the limits on the trajectory the
+    planner returned."""
+    trajectory, moves, starts, durations = plan_moves(params, planner)
+    duration = params.duration if params.duration is not None else trajectory.duration + SETTLE_S
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(params.wind > 0))
+    physics = HexapodPhysics.load(params.elevation)
+    physics.set_pose(moves[0].start_pose)
     wind = None
-    if wind_speed > 0:
-        wind = BodyWindDrag("camera", wind_speed, camera_area(physics), CAMERA_DRAG_COEFFICIENT,
+    if params.wind > 0:
+        wind = BodyWindDrag("camera", params.wind, camera_area(physics), CAMERA_DRAG_COEFFICIENT,
                             WIND_AZIMUTH_DEG)
-    evaluation = HexapodEvaluation(physics, move, trajectory.duration, wind)
+    evaluation = HexapodEvaluation(physics, moves, starts, durations, wind)
     return Setup(
         physics=physics,
         trajectory=trajectory,
         controller=controller if controller is not None else HexapodController(),
         sensors=sensors(physics),
-        problem=move,
-        planner=planner,
+        problem=moves[0] if len(moves) == 1 else tuple(moves),
+        planner=planner if planner is not None else hexapod_planner.PaperMovePlanner(),
         control_dt=CONTROL_DT,
         duration=duration,
         evaluate=evaluation,
@@ -570,18 +678,10 @@ def build(move: hexapod_planner.MoveProblem, options, planner=None, controller=N
         report=evaluation.report,
         disturbance=wind,
         video_speed=1.0,
-        seed=options.seed,
+        seed=params.seed,
         video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
         video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)",
     )
-
-
-def build_sync(options, planner=None, controller=None) -> Setup:
-    return build(problem(True), options, planner, controller)
-
-
-def build_async(options, planner=None, controller=None) -> Setup:
-    return build(problem(False), options, planner, controller)
 
 
 def strut_kinds() -> list[str]:
@@ -592,21 +692,79 @@ def strut_kinds() -> list[str]:
 
 from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
 
-_RUN = dict(options=frozenset({"wind", "elevation"}), kinds=strut_kinds, control_dt=CONTROL_DT, validate=validate)
+_POSE_UNITS = ("mm", "mm", "mm", "deg", "deg", "deg")
+_POSE_LOW = pose_mm_deg(RUBIN_LIMITS.pose_lower)
+_POSE_HIGH = pose_mm_deg(RUBIN_LIMITS.pose_upper)
+_POSE_REASON = "Rubin's pose limits per axis (REFERENCE.md); the struts' stroke is checked too"
+
+
+@dataclass(frozen=True)
+class HexapodMove(Params):
+    """One move of a hexapod run."""
+
+    target: tuple[float, ...] = param(
+        (0.0,) * 6, "target pose x, y, z (mm), rx, ry, rz (deg) of the mirror-side pivot frame",
+        unit=_POSE_UNITS, low=_POSE_LOW, high=_POSE_HIGH, reason=_POSE_REASON, length=6)
+    synchronous: bool = param(True, "all six struts arrive on the same tick (false: each at its own minimum time)")
+
+    def check(self) -> None:
+        _check_pose(self.target, "target")
+
+
+def _check_pose(pose, key: str) -> None:
+    si = pose_si(pose)
+    try:
+        hexapod_planner.check_pose_limits(si, what=key)
+        hexapod_planner.check_stroke(hexapod_planner.strut_positions(np.atleast_2d(si)), what=key)
+    except LimitError as e:
+        raise ParamError(str(e)) from None
+
+
+@dataclass(frozen=True)
+class HexapodParams(ScenarioParams):
+    """A hexapod run: moves one after another from a start pose, at an elevation, in wind."""
+
+    start_pose: tuple[float, ...] = param(
+        (0.0,) * 6, "start pose x, y, z (mm), rx, ry, rz (deg); the hexapod starts there at rest",
+        unit=_POSE_UNITS, low=_POSE_LOW, high=_POSE_HIGH, reason=_POSE_REASON, length=6)
+    moves: tuple[HexapodMove, ...] = param(
+        (HexapodMove(),), "the moves, one after another: [[moves]] tables of target and synchronous",
+        min_items=1, max_items=100, reason="at least one move; a hundred fill a night")
+    dwell: float = param(SETTLE_S, "time from one move's end to the next move's start", "s", low=SETTLE_S,
+                         high=600.0, reason="each arrival is judged after the integral action's 1 s of settling")
+    elevation: float = param(DEFAULT_ELEVATION_DEG, "telescope elevation: gravity's direction in the hexapod frame",
+                             "deg", low=ELEVATION_RANGE_DEG[0], high=ELEVATION_RANGE_DEG[1],
+                             reason="the telescope's elevation range")
+    wind: float = param(DEFAULT_WIND_M_S, "mean wind on the camera (Kaimal turbulence), 0 for none", "m/s",
+                        low=0.0, high=MAX_MEAN_SPEED_M_S,
+                        reason="IEC 61400-1 class I reference speed, the Kaimal model's range")
+    duration: float | None = param(None, "simulated time; none: the moves plus 1 s of settling", "s",
+                                   low=CONTROL_DT, reason="at least one control tick (5 ms)")
+
+    def check(self) -> None:
+        _check_pose(self.start_pose, "start_pose")
+        previous = self.start_pose
+        for i, move in enumerate(self.moves):
+            if np.array_equal(move.target, previous):
+                raise ParamError(f"moves[{i}].target equals the pose before it: a move of zero length")
+            previous = move.target
+        if self.duration is not None:
+            run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.wind > 0))
+
+
+_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT)
 
 SCENARIOS = (
     Scenario(
         "hexapod-sync-move",
-        "Rubin camera hexapod, 3 t camera: synchronous move of ~2 mm and 0.1 deg, all six struts arrive on one tick (--elevation, --wind)",
-        build_sync,
-        lambda: plan(True),
+        "Rubin camera hexapod, 3 t camera: synchronous move of ~2 mm and 0.1 deg, all six struts arrive on one tick",
+        HexapodParams(moves=(HexapodMove(SYNC_TARGET_MM_DEG, True),)),
         **_RUN,
     ),
     Scenario(
         "hexapod-async-move",
-        "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at its own minimum time (--elevation, --wind)",
-        build_async,
-        lambda: plan(False),
+        "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at its own minimum time",
+        HexapodParams(moves=(HexapodMove(ASYNC_TARGET_MM_DEG, False),)),
         **_RUN,
     ),
 )

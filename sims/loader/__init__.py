@@ -9,7 +9,9 @@ Scenarios:
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
@@ -21,6 +23,7 @@ from sims.checks import Check
 from sims.loader.collision import clearance, geoms_by_contype, obstacle_contact_pairs
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
+from sims.params import ScenarioParams, param
 from sims.task import JointEncoders, plan_checked
 
 #: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
@@ -41,10 +44,27 @@ class LoaderPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/loader/scene.xml with readable accessors."""
 
     @classmethod
-    def load(cls) -> "LoaderPhysics":
-        physics = cls.from_xml_path(str(models.scene_path("loader")))
+    def load(cls, payload_mass: float = None) -> "LoaderPhysics":
+        """The scene at its home keyframe; ``payload_mass`` (kg, None: the model's 45 kg) scales
+        the shell's geoms' masses, so its inertia scales with them (same shape and density
+        distribution), edited with MjSpec before compiling."""
+        if payload_mass is None or payload_mass == shell_mass():
+            physics = cls.from_xml_path(str(models.scene_path("loader")))
+        else:
+            spec = mujoco.MjSpec.from_file(str(models.scene_path("loader")))
+            factor = payload_mass / shell_mass()
+            for geom in spec.body("shell").find_all(mujoco.mjtObj.mjOBJ_GEOM):
+                geom.mass = geom.mass * factor
+            physics = cls.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
         physics.reset(keyframe_id=0)
         return physics
+
+    def set_start(self, q: np.ndarray) -> None:
+        """Joints and the drives' set-points at ``q`` (theta1 m, theta2 ... theta6 rad), at rest."""
+        self.named.data.qpos[self.joint_names] = q
+        self.named.data.qvel[self.joint_names] = 0.0
+        self.data.act[:] = q
+        self.forward()
 
     @property
     def joint_names(self) -> list[str]:
@@ -87,6 +107,13 @@ class LoaderPhysics(dm_mujoco.Physics):
 
 def joint_kinds() -> list[str]:
     return [j.kind for j in models.loader_spec().joints]
+
+
+@functools.lru_cache(maxsize=1)
+def shell_mass() -> float:
+    """The model's shell (the payload body ``shell``), kg."""
+    model = models.load("loader")
+    return float(model.body_mass[model.body("shell").id])
 
 
 def _joint_dofs(physics: LoaderPhysics) -> np.ndarray:
@@ -204,15 +231,6 @@ def log_bytes_per_tick() -> float:
     return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6)
 
 
-def validate(options, default_duration: float | None = None) -> None:
-    """Bad input of a loader run as a ValueError subclass naming the value and the limit,
-    before anything is built: the duration (at least one control tick, its log within the
-    memory limit; ``default_duration`` when ``options.duration`` is None, unchecked if both
-    are None)."""
-    duration = options.duration if options.duration is not None else default_duration
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
-
-
 def sensors(physics: LoaderPhysics) -> JointEncoders:
     """The loader's sensors: the drives' encoders on theta1 ... theta6, exact, every tick
     (no encoder figures are published for it; an assumption, README.md)."""
@@ -230,22 +248,38 @@ def reference_controller() -> ServoFeedforwardController:
     return ServoFeedforwardController(spec.kp, spec.kv)
 
 
-def build(problem: loader_planner.LoaderProblem, options, planner=None, controller=None) -> Setup:
-    """A loader run: ``planner`` (default the paper's cubic B-spline) plans ``problem``,
-    ``controller`` (default ``reference_controller()``) follows it; the checks judge the
-    problem's key points, the obstacles and the drive limits."""
+def problem(params: "LoaderParams") -> loader_planner.LoaderProblem:
+    """The run's planning problem: the key points at uniform times, the model's limits."""
+    points = loader_planner.table1_to_si(np.array(params.key_points))
+    times = np.arange(len(points)) * params.key_interval
+    spec = models.loader_spec()
+    return loader_planner.LoaderProblem(times, points, tuple(spec.names), spec.lower, spec.upper,
+                                        spec.rate_limit, spec.force_limit)
+
+
+def plan(params: "LoaderParams"):
+    """The paper's cubic B-spline through the run's key points (``planbench plan``)."""
+    return loader_planner.CubicBSplinePlanner().plan(problem(params))
+
+
+def build(params: "LoaderParams", planner=None, controller=None) -> Setup:
+    """A loader run: ``planner`` (default the paper's cubic B-spline) plans the key points,
+    ``controller`` (default ``reference_controller()``) follows it from the first key point, at
+    rest; the checks judge the key points, the obstacles and the drive limits."""
+    task = problem(params)
     planner = loader_planner.CubicBSplinePlanner() if planner is None else planner
-    trajectory = plan_checked(planner, problem, problem.labels)
-    duration = options.duration if options.duration is not None else trajectory.duration + SETTLE_S
-    validate(options, duration)
-    physics = LoaderPhysics.load()
-    evaluation = LoaderEvaluation(physics, problem.key_times, problem.key_points)
+    trajectory = plan_checked(planner, task, task.labels)
+    duration = params.duration if params.duration is not None else trajectory.duration + params.settle
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
+    physics = LoaderPhysics.load(params.payload_mass)
+    physics.set_start(task.key_points[0])
+    evaluation = LoaderEvaluation(physics, task.key_times, task.key_points)
     return Setup(
         physics=physics,
         trajectory=trajectory,
         controller=reference_controller() if controller is None else controller,
         sensors=sensors(physics),
-        problem=problem,
+        problem=task,
         planner=planner,
         control_dt=CONTROL_DT,
         duration=duration,
@@ -253,38 +287,63 @@ def build(problem: loader_planner.LoaderProblem, options, planner=None, controll
         timeseries=evaluation.timeseries,
         report=evaluation.report,
         video_speed=1.0,
-        seed=options.seed,
+        seed=params.seed,
     )
 
 
-def build_supply(options, planner=None, controller=None) -> Setup:
-    return build(loader_planner.supply_problem(), options, planner, controller)
+# ----------------------------------------------------------------------------- parameters
+
+_JOINTS = models.loader_spec()
+#: Each key point column's range in Table 1's units (mm, deg): the model's joint ranges.
+_KEY_LOW = tuple(float(v) for v in loader_planner.si_to_table1(_JOINTS.lower))
+_KEY_HIGH = tuple(float(v) for v in loader_planner.si_to_table1(_JOINTS.upper))
 
 
-def build_direct(options, planner=None, controller=None) -> Setup:
-    # The key points checked are the endpoints; M1 ... M4 are not in this problem.
-    return build(loader_planner.direct_problem(), options, planner, controller)
+@dataclass(frozen=True)
+class LoaderParams(ScenarioParams):
+    """A loader run: key points through the cubic B-spline, the payload, the run's length."""
+
+    key_points: tuple[tuple[float, ...], ...] = param(
+        tuple(tuple(float(v) for v in row) for row in loader_planner.TABLE1),
+        "key points, one row per point: theta1 (mm), theta2 ... theta6 (deg), as Table 1; the "
+        "first is the start pose", unit=("mm", "deg", "deg", "deg", "deg", "deg"), low=_KEY_LOW, high=_KEY_HIGH,
+        reason="the joint ranges of models/loader/loader.xml", length=6, min_items=2, max_items=200)
+    key_interval: float = param(0.5, "time from one key point to the next (uniform, as Table 1)", "s",
+                                low=CONTROL_DT, high=60.0,
+                                reason="at least one control tick; a minute is longer than any loading stroke")
+    settle: float = param(SETTLE_S, "time simulated after the last key point, so the arrival is seen at rest",
+                          "s", low=0.0, high=60.0, reason="the drives settle in well under a second")
+    payload_mass: float = param(45.0, "mass of the shell in the gripper (its inertia scales with it)", "kg",
+                                low=0.0, high=90.0,
+                                reason="none to twice the 45 kg 155 mm shell the drives are sized for "
+                                       "(models/loader/README.md)")
+    duration: float | None = param(None, "simulated time; none: the key points' span plus the settle time",
+                                   "s", low=CONTROL_DT, reason="at least one control tick (5 ms)")
+
+    def check(self) -> None:
+        duration = self.duration if self.duration is not None else \
+            (len(self.key_points) - 1) * self.key_interval + self.settle
+        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
 
 
 # ----------------------------------------------------------------------------- registry
 
 from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
 
-_RUN = dict(kinds=joint_kinds, control_dt=CONTROL_DT, validate=validate)
+_RUN = dict(build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT)
 
 SCENARIOS = (
     Scenario(
         "loader-supply",
         "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the breechblock and seat ring",
-        build_supply,
-        lambda: loader_planner.supply_plan(),
+        LoaderParams(),
         **_RUN,
     ),
     Scenario(
         "loader-direct",
         "PRR-3R loader: P2 to P3 as a straight joint-space move in the same 2.5 s; strikes the obstacles (expected to fail)",
-        build_direct,
-        lambda: loader_planner.direct_plan(),
+        # The key points checked are the endpoints; M1 ... M4 are not in this problem.
+        LoaderParams(key_points=LoaderParams().key_points[::5], key_interval=2.5),
         expect_pass=False,
         **_RUN,
     ),

@@ -1,0 +1,430 @@
+"""Typed scenario parameters, declared once (ARCHITECTURE.md, "Typed scenario parameters").
+
+Each scenario's parameters are one frozen dataclass, a subclass of ``Params``. Every field is
+declared with ``param``: its default, unit, valid range and the reason for the range, and a
+one-line help. The declaration is the only place a parameter exists. The rest is derived from it:
+  * validation: ``Params.__post_init__`` converts and checks every field, then the class's
+    own ``check`` (limits between fields: a sea no sea has, a source that sets during the run);
+  * ``planbench run NAME --help``, the CLI's flags and ``--set KEY=VALUE`` (sims/cli.py);
+  * scenario files (TOML, ``from_mapping``) and the resolved parameters in summary.json
+    (``to_dict``), from which a run is repeated;
+  * the README's parameter tables (``markdown_table``; a test keeps them equal).
+
+Values are SI-like in the units each field states (deg for angles, as users write them).
+Vectors and tables are tuples (the dataclass stays frozen and hashable); a list of moves is a
+tuple of a nested ``Params`` class. Every error is a ``ParamError`` naming the key, the value
+and the range: exit 2 and one line on the command line.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+import types
+import typing
+from dataclasses import dataclass, field
+from typing import Any
+
+from planners.errors import LimitError
+
+
+class ParamError(LimitError):
+    """A parameter that is unknown, of the wrong type or outside its range."""
+
+
+def override(cls, name: str, default):
+    """The field ``name`` of the Params class ``cls`` with another default, for a subclass
+    (a scenario's own default of a shared declaration)."""
+    return field(default=default, metadata=cls.__dataclass_fields__[name].metadata)
+
+
+@dataclass(frozen=True)
+class Declared:
+    """What ``param`` declares about a field (``dataclasses.Field.metadata["declared"]``).
+
+    Attributes:
+      help: one line.
+      unit: "m", "deg", "s", "m/s", "Hz", ... ("" for numbers without unit, names, switches).
+      low, high: inclusive range of a number, or of every element of a vector (a tuple gives
+        one bound per column of a table); None: unbounded on that side.
+      reason: why the range is what it is (a stroke, a standard, the model's validity).
+      choices: the allowed values of a name.
+      length: exact number of elements of a vector, or of each row of a table.
+      min_items, max_items: number of elements (rows) of a list (table).
+      excludes: fields that this one replaces when a user sets it and not them (the satellite
+        by orbital longitude or by look angles: setting one clears the other).
+      path: the value is a file name.
+    """
+
+    help: str
+    unit: Any = ""
+    low: Any = None
+    high: Any = None
+    reason: str = ""
+    choices: tuple | None = None
+    length: int | None = None
+    min_items: int | None = None
+    max_items: int | None = None
+    excludes: tuple = ()
+    path: bool = False
+
+
+def param(default, help: str, unit="", low=None, high=None, reason: str = "", choices=None,
+          length: int | None = None, min_items: int | None = None, max_items: int | None = None,
+          excludes: tuple = (), path: bool = False):
+    """A declared field of a ``Params`` dataclass (see ``Declared``; ``path``: a file name,
+    which a scenario file's relative value names from the file's own directory)."""
+    declared = Declared(help, unit, low, high, reason, None if choices is None else tuple(choices), length,
+                        min_items, max_items, tuple(excludes), path)
+    return field(default=default, metadata={"declared": declared})
+
+
+def _format(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, str):
+        return repr(value)
+    if isinstance(value, tuple):
+        return "[" + ", ".join(_format(v) for v in value) + "]"
+    if dataclasses.is_dataclass(value):
+        return "{" + ", ".join(f"{k} = {_format(v)}" for k, v in value.to_dict().items()) + "}"
+    return str(value)
+
+
+def _bound(bound, column: int | None):
+    if isinstance(bound, tuple):
+        return None if column is None else bound[column]
+    return bound
+
+
+def range_text(declared: Declared, column: int | None = None) -> str:
+    """"[lo, hi] unit", "one of a, b", "" for the help and the errors."""
+    if declared.choices is not None:
+        return "one of " + ", ".join(str(c) for c in declared.choices)
+    low, high = _bound(declared.low, column), _bound(declared.high, column)
+    if isinstance(declared.low, tuple) and column is None:
+        units = declared.unit if isinstance(declared.unit, tuple) else (declared.unit,) * len(declared.low)
+        return "per column " + ", ".join(
+            f"[{_g(lo)}, {_g(hi)}]" + (f" {u}" if u else "") for lo, hi, u in zip(declared.low, declared.high, units))
+    if low is None and high is None:
+        return ""
+    unit = f" {unit_of(declared, column)}" if unit_of(declared, column) else ""
+    return f"[{_g(low)}, {_g(high)}]{unit}"
+
+
+def _g(bound) -> str:
+    if bound is None:
+        return "..."
+    return str(bound) if isinstance(bound, int) else f"{bound:g}"
+
+
+class _Type:
+    """One field's annotation, parsed: kind in bool, int, float, str, nested (a Params
+    class), vector (of ``item``), with ``optional``."""
+
+    def __init__(self, annotation):
+        self.optional = False
+        args = typing.get_args(annotation)
+        origin = typing.get_origin(annotation)
+        if origin in (typing.Union, types.UnionType):
+            rest = [a for a in args if a is not type(None)]
+            if len(rest) != 1:
+                raise TypeError(f"unsupported parameter type {annotation!r}")
+            self.optional = True
+            annotation = rest[0]
+            args, origin = typing.get_args(annotation), typing.get_origin(annotation)
+        if origin is tuple:
+            self.kind, self.item = "vector", _Type(args[0])
+        elif annotation in (bool, int, float, str):
+            self.kind, self.item = annotation.__name__, None
+        elif isinstance(annotation, type) and issubclass(annotation, Params):
+            self.kind, self.item, self.cls = "nested", None, annotation
+        else:
+            raise TypeError(f"unsupported parameter type {annotation!r}")
+
+    @property
+    def scalar(self) -> bool:
+        return self.kind in ("bool", "int", "float", "str")
+
+    def name(self) -> str:
+        if self.kind == "vector":
+            inner = self.item.name()
+            return f"list of {inner}" if self.item.kind != "vector" else f"table ({inner.replace('list of ', '')} rows)"
+        if self.kind == "nested":
+            return f"table {self.cls.__name__}"
+        return {"float": "number", "int": "integer", "bool": "true/false", "str": "name"}[self.kind]
+
+
+@typing.no_type_check
+def _convert(kind: _Type, value, key: str, declared: Declared, column: int | None = None):
+    if value is None:
+        if kind.optional:
+            return None
+        raise ParamError(f"{key} must be given ({kind.name()})")
+    if kind.kind == "bool":
+        if isinstance(value, bool):
+            return value
+        raise ParamError(f"{key} = {value!r} is not true or false")
+    if kind.kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            if isinstance(value, float) and value.is_integer():
+                value = int(value)
+            else:
+                raise ParamError(f"{key} = {value!r} is not an integer")
+        return _in_range(int(value), key, declared, column)
+    if kind.kind == "float":
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ParamError(f"{key} = {value!r} is not a number")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ParamError(f"{key} = {value} is not finite")
+        return _in_range(value, key, declared, column)
+    if kind.kind == "str":
+        if not isinstance(value, str):
+            raise ParamError(f"{key} = {value!r} is not a name (a string)")
+        if declared.choices is not None and value not in declared.choices:
+            raise ParamError(f"{key} = {value!r} is not {range_text(declared)}")
+        return value
+    if kind.kind == "nested":
+        if isinstance(value, kind.cls):
+            return value
+        if not isinstance(value, dict):
+            raise ParamError(f"{key} = {value!r} is not a table of {', '.join(kind.cls.names())}")
+        return kind.cls.from_mapping(value, prefix=f"{key}.")
+    # vector
+    if isinstance(value, (str, bytes, dict)) or not isinstance(value, (list, tuple)):
+        raise ParamError(f"{key} = {value!r} is not a list")
+    items = list(value)
+    nested = kind.item.kind == "vector"
+    if not nested and kind.item.kind != "nested" and declared.length is not None and len(items) != declared.length:
+        raise ParamError(f"{key} has {len(items)} values, not {declared.length}")
+    if (nested or kind.item.kind == "nested") or declared.length is None:
+        if declared.min_items is not None and len(items) < declared.min_items:
+            raise ParamError(f"{key} has {len(items)} {'rows' if nested else 'items'}, fewer than "
+                             f"{declared.min_items}{': ' + declared.reason if declared.reason and not nested else ''}")
+        if declared.max_items is not None and len(items) > declared.max_items:
+            raise ParamError(f"{key} has {len(items)} {'rows' if nested else 'items'}, more than {declared.max_items}")
+    out = []
+    for i, item in enumerate(items):
+        if nested:
+            if isinstance(item, (str, bytes, dict)) or not isinstance(item, (list, tuple)):
+                raise ParamError(f"{key}[{i}] = {item!r} is not a row (a list)")
+            if declared.length is not None and len(item) != declared.length:
+                raise ParamError(f"{key}[{i}] has {len(item)} values, not {declared.length}")
+            out.append(tuple(_convert(kind.item.item, v, f"{key}[{i}][{j}]", declared, j) for j, v in enumerate(item)))
+        else:
+            col = i if isinstance(declared.low, tuple) else None
+            out.append(_convert(kind.item, item, f"{key}[{i}]", declared, col))
+    return tuple(out)
+
+
+def unit_of(declared: Declared, column: int | None = None) -> str:
+    """The unit of a field, or of one column of a table whose columns differ (a pose: mm and deg)."""
+    if isinstance(declared.unit, tuple):
+        return "/".join(declared.unit) if column is None else declared.unit[column]
+    return declared.unit
+
+
+def _in_range(value, key: str, declared: Declared, column: int | None):
+    low, high = _bound(declared.low, column), _bound(declared.high, column)
+    if (low is not None and value < low) or (high is not None and value > high):
+        unit = f" {unit_of(declared, column)}" if unit_of(declared, column) else ""
+        reason = f": {declared.reason}" if declared.reason else ""
+        raise ParamError(f"{key} = {value:g}{unit} is outside [{_g(low)}, {_g(high)}]{unit}{reason}")
+    return value
+
+
+@dataclass(frozen=True)
+class Params:
+    """Typed, ranged, validated fields (a scenario's, or a row of a list such as a move).
+
+    Every subclass is a frozen dataclass whose fields are all ``param``s. Construction converts
+    and checks every field (a ParamError names the first bad one), then calls ``check`` for the
+    limits between fields.
+    """
+
+    def __post_init__(self):
+        hints = _hints(type(self))
+        for f in dataclasses.fields(self):
+            declared = f.metadata.get("declared")
+            if declared is None:
+                raise TypeError(f"{type(self).__name__}.{f.name} is not declared with sims.params.param")
+            object.__setattr__(self, f.name, _convert(hints[f.name], getattr(self, f.name), f.name, declared))
+        self.check()
+
+    def check(self) -> None:
+        """Limits between fields (and ones that need computing): a ParamError naming the key,
+        the value and the limit. Subclasses extend it."""
+
+    # ------------------------------------------------------------------ declarations
+
+    @classmethod
+    def names(cls) -> list[str]:
+        return [f.name for f in dataclasses.fields(cls)]
+
+    @classmethod
+    def declarations(cls) -> list[tuple[str, _Type, Declared, Any]]:
+        """(name, type, declaration, default) of every field, in order."""
+        hints = _hints(cls)
+        out = []
+        for f in dataclasses.fields(cls):
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            out.append((f.name, hints[f.name], f.metadata["declared"], default))
+        return out
+
+    # ------------------------------------------------------------------ values
+
+    def to_dict(self) -> dict:
+        """Every field, JSON- and TOML-ready (tuples as lists, nested tables as dicts; None
+        stays None in JSON and is left out of TOML)."""
+        def plain(v):
+            if isinstance(v, Params):
+                return v.to_dict()
+            if isinstance(v, tuple):
+                return [plain(x) for x in v]
+            return v
+        return {f.name: plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
+
+    @classmethod
+    def from_mapping(cls, mapping: dict, base: "Params | None" = None, prefix: str = "") -> "Params":
+        """``base`` (default: the declared defaults) with the keys of ``mapping`` replaced.
+
+        An unknown key, a value of the wrong type or out of its range is a ParamError naming
+        it. A key whose declaration ``excludes`` others clears them when they are not given too.
+        """
+        if not isinstance(mapping, dict):
+            raise ParamError(f"{prefix.rstrip('.') or 'parameters'} must be a table, got {mapping!r}")
+        names = cls.names()
+        unknown = [k for k in mapping if k not in names]
+        if unknown:
+            raise ParamError(f"unknown parameter '{prefix}{unknown[0]}'; {cls.__name__} has: {', '.join(names)}")
+        values = {} if base is None else {n: getattr(base, n) for n in names}
+        declared = {n: d for n, _, d, _ in cls.declarations()}
+        for key, value in mapping.items():
+            values[key] = value
+            for other in declared[key].excludes:
+                if other not in mapping:
+                    values[other] = None
+        try:
+            return cls(**values)
+        except ParamError as e:
+            if prefix:
+                raise ParamError(f"{prefix}{e}") from None
+            raise
+
+    def replace(self, **changes) -> "Params":
+        """A copy with ``changes`` (as ``from_mapping``: validated, exclusions applied)."""
+        return type(self).from_mapping(changes, base=self)
+
+
+@dataclass(frozen=True)
+class ScenarioParams(Params):
+    """The parameters of a run: the seed, then each mechanism's and scenario's fields."""
+
+    seed: int = param(0, "seed of every random process of the run (disturbances, noise)", low=0,
+                      high=2**63 - 1, reason="numpy's SeedSequence takes non-negative 64-bit integers")
+
+
+@typing.no_type_check
+def _hints(cls) -> dict:
+    cache = cls.__dict__.get("_parsed_hints")
+    if cache is None:
+        cache = {name: _Type(t) for name, t in typing.get_type_hints(cls).items() if not name.startswith("_")}
+        setattr(cls, "_parsed_hints", cache)
+    return cache
+
+
+# ---------------------------------------------------------------------- text forms
+
+
+def parse_value(kind: _Type, text: str):
+    """A command-line value: TOML's syntax for numbers, booleans, lists and tables
+    (``--set moves=[{target=[1,0,0,0,0,0]}]``); on/off, yes/no for switches; "none" for an
+    optional value; anything else as a name."""
+    stripped = text.strip()
+    if kind.optional and stripped.lower() in ("none", "null", ""):
+        return None
+    if kind.kind == "bool" and stripped.lower() in ("on", "off", "yes", "no", "true", "false", "1", "0"):
+        return stripped.lower() in ("on", "yes", "true", "1")
+    if kind.kind == "str":
+        try:
+            value = tomllib.loads(f"v = {stripped}")["v"]
+            return value if isinstance(value, str) else stripped
+        except tomllib.TOMLDecodeError:
+            return stripped
+    try:
+        return tomllib.loads(f"v = {stripped}")["v"]
+    except tomllib.TOMLDecodeError:
+        # Python's spellings of numbers TOML lacks (1e3 is TOML; .5, 5., inf are not).
+        try:
+            return float(stripped)
+        except ValueError:
+            return stripped
+
+
+def set_overrides(cls: type[Params], assignments: list[str]) -> dict:
+    """``--set KEY=VALUE`` (repeatable) as a mapping for ``from_mapping``."""
+    hints = _hints(cls)
+    out = {}
+    for text in assignments:
+        key, sep, value = text.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ParamError(f"--set {text!r} is not KEY=VALUE")
+        if key not in hints:
+            raise ParamError(f"--set: unknown parameter {key!r}; {cls.__name__} has: {', '.join(cls.names())}")
+        out[key] = parse_value(hints[key], value)
+    return out
+
+
+def describe(name: str, kind: _Type, declared: Declared, default) -> str:
+    """One parameter's line of help: what it is, its unit, default and range."""
+    parts = [declared.help]
+    unit = unit_of(declared)
+    text = f"{kind.name()}" + (f", {unit}" if unit else "")
+    parts.append(f"[{text}; default {_format(default) if default is not None else 'none'}")
+    rng = range_text(declared)
+    if declared.length is not None:
+        rng = (f"{declared.length} values" + (f", {rng}" if rng else ""))
+    if rng:
+        parts[-1] += f"; {rng}"
+    parts[-1] += "]"
+    if declared.reason:
+        parts.append(f"({declared.reason})")
+    return " ".join(parts)
+
+
+def markdown_table(cls: type[Params]) -> str:
+    """The README's table of ``cls``'s parameters: key, unit, default, range, meaning."""
+    lines = ["| key | unit | default | range | meaning |", "|---|---|---|---|---|"]
+    for name, kind, declared, default in cls.declarations():
+        rng = range_text(declared)
+        if declared.length is not None:
+            rng = f"{declared.length} values" + (f", {rng}" if rng else "")
+        meaning = declared.help + (f" ({declared.reason})" if declared.reason else "")
+        default_text = "none" if default is None else _format(default)
+        lines.append(f"| `{name}` | {unit_of(declared)} | `{default_text}` | {rng} | {meaning} |".replace("  ", " "))
+    return "\n".join(lines)
+
+
+def readme_tables() -> str:
+    """The README's parameter tables, one per Params class of the registered scenarios
+    (``python -m sims.params`` prints them; tests/test_scenario_params.py keeps the README equal)."""
+    from sims import scenarios
+
+    by_class = {}
+    for s in [*scenarios.SCENARIOS.values(), *scenarios.PLANS.values()]:
+        by_class.setdefault(type(s.params), []).append(s.name)
+    parts = []
+    for cls, names in by_class.items():
+        nested = [k.cls for _, k, _, _ in cls.declarations() if k.kind == "vector" and k.item.kind == "nested"]
+        parts.append(f"#### `{cls.__name__}`: {', '.join(f'`{n}`' for n in names)}\n\n{markdown_table(cls)}")
+        parts += [f"Each of `{cls.__name__}`'s list items, `{c.__name__}`:\n\n{markdown_table(c)}" for c in nested]
+    return "\n\n".join(parts)
+
+
+if __name__ == "__main__":
+    print(readme_tables())
