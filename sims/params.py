@@ -233,7 +233,7 @@ def _in_range(value, key: str, declared: Declared, column: int | None):
     if (low is not None and value < low) or (high is not None and value > high):
         unit = f" {unit_of(declared, column)}" if unit_of(declared, column) else ""
         reason = f": {declared.reason}" if declared.reason else ""
-        raise ParamError(f"{key} = {value:g}{unit} is outside [{_g(low)}, {_g(high)}]{unit}{reason}")
+        raise ParamError(f"{key} = {_g(value)}{unit} is outside [{_g(low)}, {_g(high)}]{unit}{reason}")
     return value
 
 
@@ -355,6 +355,11 @@ def parse_value(kind: _Type, text: str):
             return value if isinstance(value, str) else stripped
         except tomllib.TOMLDecodeError:
             return stripped
+    if kind.kind == "int":
+        try:
+            return int(stripped)  # beyond TOML's 64 bits too, so the range names the value
+        except ValueError:
+            pass
     try:
         return tomllib.loads(f"v = {stripped}")["v"]
     except tomllib.TOMLDecodeError:
@@ -420,11 +425,13 @@ def readme_tables() -> str:
         by_class.setdefault(type(s.params), []).append(s.name)
     parts = []
     for cls, names in by_class.items():
-        nested = [k.cls for _, k, _, _ in cls.declarations() if k.kind == "vector" and k.item.kind == "nested"]
+        nested = [k.item.cls for _, k, _, _ in cls.declarations() if k.kind == "vector" and k.item.kind == "nested"]
         parts.append(f"#### `{cls.__name__}`: {', '.join(f'`{n}`' for n in names)}\n\n{markdown_table(cls)}")
         parts += [f"Each of `{cls.__name__}`'s list items, `{c.__name__}`:\n\n{markdown_table(c)}" for c in nested]
     return "\n\n".join(parts)
 
 
 if __name__ == "__main__":
-    print(readme_tables())
+    from sims.params import readme_tables as tables  # the module's own classes, not __main__'s
+
+    print(tables())

@@ -154,7 +154,7 @@ def scenario_run(tmp_path_factory, name: str) -> Written:
     # FAST's cable actuators are re-linearized in the run's model every tick: read FAST runs
     # with the compiled model (the same sensors, sites and leg drives).
     model = models.load("fast") if name.startswith("fast") else None
-    return write(tmp_path_factory, name, setup, setup.duration, scenario.plan, model)
+    return write(tmp_path_factory, name, setup, setup.duration, lambda: scenario.plan(scenario.params), model)
 
 
 def scenario_fixture(name: str):
@@ -344,7 +344,7 @@ def hexapod_sync_driven_async(tmp_path_factory):
     user's planner plugged in): the sync scenario's arrival_spread is then not 0 (the struts
     arrive over ~5 s), so a mis-scaled spread shows."""
     setup = scenarios.get("hexapod-sync-move").build(scenarios.get("hexapod-sync-move").resolve(duration=1.0))
-    plan = scenarios.get("hexapod-async-move").plan()
+    plan = scenarios.get("hexapod-async-move").plan(scenarios.get("hexapod-async-move").params)
     setup.trajectory = plan
     setup.duration = plan.duration + 1.0
     return write(tmp_path_factory, "hexapod-sync-driven-async", setup, setup.duration, plan)
@@ -746,7 +746,7 @@ def diverging_loader(tmp_path_factory):
     ``faulty_loader``.)"""
     setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").resolve(duration=0.5))
     setup.physics.model.ptr.opt.gravity[:] = [0.0, 0.0, -1e12]
-    return write(tmp_path_factory, "loader-diverging", setup, setup.duration, scenarios.get("loader-supply").plan())
+    return write(tmp_path_factory, "loader-diverging", setup, setup.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
 
 
 FAULT_TICK = 40
@@ -768,7 +768,7 @@ def faulty_loader(tmp_path_factory):
             inner(tick, observation)
 
     setup.controller = RaisingController()
-    return write(tmp_path_factory, "loader-faulty", setup, setup.duration, scenarios.get("loader-supply").plan())
+    return write(tmp_path_factory, "loader-faulty", setup, setup.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
 
 
 def _replayed_warnings(w: Written) -> int:
