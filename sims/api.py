@@ -61,12 +61,8 @@ def run(scenario: str, *, planner=None, controller=None, params=None,
 
 
 def _run(spec, params, planner, controller, quiet):
-    from sims.cli import resolved_parameters
-
     setup = spec.build(params, planner=planner, controller=controller)
-    result = runner.run(spec.name, setup, quiet=quiet)
-    result.parameters = resolved_parameters(params, setup)
-    return setup, result
+    return setup, runner.run(spec.name, setup, quiet=quiet)
 
 
 def _run_and_write(spec, params, planner, controller, target, video, quiet):

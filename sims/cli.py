@@ -78,7 +78,7 @@ def scenario_parser(command: str, scenario, source: str) -> argparse.ArgumentPar
     epilog = ""
     if other:
         epilog = ("parameters set with --set KEY=VALUE (TOML syntax) or in a scenario file's [parameters]:\n"
-                  + "\n".join(f"  {name}: {describe(name, kind, declared, scenario.params.__dict__[name])}"
+                  + "\n".join(f"  {name}: {describe(kind, declared, getattr(scenario.params, name))}"
                                for name, kind, declared, _ in other))
     parser = _Parser(prog=f"planbench {command} {source}", description=f"{scenario.name}: {scenario.summary}",
                      epilog=epilog, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -91,7 +91,7 @@ def scenario_parser(command: str, scenario, source: str) -> argparse.ArgumentPar
         if declared.choices:
             metavar = "|".join(declared.choices)
         group.add_argument(_flag(name), dest=f"param_{name}", metavar=metavar,
-                           help=describe(name, kind, declared, scenario.params.__dict__[name]).replace("%", "%%"))
+                           help=describe(kind, declared, getattr(scenario.params, name)).replace("%", "%%"))
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="set any parameter (TOML value syntax: --set 'moves=[{target=[1,0,0,0,0,0]}]')")
     if command == "run":
@@ -122,12 +122,11 @@ def _resolve_source(command: str, argv: list[str]):
     from sims import scenarios, scenario_files
     from sims.params import ParamError
 
-    get = scenarios.get if command == "run" else scenarios.get_plan
+    get, names = ((scenarios.get, scenarios.SCENARIOS) if command == "run" else
+                  (scenarios.get_plan, {**scenarios.SCENARIOS, **scenarios.PLANS}))
     try:
-        source = scenario_files.resolve(argv[0], get)
-    except ParamError as e:
-        raise BadInput(str(e)) from None
-    except ValueError as e:
+        source = scenario_files.resolve(argv[0], get, names)
+    except ValueError as e:  # a ParamError, or an unknown scenario name
         raise BadInput(str(e)) from None
     scenario = source.scenario
     args = scenario_parser(command, scenario, argv[0]).parse_args(argv[1:])
@@ -200,8 +199,8 @@ def cmd_run(argv: list[str]) -> int:
     made = {role: plugins_module.make(plugin_spec, role, online_planner=scenario.online_planner)
             for role, plugin_spec in plugins.items()}
     if source.recorded_versions:
-        differ = {k: (v, outputs.software_versions().get(k)) for k, v in source.recorded_versions.items()
-                  if outputs.software_versions().get(k) != v}
+        now = outputs.software_versions()
+        differ = {k: (v, now.get(k)) for k, v in source.recorded_versions.items() if now.get(k) != v}
         if differ:
             print("planbench: note: " + source.origin + " was written with "
                   + ", ".join(f"{k} {old} (now {new})" for k, (old, new) in differ.items())
@@ -215,20 +214,11 @@ def cmd_run(argv: list[str]) -> int:
         setup = scenario.build(params, **made)
         result = runner.run(scenario.name, setup, quiet=args.quiet)
         result.plugins = plugins
-        result.parameters = resolved_parameters(params, setup)
         outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
     print(format_checks([(scenario.name, c) for c in result.checks]))
     print(f"{'PASSED' if result.passed else 'FAILED'}: {scenario.name}, "
           f"{result.sim_time_s:.2f} s simulated in {result.wall_time_s:.2f} s; outputs in {out}")
     return EXIT_OK if result.passed else EXIT_CHECK_FAILED
-
-
-def resolved_parameters(params, setup) -> dict:
-    """Every parameter of the run as it ran: an unset duration is the one the run took."""
-    values = params.to_dict()
-    if values.get("duration", 0) is None:
-        values["duration"] = float(setup.duration)
-    return values
 
 
 def cmd_plan(argv: list[str]) -> int:
@@ -282,7 +272,6 @@ def cmd_demo(args) -> int:
             out = targets[scenario.name]
             setup = scenario.build(scenario.params)
             result = runner.run(scenario.name, setup, quiet=args.quiet)
-            result.parameters = resolved_parameters(scenario.params, setup)
             outputs.write_run(result, setup, out, video=outputs.VideoFile(out.path / f"{scenario.name}.mp4", out),
                               camera=scenario.camera, quiet=args.quiet,
                               more_videos=[(f"{scenario.name}-{c}.mp4", c) for c in scenario.demo_cameras])

@@ -7,7 +7,6 @@ import copy
 import mujoco
 import numpy as np
 
-from planners.trajectory import TrajectorySample
 
 
 class ServoFeedforwardController:

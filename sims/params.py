@@ -55,6 +55,7 @@ class Declared:
       excludes: fields that this one replaces when a user sets it and not them (the satellite
         by orbital longitude or by look angles: setting one clears the other).
       path: the value is a file name.
+      low_open, high_open: the bound is excluded (a scalar's range only).
     """
 
     help: str
@@ -68,15 +69,18 @@ class Declared:
     max_items: int | None = None
     excludes: tuple = ()
     path: bool = False
+    low_open: bool = False
+    high_open: bool = False
 
 
 def param(default, help: str, unit="", low=None, high=None, reason: str = "", choices=None,
           length: int | None = None, min_items: int | None = None, max_items: int | None = None,
-          excludes: tuple = (), path: bool = False):
+          excludes: tuple = (), path: bool = False, low_open: bool = False, high_open: bool = False):
     """A declared field of a ``Params`` dataclass (see ``Declared``; ``path``: a file name,
-    which a scenario file's relative value names from the file's own directory)."""
+    which a scenario file's relative value names from the file's own directory;
+    ``low_open``, ``high_open``: the bound itself is outside, as for a period that must be > 0)."""
     declared = Declared(help, unit, low, high, reason, None if choices is None else tuple(choices), length,
-                        min_items, max_items, tuple(excludes), path)
+                        min_items, max_items, tuple(excludes), path, low_open, high_open)
     return field(default=default, metadata={"declared": declared})
 
 
@@ -112,7 +116,12 @@ def range_text(declared: Declared, column: int | None = None) -> str:
     if low is None and high is None:
         return ""
     unit = f" {unit_of(declared, column)}" if unit_of(declared, column) else ""
-    return f"[{_g(low)}, {_g(high)}]{unit}"
+    return f"{_interval(declared, low, high)}{unit}"
+
+
+def _interval(declared: Declared, low, high) -> str:
+    return (f"{'(' if declared.low_open else '['}{_g(low)}, {_g(high)}"
+            f"{')' if declared.high_open else ']'}")
 
 
 def _g(bound) -> str:
@@ -194,31 +203,36 @@ def _convert(kind: _Type, value, key: str, declared: Declared, column: int | Non
         if not isinstance(value, dict):
             raise ParamError(f"{key} = {value!r} is not a table of {', '.join(kind.cls.names())}")
         return kind.cls.from_mapping(value, prefix=f"{key}.")
-    # vector
-    if isinstance(value, (str, bytes, dict)) or not isinstance(value, (list, tuple)):
-        raise ParamError(f"{key} = {value!r} is not a list")
-    items = list(value)
-    nested = kind.item.kind == "vector"
-    if not nested and kind.item.kind != "nested" and declared.length is not None and len(items) != declared.length:
-        raise ParamError(f"{key} has {len(items)} values, not {declared.length}")
-    if (nested or kind.item.kind == "nested") or declared.length is None:
+    # A list: of numbers (``length`` of them), of names or tables (``min_items`` ...
+    # ``max_items``), or a table of rows (that many rows of ``length`` numbers each).
+    table = kind.item.kind == "vector"
+    items = _as_list(value, key, "a list")
+    if declared.length is not None and not table:
+        if len(items) != declared.length:
+            raise ParamError(f"{key} has {len(items)} values, not {declared.length}")
+    else:
+        noun = "rows" if table else "items"
         if declared.min_items is not None and len(items) < declared.min_items:
-            raise ParamError(f"{key} has {len(items)} {'rows' if nested else 'items'}, fewer than "
-                             f"{declared.min_items}{': ' + declared.reason if declared.reason and not nested else ''}")
+            raise ParamError(f"{key} has {len(items)} {noun}, fewer than {declared.min_items}")
         if declared.max_items is not None and len(items) > declared.max_items:
-            raise ParamError(f"{key} has {len(items)} {'rows' if nested else 'items'}, more than {declared.max_items}")
+            raise ParamError(f"{key} has {len(items)} {noun}, more than {declared.max_items}")
     out = []
     for i, item in enumerate(items):
-        if nested:
-            if isinstance(item, (str, bytes, dict)) or not isinstance(item, (list, tuple)):
-                raise ParamError(f"{key}[{i}] = {item!r} is not a row (a list)")
-            if declared.length is not None and len(item) != declared.length:
-                raise ParamError(f"{key}[{i}] has {len(item)} values, not {declared.length}")
-            out.append(tuple(_convert(kind.item.item, v, f"{key}[{i}][{j}]", declared, j) for j, v in enumerate(item)))
+        name = f"{key}[{i}]"
+        if table:
+            row = _as_list(item, name, "a row (a list)")
+            if declared.length is not None and len(row) != declared.length:
+                raise ParamError(f"{name} has {len(row)} values, not {declared.length}")
+            out.append(tuple(_convert(kind.item.item, v, f"{name}[{j}]", declared, j) for j, v in enumerate(row)))
         else:
-            col = i if isinstance(declared.low, tuple) else None
-            out.append(_convert(kind.item, item, f"{key}[{i}]", declared, col))
+            out.append(_convert(kind.item, item, name, declared, i if isinstance(declared.low, tuple) else None))
     return tuple(out)
+
+
+def _as_list(value, key: str, what: str) -> list:
+    if isinstance(value, (str, bytes, dict)) or not isinstance(value, (list, tuple)):
+        raise ParamError(f"{key} = {value!r} is not {what}")
+    return list(value)
 
 
 def unit_of(declared: Declared, column: int | None = None) -> str:
@@ -230,10 +244,12 @@ def unit_of(declared: Declared, column: int | None = None) -> str:
 
 def _in_range(value, key: str, declared: Declared, column: int | None):
     low, high = _bound(declared.low, column), _bound(declared.high, column)
-    if (low is not None and value < low) or (high is not None and value > high):
+    below = low is not None and (value <= low if declared.low_open else value < low)
+    above = high is not None and (value >= high if declared.high_open else value > high)
+    if below or above:
         unit = f" {unit_of(declared, column)}" if unit_of(declared, column) else ""
         reason = f": {declared.reason}" if declared.reason else ""
-        raise ParamError(f"{key} = {_g(value)}{unit} is outside [{_g(low)}, {_g(high)}]{unit}{reason}")
+        raise ParamError(f"{key} = {_g(value)}{unit} is outside {_interval(declared, low, high)}{unit}{reason}")
     return value
 
 
@@ -247,7 +263,7 @@ class Params:
     """
 
     def __post_init__(self):
-        hints = _hints(type(self))
+        hints = field_types(type(self))
         for f in dataclasses.fields(self):
             declared = f.metadata.get("declared")
             if declared is None:
@@ -268,7 +284,7 @@ class Params:
     @classmethod
     def declarations(cls) -> list[tuple[str, _Type, Declared, Any]]:
         """(name, type, declaration, default) of every field, in order."""
-        hints = _hints(cls)
+        hints = field_types(cls)
         out = []
         for f in dataclasses.fields(cls):
             default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
@@ -329,7 +345,8 @@ class ScenarioParams(Params):
 
 
 @typing.no_type_check
-def _hints(cls) -> dict:
+def field_types(cls) -> dict:
+    """{field name: its parsed type} of a Params class (cached on the class)."""
     cache = cls.__dict__.get("_parsed_hints")
     if cache is None:
         cache = {name: _Type(t) for name, t in typing.get_type_hints(cls).items() if not name.startswith("_")}
@@ -372,7 +389,7 @@ def parse_value(kind: _Type, text: str):
 
 def set_overrides(cls: type[Params], assignments: list[str]) -> dict:
     """``--set KEY=VALUE`` (repeatable) as a mapping for ``from_mapping``."""
-    hints = _hints(cls)
+    hints = field_types(cls)
     out = {}
     for text in assignments:
         key, sep, value = text.partition("=")
@@ -385,18 +402,21 @@ def set_overrides(cls: type[Params], assignments: list[str]) -> dict:
     return out
 
 
-def describe(name: str, kind: _Type, declared: Declared, default) -> str:
+def _range_and_length(declared: Declared) -> str:
+    rng = range_text(declared)
+    if declared.length is None:
+        return rng
+    return f"{declared.length} values" + (f", {rng}" if rng else "")
+
+
+def describe(kind: _Type, declared: Declared, default) -> str:
     """One parameter's line of help: what it is, its unit, default and range."""
     parts = [declared.help]
     unit = unit_of(declared)
     text = f"{kind.name()}" + (f", {unit}" if unit else "")
     parts.append(f"[{text}; default {_format(default) if default is not None else 'none'}")
-    rng = range_text(declared)
-    if declared.length is not None:
-        rng = (f"{declared.length} values" + (f", {rng}" if rng else ""))
-    if rng:
-        parts[-1] += f"; {rng}"
-    parts[-1] += "]"
+    rng = _range_and_length(declared)
+    parts[-1] += (f"; {rng}" if rng else "") + "]"
     if declared.reason:
         parts.append(f"({declared.reason})")
     return " ".join(parts)
@@ -406,9 +426,7 @@ def markdown_table(cls: type[Params]) -> str:
     """The README's table of ``cls``'s parameters: key, unit, default, range, meaning."""
     lines = ["| key | unit | default | range | meaning |", "|---|---|---|---|---|"]
     for name, kind, declared, default in cls.declarations():
-        rng = range_text(declared)
-        if declared.length is not None:
-            rng = f"{declared.length} values" + (f", {rng}" if rng else "")
+        rng = _range_and_length(declared)
         meaning = declared.help + (f" ({declared.reason})" if declared.reason else "")
         default_text = "none" if default is None else _format(default)
         lines.append(f"| `{name}` | {unit_of(declared)} | `{default_text}` | {rng} | {meaning} |".replace("  ", " "))

@@ -19,9 +19,23 @@ from pathlib import Path
 from sims.task import PluginError, _callable_with, check_controller, check_planner
 
 
+def is_file(module_name: str) -> bool:
+    """``MODULE`` of a spec names a .py file (else an importable module)."""
+    return module_name.endswith(".py") or "/" in module_name or "\\" in module_name
+
+
+def split_spec(spec: str, role: str) -> tuple[str, str]:
+    """(MODULE, FACTORY) of ``MODULE:FACTORY``; PluginError otherwise."""
+    module_name, sep, attribute = spec.rpartition(":")
+    if not sep or not module_name or not attribute:
+        raise PluginError(f"--{role} {spec!r} must be MODULE:FACTORY (a module or .py file, a colon, "
+                          "and the callable that makes the object)")
+    return module_name, attribute
+
+
 def _module(name: str, role: str):
     """The module ``name``: a path to a .py file, or an importable module."""
-    if name.endswith(".py") or "/" in name or "\\" in name:
+    if is_file(name):
         path = Path(name).expanduser()
         if not path.is_file():
             raise PluginError(f"--{role} {name}: no such file")
@@ -53,10 +67,7 @@ def _module(name: str, role: str):
 def load_factory(spec: str, role: str):
     """The callable that ``spec`` (``MODULE:FACTORY``) names; PluginError naming what is
     missing otherwise. ``role``: "controller" or "planner" (for the messages)."""
-    module_name, sep, attribute = spec.rpartition(":")
-    if not sep or not module_name or not attribute:
-        raise PluginError(f"--{role} {spec!r} must be MODULE:FACTORY (a module or .py file, a colon, "
-                          "and the callable that makes the object)")
+    module_name, attribute = split_spec(spec, role)
     obj = _module(module_name, role)
     for part in attribute.split("."):
         if not hasattr(obj, part):

@@ -73,6 +73,8 @@ class Setup:
         long runs at a high control rate would otherwise write hundreds of MB.
       nominal_physics: () -> the controller's nominal model at the initial state
         (``ControlContext.nominal_physics``); default: a copy of ``physics`` as it is now.
+      params: the scenario's parameters (sims.params) the run was built from, None for a
+        setup built by hand; the result records them resolved (``RunResult.parameters``).
       controlled: indices of the actuators a controller drives (the dm_control action), None
         for all (the antenna's deck drives are the sea's).
       reference_visible: False when ``trajectory`` is not a plan but the truth (the antenna's
@@ -99,6 +101,7 @@ class Setup:
     video_note: str = ""
     output_stride: int = 1
     nominal_physics: Callable | None = None
+    params: object = None
     controlled: np.ndarray | None = None
     reference_visible: bool = True
 
@@ -146,8 +149,8 @@ class RunResult:
     ``planner``, the ``trajectory`` it returned, the ``controller``, the ``sensors`` and the
     ``disturbance`` (None when there is none). ``plugins``: the ``MODULE:FACTORY`` of a user's
     planner or controller given on the command line. ``sensors``: each sensor's SensorSpec.
-    ``parameters``: the scenario's parameters, every one resolved (sims.params), that the
-    caller ran it with (written to summary.json; ``planbench run DIR/summary.json`` repeats it)."""
+    ``parameters``: the setup's parameters, every one resolved (an unset duration is the one
+    the run took), written to summary.json (``planbench run DIR/summary.json`` repeats it)."""
 
     scenario: str
     seed: int
@@ -415,4 +418,13 @@ def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
                                     ("controller", setup.controller), ("sensors", setup.sensors),
                                     ("disturbance", setup.disturbance))}
     return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall, components,
-                     sensors=setup.sensors.describe())
+                     sensors=setup.sensors.describe(), parameters=_resolved(setup))
+
+
+def _resolved(setup: Setup) -> dict | None:
+    if setup.params is None:
+        return None
+    values = setup.params.to_dict()
+    if "duration" in values and values["duration"] is None:
+        values["duration"] = float(setup.duration)
+    return values

@@ -19,7 +19,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from sims.params import ParamError, Params, _hints
+from sims.params import ParamError, Params, field_types, parse_value, set_overrides
+from sims.plugins import is_file, split_spec
 
 TOP_LEVEL_KEYS = ("scenario", "planner", "controller", "parameters")
 
@@ -36,51 +37,34 @@ class Source:
     recorded_versions: dict | None = None
 
 
-def is_file_argument(text: str) -> bool:
-    return text.endswith((".toml", ".json")) or "/" in text or Path(text).is_file()
-
-
-def resolve(argument: str, get_scenario) -> Source:
-    """A scenario name, a scenario file (.toml) or a run's summary.json."""
-    if not is_file_argument(argument):
+def resolve(argument: str, get_scenario, known_names) -> Source:
+    """A scenario name (``known_names`` win, so a file called like a scenario does not
+    shadow it), a scenario file (.toml) or a run's summary.json."""
+    if argument in known_names or not (argument.endswith((".toml", ".json")) or "/" in argument
+                                       or Path(argument).is_file()):
         scenario = get_scenario(argument)
         return Source(scenario, scenario.params, {}, argument)
     path = Path(argument)
     if not path.is_file():
         raise ParamError(f"scenario file {path} does not exist (or is not a file)")
     if path.suffix == ".json":
-        return _from_summary(path, get_scenario)
-    return _from_toml(path, get_scenario)
+        data = _read(path, json.loads, json.JSONDecodeError, "JSON")
+        if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):
+            raise ParamError(f"{path}: not a planbench summary.json with resolved \"parameters\" (written by "
+                             "planbench run since scenario files exist)")
+        # Every value as it ran (null: an optional value unset); plug-ins as they were given.
+        run = {"scenario": data.get("scenario"), "parameters": data["parameters"], **(data.get("plugins") or {})}
+        return _from_data(path, run, get_scenario, data.get("versions"))
+    return _from_data(path, _read(path, tomllib.loads, tomllib.TOMLDecodeError, "TOML"), get_scenario, None)
 
 
-def _from_toml(path: Path, get_scenario) -> Source:
+def _read(path: Path, parse, parse_error, kind: str):
     try:
-        data = tomllib.loads(path.read_text())
+        return parse(path.read_text())
     except (OSError, UnicodeDecodeError) as e:
         raise ParamError(f"{path}: cannot be read ({e})") from None
-    except tomllib.TOMLDecodeError as e:
-        raise ParamError(f"{path}: not TOML: {e}") from None
-    return _from_data(path, data, get_scenario, None)
-
-
-def _from_summary(path: Path, get_scenario) -> Source:
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError) as e:
-        raise ParamError(f"{path}: cannot be read ({e})") from None
-    except json.JSONDecodeError as e:
-        raise ParamError(f"{path}: not JSON: {e}") from None
-    if not isinstance(data, dict) or "parameters" not in data or not isinstance(data.get("parameters"), dict):
-        raise ParamError(f"{path}: not a planbench summary.json with resolved \"parameters\" (written by "
-                         "planbench run since scenario files exist)")
-    plugins = data.get("plugins") or {}
-    run = {"scenario": data.get("scenario"), "parameters": _without_none(data["parameters"]), **plugins}
-    return _from_data(path, run, get_scenario, data.get("versions"))
-
-
-def _without_none(mapping: dict) -> dict:
-    # JSON writes an unset optional value as null; TOML has none: both mean "not given".
-    return {k: v for k, v in mapping.items() if v is not None}
+    except parse_error as e:
+        raise ParamError(f"{path}: not {kind}: {e}") from None
 
 
 def _from_data(path: Path, data: dict, get_scenario, versions) -> Source:
@@ -99,13 +83,13 @@ def _from_data(path: Path, data: dict, get_scenario, versions) -> Source:
         if role in data:
             if not isinstance(data[role], str):
                 raise ParamError(f"{path}: key {role!r} must be MODULE:FACTORY, got {data[role]!r}")
-            plugins[role] = _relative(path, data[role], plugin=True)
+            module_name, factory = split_spec(data[role], role)
+            plugins[role] = f"{_beside(path, module_name) if is_file(module_name) else module_name}:{factory}"
     overrides = data.get("parameters", {})
     if not isinstance(overrides, dict):
         raise ParamError(f"{path}: key 'parameters' must be a table, got {overrides!r}")
-    cls = type(scenario.params)
-    declared = {n: d for n, _, d, _ in cls.declarations()}
-    overrides = {k: (_relative(path, v) if k in declared and declared[k].path and isinstance(v, str) else v)
+    declared = {n: d for n, _, d, _ in type(scenario.params).declarations()}
+    overrides = {k: (_beside(path, v) if k in declared and declared[k].path and isinstance(v, str) else v)
                  for k, v in overrides.items()}
     try:
         params = scenario.resolve(overrides)
@@ -114,25 +98,16 @@ def _from_data(path: Path, data: dict, get_scenario, versions) -> Source:
     return Source(scenario, params, plugins, str(path), versions)
 
 
-def _relative(path: Path, value: str, plugin: bool = False) -> str:
-    """A file named relative to the scenario file: relative to its directory."""
-    name, sep, factory = value.rpartition(":") if plugin else (value, "", "")
-    if plugin and not sep:
-        return value
-    if plugin and not name.endswith(".py"):
-        return value  # an importable module, not a file
-    candidate = Path(name)
-    if not candidate.is_absolute():
-        candidate = (path.parent / candidate)
-    return f"{candidate}{sep}{factory}" if plugin else str(candidate)
+def _beside(path: Path, name: str) -> str:
+    """A file the scenario file names: a relative name is relative to the file's directory."""
+    candidate = Path(name).expanduser()
+    return str(candidate if candidate.is_absolute() else path.parent / candidate)
 
 
 def overrides_from_flags(cls, flags: dict, assignments: list[str]) -> dict:
     """The command line's values: ``--KEY VALUE`` flags (text) and ``--set KEY=VALUE``,
     parsed by each field's type (sims.params.parse_value)."""
-    from sims.params import parse_value, set_overrides
-
-    hints = _hints(cls)
-    out = {key: parse_value(hints[key], text) for key, text in flags.items()}
+    types = field_types(cls)
+    out = {key: parse_value(types[key], text) for key, text in flags.items()}
     out.update(set_overrides(cls, assignments))
     return out

@@ -26,7 +26,7 @@ import copy
 import inspect
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from typing import Any, Callable, Protocol, runtime_checkable
 
 import mujoco
@@ -381,7 +381,8 @@ def check_trajectory(trajectory, labels: tuple, duration_min: float = 0.0) -> No
 
 def check_first_command(command, nu: int, actuators) -> np.ndarray | None:
     """The command a controller returned at its first call, checked: None (it wrote
-    ``context.command``) or a finite vector of ``nu`` numbers; PluginError otherwise."""
+    ``context.command``) or a vector of ``nu`` numbers; PluginError otherwise (the runner
+    checks every command, this one too, for non-finite values)."""
     if command is None:
         return None
     try:

@@ -16,6 +16,7 @@ one point's gusts act on the whole body, which overstates the load of the shorte
 
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
@@ -40,6 +41,12 @@ def check_mean_speed(mean_speed: float) -> float:
         raise ValueError(f"mean wind speed {value:g} m/s is above {MAX_MEAN_SPEED_M_S:g} m/s, the "
                          "reference wind speed of IEC 61400-1 class I (the Kaimal model's range)")
     return value
+
+
+def horizontal_direction(azimuth_deg: float) -> np.ndarray:
+    """The unit vector (3,) of a horizontal direction given as an azimuth, deg from +x toward +y."""
+    az = math.radians(azimuth_deg)
+    return np.array([math.cos(az), math.sin(az), 0.0])
 
 
 def kaimal_spectrum(f, mean_speed: float, turbulence_ref: float = IEC_TURBULENCE_B,
@@ -157,8 +164,7 @@ class BodyWindDrag:
         self.mean_speed = float(mean_speed)
         self.area = area
         self.drag_coefficient = float(drag_coefficient)
-        az = np.radians(azimuth_deg)
-        self.direction = np.array([np.cos(az), np.sin(az), 0.0])
+        self.direction = horizontal_direction(azimuth_deg)
         self.spectrum = spectrum
         self.speed = None
         self.force = None

@@ -163,7 +163,7 @@ def test_antenna_sea_state_run_with_sea_options(tmp_path):
 
 
 @pytest.mark.parametrize("args, words", [
-    (("antenna-sea-state", "--hs", "-2"), ("hs = -2 m", "[0.001, 20] m")),
+    (("antenna-sea-state", "--hs", "-2"), ("hs = -2 m", "(0, 20] m")),
     (("antenna-sea-state", "--tp", "nan"), ("tp = nan", "not finite")),
     (("antenna-paper-motion", "--hs", "4"), ("unrecognized arguments", "--hs")),
     (("hexapod-sync-move", "--wave-heading", "90"), ("unrecognized arguments", "--wave-heading")),

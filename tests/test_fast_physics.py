@@ -215,12 +215,14 @@ def test_dm_control_environment_with_the_winch_feedforward():
 
 
 @pytest.mark.parametrize("options, option, value, words", [
-    (SensorOptions, "pose_rate_hz", 0.0, "sensor option pose_rate_hz = 0.0 must be finite and > 0"),
-    (SensorOptions, "pose_rate_hz", 400.0, "must be <= 100 Hz"),
-    (SensorOptions, "pose_latency_s", -0.1, "pose_latency_s = -0.1 must be finite and >= 0"),
-    (SensorOptions, "stewart_noise_m", float("nan"), "stewart_noise_m = nan"),
-    (ControllerOptions, "stewart_bandwidth_hz", 60.0, "< 50 Hz"),
-    (ControllerOptions, "ki", -1.0, "controller option ki = -1.0 must be finite and >= 0"),
+    (SensorOptions, "pose_rate_hz", 0.0, r"pose_rate_hz = 0 Hz is outside \[0.1, 100\] Hz"),
+    (SensorOptions, "pose_rate_hz", 400.0, r"outside \[0.1, 100\] Hz: .* at most one per 10 ms control tick"),
+    (SensorOptions, "pose_latency_s", -0.1, r"pose_latency_s = -0.1 s is outside \[0, 10\] s"),
+    (SensorOptions, "stewart_noise_m", float("nan"), "stewart_noise_m = nan is not finite"),
+    (ControllerOptions, "stewart_bandwidth_hz", 60.0, r"outside \(0, 50\) Hz"),
+    (ControllerOptions, "stewart_bandwidth_hz", 50.0, r"outside \(0, 50\) Hz"),
+    (ControllerOptions, "leg_integral_s", 0.0, r"leg_integral_s = 0 s is outside \(0, \.\.\.\] s"),
+    (ControllerOptions, "ki", -1.0, r"ki = -1 1/s is outside \[0, \.\.\.\] 1/s"),
 ])
 def test_bad_controller_and_sensor_options_are_named(options, option, value, words):
     with pytest.raises(ValueError, match=words):

@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-from planners import hexapod
 from planners.trajectory import TrajectorySample
 from sims import runner, scenarios
 from sims import hexapod as sim_hexapod

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 from pathlib import Path
 
 import erfa
@@ -270,8 +271,6 @@ def test_every_example_scenario_file_runs_through_the_cli(tmp_path, capsys, path
     code, captured = _run(capsys, path, "--out", tmp_path / "out", *extra)
     assert code == 0, captured.out + captured.err
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    import tomllib
-
     data = tomllib.loads(path.read_text())
     assert summary["scenario"] == data["scenario"]
     for key, value in data["parameters"].items():
@@ -339,11 +338,11 @@ def test_fast_tracks_another_source_at_another_time_as_pyerfa_says():
     assert np.degrees(np.arccos(np.clip(-feed_later[0] / np.linalg.norm(feed_later[0]) @ d[0], -1, 1))) > 5.0
 
 
-def test_a_source_that_leaves_fasts_sky_is_refused_with_its_keys(capsys):
+def test_a_source_that_leaves_fasts_sky_is_refused_with_its_keys(tmp_path, capsys):
     code, captured = _run(capsys, "fast-tracking", "--source", "Crab", "--start-utc", "2026-12-01T06:00:00",
-                          "--out", "/tmp/never-written")
+                          "--out", tmp_path / "out")
     assert code == 2 and "source, start_utc, tracking" in captured.err and "40" in captured.err
-    assert not Path("/tmp/never-written").exists()
+    assert not (tmp_path / "out").exists()
 
 
 def test_the_antenna_elsewhere_points_as_the_geostationary_formulas_say(tmp_path, capsys):
@@ -404,9 +403,8 @@ def test_plan_takes_the_same_files_and_overrides(tmp_path, capsys):
     assert main(["plan", str(path), "--out", str(tmp_path / "p"), "--set", "dwell=2.0"]) == 0
     capsys.readouterr()
     plan = np.load(tmp_path / "p" / "plan.npz")
-    expected = scenarios.get("hexapod-sync-move").plan(
-        scenarios.get("hexapod-sync-move").resolve(
-            {**__import__("tomllib").loads(path.read_text())["parameters"], "dwell": 2.0}))
+    spec = scenarios.get("hexapod-sync-move")
+    expected = spec.plan(spec.resolve({**tomllib.loads(path.read_text())["parameters"], "dwell": 2.0}))
     assert plan["t"][-1] == pytest.approx(expected.duration, abs=2e-3)
 
 
@@ -427,3 +425,17 @@ def test_measured_wind_is_validated_and_resampled(tmp_path):
             MeasuredWind(bad)
     with pytest.raises(ParamError, match="wind_file: .* spans t = 0 ... 10 s, not the run's 0 ... 20 s"):
         scenarios.get("fast-tracking").build(fast.FastTrackingParams(wind_file=str(good), duration=20.0))
+
+
+def test_a_file_called_like_a_scenario_does_not_shadow_it(tmp_path, monkeypatch):
+    from sims.cli import _resolve_source
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "loader-supply").write_text("not a scenario file")
+    source, _, params = _resolve_source("run", ["loader-supply"])
+    assert source.scenario.name == "loader-supply" and params == source.scenario.params
+
+
+def test_a_scan_out_of_fasts_sky_names_the_source_keys():
+    with pytest.raises(ParamError, match=r"^source, start_utc: .*zenith angle .*Table 1"):
+        fast.goal_plan(fast.FastScanParams().replace(source_radec=(10.0, 80.0)))

@@ -224,15 +224,19 @@ def zenith_angle(direction) -> np.ndarray:
     return np.arctan2(np.linalg.norm(d[..., :2], axis=-1), d[..., 2])
 
 
+class ZenithLimitError(LimitError):
+    """A direction beyond FAST's zenith-angle limit (40 deg, Table 1): a source out of reach."""
+
+
 def check_zenith_angle(direction, limit: float = MAX_ZENITH_ANGLE, times=None) -> None:
-    """LimitError naming the first sample whose zenith angle exceeds the limit (40 deg)."""
+    """ZenithLimitError naming the first sample whose zenith angle exceeds the limit (40 deg)."""
     za = np.atleast_1d(zenith_angle(direction))
     bad = np.flatnonzero(za > limit + 1e-12)
     if bad.size:
         i = int(bad[0])
         where = f" at t = {float(np.atleast_1d(times)[i]):.3f} s" if times is not None else f" (sample {i})"
-        raise LimitError(f"zenith angle {math.degrees(za[i]):.3f} deg{where} is beyond the limit "
-                         f"{math.degrees(limit):.1f} deg")
+        raise ZenithLimitError(f"zenith angle {math.degrees(za[i]):.3f} deg{where} is beyond the limit "
+                               f"{math.degrees(limit):.1f} deg")
 
 
 def feed_position(direction, radius: float = FOCAL_SURFACE_RADIUS) -> np.ndarray:
@@ -412,9 +416,9 @@ def split_tilt(feed, axis, geometry: FastGeometry = FAST, limits: FastLimits = F
     hi = np.minimum(limits.cabin_tilt, za)
     if check and np.any(lo > hi + 1e-12):
         i = int(np.flatnonzero((lo > hi + 1e-12).ravel())[0])
-        raise LimitError(f"zenith angle {math.degrees(za.ravel()[i]):.3f} deg (pose {i}) is beyond the "
-                         f"cabin's {math.degrees(limits.cabin_tilt):.1f} deg plus the A-B rotator's "
-                         f"{math.degrees(limits.ab_tilt):.1f} deg")
+        raise ZenithLimitError(f"zenith angle {math.degrees(za.ravel()[i]):.3f} deg (pose {i}) is beyond the "
+                               f"cabin's {math.degrees(limits.cabin_tilt):.1f} deg plus the A-B rotator's "
+                               f"{math.degrees(limits.ab_tilt):.1f} deg")
     hi = np.maximum(hi, lo)
 
     def objective(tilt):

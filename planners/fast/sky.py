@@ -105,8 +105,8 @@ from typing import NamedTuple
 import erfa
 import numpy as np
 
-from planners.errors import LimitError, PlanningError
-from planners.fast import FOCAL_SURFACE_RADIUS, MAX_ZENITH_ANGLE, source_direction
+from planners.errors import PlanningError
+from planners.fast import FOCAL_SURFACE_RADIUS, MAX_ZENITH_ANGLE, ZenithLimitError, source_direction
 
 #: 1 deg/h in rad/s: the paper's scan speeds (V_dec, deg/h) at the edges.
 DEG_PER_HOUR = math.radians(1.0) / 3600.0
@@ -449,7 +449,7 @@ def _check_zenith(what: str, za: np.ndarray, t: np.ndarray, jd1, jd2, limit) -> 
     bad = np.flatnonzero(za > limit + 1e-12)
     if bad.size:
         i = int(bad[0])
-        raise LimitError(
+        raise ZenithLimitError(
             f"{what} reaches zenith angle {math.degrees(za[i]):.3f} deg at "
             f"{jd_to_iso(jd1[i], jd2[i])} UTC ({t[i]:.1f} s after the start), beyond the FAST "
             f"limit {math.degrees(limit):.1f} deg")

@@ -662,7 +662,7 @@ def _model() -> mujoco.MjModel:
 
 def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_max_deg,
            rms_limit_deg, description, antenna_options: AntennaOptions,
-           video_length_s: float = 60.0, planner=None, controller=None) -> Setup:
+           video_length_s: float = 60.0, planner=None, controller=None, params=None) -> Setup:
     physics = AntennaPhysics.load()
     satellite = ant.satellite_attitude(azimuth, elevation, polarization)
     theta0 = start_angles(motion, satellite, azimuth, elevation, polarization)
@@ -714,6 +714,7 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
         # Time-lapse so the video lasts at most video_length_s.
         video_speed=max(1.0, duration / video_length_s),
         seed=seed,
+        params=params,
     )
 
 
@@ -737,8 +738,8 @@ def motion_of(params: "AntennaParams"):
     """The ship's motion: the paper's eq. (15)-(16) with the run's amplitudes and periods, or
     a JONSWAP sea drawn from the run's seed."""
     if isinstance(params, AntennaPaperParams):
-        if params.is_paper():
-            return PaperShipMotion()
+        # At the defaults this is eq. (15)-(16) to the bit (radians(1 deg/s) equals the
+        # paper's 0.01 deg per 0.01 s sample).
         return PaperShipMotion(
             amplitudes_deg={"heading": params.heading_amplitude, "pitch": params.pitch_amplitude,
                             "roll": params.roll_amplitude},
@@ -746,11 +747,6 @@ def motion_of(params: "AntennaParams"):
             turn_rate_deg_s=params.turn_rate, course_deg=-params.ship_heading)
     return SeaStateMotion(params.hs, params.tp, params.wave_heading, np.random.default_rng([params.seed, 0x5EA]),
                           gamma=params.gamma, speed=params.ship_speed, course_deg=-params.ship_heading)
-
-
-def sea_state_motion(hs: float, tp: float, heading_deg: float, seed: int) -> SeaStateMotion:
-    """A JONSWAP sea (gamma 3.3, the ship at rest heading north) from ``seed``."""
-    return motion_of(AntennaSeaParams(hs=hs, tp=tp, wave_heading=heading_deg, seed=seed))
 
 
 def build(params: "AntennaParams", planner=None, controller=None,
@@ -766,13 +762,14 @@ def build(params: "AntennaParams", planner=None, controller=None,
     motion = motion_of(params)
     duration = params.duration
     if isinstance(params, AntennaPaperParams):
-        description = {"ship_motion": "paper eq. (15)-(16)" if params.is_paper() else
-                       "paper eq. (15)-(16) with the run's amplitudes and periods",
-                       "satellite_az_el_pol_deg": list(params.satellite_look) if params.satellite_look else
-                       np.degrees([az, el, pol]).round(4).tolist()}
+        description = {"ship_motion": f"paper eq. (15)-(16): heading {params.heading_amplitude:g} deg / "
+                                      f"{params.heading_period:g} s and {params.turn_rate:g} deg/s, pitch "
+                                      f"{params.pitch_amplitude:g} deg / {params.pitch_period:g} s, roll "
+                                      f"{params.roll_amplitude:g} deg / {params.roll_period:g} s",
+                       "satellite_az_el_pol_deg": np.degrees([az, el, pol]).round(4).tolist()}
         # A 30 s video: the 8 s and 10 s periods shown at 4 s and 5 s.
         return _setup(motion, az, el, pol, duration, params.seed, POINTING_MAX_PAPER_DEG, None, description,
-                      antenna_options, video_length_s=30.0, planner=planner, controller=controller)
+                      antenna_options, video_length_s=30.0, planner=planner, controller=controller, params=params)
     sd = motion.standard_deviation()
     description = {
         "ship_motion": f"JONSWAP Hs {params.hs:g} m, Tp {params.tp:g} s, gamma {motion.gamma:g}, waves {params.wave_heading:g} deg off the bow",
@@ -783,7 +780,7 @@ def build(params: "AntennaParams", planner=None, controller=None,
         "satellite_az_el_pol_deg": np.degrees([az, el, pol]).round(4).tolist(),
     }
     return _setup(motion, az, el, pol, duration, params.seed, POINTING_MAX_SEA_DEG, POINTING_RMS_DEG, description,
-                  antenna_options, planner=planner, controller=controller)
+                  antenna_options, planner=planner, controller=controller, params=params)
 
 
 def plan(params: "AntennaParams") -> ant.JointPathTrajectory:
@@ -792,11 +789,7 @@ def plan(params: "AntennaParams") -> ant.JointPathTrajectory:
     az, el, pol = satellite_of(params)
     satellite = ant.satellite_attitude(az, el, pol)
     motion = motion_of(params)
-    if isinstance(params, AntennaPaperParams) and params.is_paper():
-        theta0 = ant.joint_angles_at_rest(az, el, pol)  # the paper's own start
-    else:
-        theta0 = start_angles(motion, satellite, az, el, pol)
-    return ideal_path(motion, satellite, params.duration, theta0)
+    return ideal_path(motion, satellite, params.duration, start_angles(motion, satellite, az, el, pol))
 
 
 def compare_methods(duration: float = PAPER_DURATION_S) -> dict:
@@ -925,10 +918,6 @@ class AntennaPaperParams(AntennaParams):
     roll_period: float = param(10.0, "roll period", "s", low=1.0, high=60.0, reason="ship motion periods")
     duration: float = param(PAPER_DURATION_S, "simulated time", "s", low=CONTROL_DT, reason="at least one control tick (5 ms)")
 
-    def is_paper(self) -> bool:
-        """The motion is eq. (15)-(16) as printed."""
-        return (self.heading_amplitude, self.heading_period, self.turn_rate, self.pitch_amplitude, self.pitch_period,
-                self.roll_amplitude, self.roll_period, self.ship_heading) == (40.0, 300.0, 1.0, 40.0, 8.0, 45.0, 10.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -936,7 +925,7 @@ class AntennaSeaParams(AntennaParams):
     """A JONSWAP sea through the ship's RAOs; the satellite by its orbital slot."""
 
     satellite_lon: float | None = override(AntennaParams, "satellite_lon", SATELLITE_LON_DEG)
-    hs: float = param(SEA_HS_M, "significant wave height", "m", low=1e-3, high=SEA_HS_MAX_M,
+    hs: float = param(SEA_HS_M, "significant wave height", "m", low=0.0, low_open=True, high=SEA_HS_MAX_M,
                       reason="WMO's record is 19.0 m; also no steeper than DNV-RP-C205 allows (checked with tp)")
     tp: float = param(SEA_TP_S, "spectral peak period", "s", low=SEA_TP_RANGE_S[0], high=SEA_TP_RANGE_S[1],
                       reason="wind seas and swell (Munk 1950)")

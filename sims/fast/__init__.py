@@ -458,18 +458,6 @@ def log_bytes_per_tick(cable_segments: int = 0) -> float:
                              + PER_TICK_FLOATS)
 
 
-def check_cable_segments(segments) -> int:
-    """``segments`` if it is 0 (the lumped cables) or a whole number in [2, max_cable_segments()],
-    else a LimitError naming the value and the limit."""
-    most = max_cable_segments()
-    if isinstance(segments, bool) or not isinstance(segments, (int, np.integer)) \
-            or not (segments == 0 or 2 <= segments <= most):
-        raise LimitError(f"cable segments {segments!r} must be 0 (lumped cables) or a whole number in "
-                         f"[2, {most}] (the timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g} on the "
-                         "segments' axial mode)")
-    return int(segments)
-
-
 def problem(plan: fp.FastPlan) -> fp.FastProblem:
     """The session whose goal is ``plan``: its observing windows are the segments named
     OBSERVING_PREFIXES (observations, scan legs and their transitions)."""
@@ -514,7 +502,7 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     return Setup(physics=physics, trajectory=trajectory, controller=controller,
                  sensors=FastSensors(physics, sensor_options, CONTROL_DT), problem=session, planner=planner,
                  control_dt=CONTROL_DT, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
-                 report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed,
+                 report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed, params=params,
                  output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1)
 
 
@@ -530,9 +518,13 @@ def goal_plan(params: "FastParams") -> fp.FastPlan:
             return scan_plan(spec, params.source_of(), params.start_utc)
         if isinstance(params, FastSwitchParams):
             return source_switch_plan(params.tracking, params.sources, params.start_utc)
-    except LimitError as e:
+    except fast.ZenithLimitError as e:
         keys = "sources, start_utc" if isinstance(params, FastSwitchParams) else "source, start_utc"
         raise ParamError(f"{keys}: {e} (FAST observes within 40 deg of the zenith, Table 1)") from None
+    except LimitError as e:  # a scan whose transitions no t2 can keep under A_t-max
+        if isinstance(params, FastScanParams):
+            raise ParamError(f"legs_along, legs, leg_length, scan_speed, leg_spacing: {e}") from None
+        raise
     raise TypeError(f"no session for {type(params).__name__}")
 
 
@@ -619,7 +611,8 @@ class FastTrackingParams(FastSourceParams):
     """Park -> the source, start, tracking, termination."""
 
     tracking: float = param(1200.0, "time on the source", "s", low=10.0, high=6 * 3600.0,
-                            reason="10 s to 6 h (a source stays within 40 deg of FAST's zenith for at most ~5.3 h)")
+                            reason="10 s to 6 h (a source stays within 40 deg of FAST's zenith for at most 5.9 h: at "
+                                   "Dec = latitude, cos H = (cos 40 - sin^2 lat) / cos^2 lat, H = 44.6 deg)")
 
     def check(self) -> None:
         super().check()
@@ -627,7 +620,7 @@ class FastTrackingParams(FastSourceParams):
         start = _start(self.source_of(), self.start_utc, self.tracking)
         try:
             sky.track(ra, dec, start, self.tracking, step=max(self.tracking / 100.0, 1.0))
-        except LimitError as e:
+        except fast.ZenithLimitError as e:
             raise ParamError(f"source, start_utc, tracking: {e} (FAST observes within 40 deg of the zenith, "
                              "Table 1)") from None
 

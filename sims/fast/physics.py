@@ -45,9 +45,9 @@ from planners.fast import plan as fast_plan
 from planners.errors import LimitError
 from planners.legs import leg_lengths, structure_matrix
 from planners.rotations import rot_y, rot_z, skew, vee, wxyz
-from planners.trajectory import TrajectorySample
 from sims.task import Sensors, SensorSpec
-from sims.wind import AIR_DENSITY, check_mean_speed, wind_speed_series
+from sims.params import Params, param
+from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
 
 CONTROL_DT = 0.01  # s: the runner's tick, the Stewart stabilizer's 100 Hz
 
@@ -481,8 +481,7 @@ class CableLoads:
     def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal",
                  turbulence_intensity: float | None = None, measured=None):
         self.mean_speed = check_mean_speed(wind_speed) if measured is None else float(np.mean(measured.speed))
-        az = math.radians(wind_azimuth_deg)
-        self.direction = np.array([math.cos(az), math.sin(az), 0.0])
+        self.direction = horizontal_direction(wind_azimuth_deg)
         self.spectrum = spectrum
         self.turbulence_intensity = turbulence_intensity
         self.measured = measured
@@ -649,87 +648,58 @@ class ChainCableLoads(CableLoads):
 
 
 @dataclass(frozen=True)
-class SensorOptions:
+class SensorOptions(Params):
     """FAST's sensors of the cabin pose (the task's, not the controller's: a user's controller
-    gets the same readings).
+    gets the same readings). Typed and ranged as the scenarios' parameters (sims.params)."""
 
-    Attributes:
-      pose_rate_hz, pose_latency_s: the cabin pose measurement of the cable loop (total
-        stations: 10 Hz, 150 ms; the issue's values).
-      pose_noise_m, pose_noise_rad: its white noise, 1-sigma per axis (assumed: 1 mm and
-        20 urad, a total station's class at 150-300 m).
-      stewart_latency_s, stewart_noise_m, stewart_noise_rad: the 100 Hz measurement of the
-        cabin pose that the stabilizer corrects with (assumed: IMU-aided, 10 ms, 0.5 mm,
-        10 urad white).
-    """
-
-    pose_rate_hz: float = 10.0
-    pose_latency_s: float = 0.15
-    pose_noise_m: float = 1e-3
-    pose_noise_rad: float = 20e-6
-    stewart_latency_s: float = 0.01
-    stewart_noise_m: float = 0.5e-3
-    stewart_noise_rad: float = 10e-6
-
-    def __post_init__(self):
-        _check_options(self, positive=("pose_rate_hz",),
-                       non_negative=("pose_latency_s", "pose_noise_m", "pose_noise_rad", "stewart_latency_s",
-                                     "stewart_noise_m", "stewart_noise_rad"), what="sensor option")
-        if self.pose_rate_hz > 1.0 / CONTROL_DT:
-            raise ValueError(f"pose_rate_hz = {self.pose_rate_hz} must be <= {1.0 / CONTROL_DT:g} Hz "
-                             f"(the {1.0 / CONTROL_DT:g} Hz control tick)")
-
-
-def _check_options(options, positive, non_negative, what: str) -> None:
-    for name in positive:
-        value = getattr(options, name)
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{what} {name} = {value!r} must be finite and > 0")
-    for name in non_negative:
-        value = getattr(options, name)
-        if not (math.isfinite(value) and value >= 0):
-            raise ValueError(f"{what} {name} = {value!r} must be finite and >= 0")
+    pose_rate_hz: float = param(10.0, "rate of the cable loop's cabin pose fixes (total stations; the issue's "
+                                "10 Hz)", "Hz", low=0.1, high=1.0 / CONTROL_DT,
+                                reason="a fix at least every 10 s (assumed), at most one per 10 ms control tick")
+    pose_latency_s: float = param(0.15, "their latency (the issue's 150 ms)", "s", low=0.0, high=10.0,
+                                  reason="total stations lag 150-240 ms (REFERENCE.md); 10 s is an assumed bound")
+    pose_noise_m: float = param(1e-3, "their white position noise per axis, 1 sigma (assumed: a total station's "
+                                "class at 150-300 m)", "m", low=0.0, high=1.0, reason="an assumed bound")
+    pose_noise_rad: float = param(20e-6, "their white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
+                                  high=0.1, reason="an assumed bound")
+    stewart_latency_s: float = param(0.01, "latency of the 100 Hz pose measurement the stabilizer corrects with "
+                                     "(assumed: IMU-aided)", "s", low=0.0, high=10.0, reason="an assumed bound")
+    stewart_noise_m: float = param(0.5e-3, "its white position noise per axis, 1 sigma (assumed)", "m", low=0.0,
+                                   high=1.0, reason="an assumed bound")
+    stewart_noise_rad: float = param(10e-6, "its white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
+                                     high=0.1, reason="an assumed bound")
 
 
 @dataclass(frozen=True)
-class ControllerOptions:
-    """The FAST controller's settings.
+class ControllerOptions(Params):
+    """The FAST controller's settings (typed and ranged as sims.params declares).
 
-    Attributes:
-      stewart: the Stewart stabilizer corrects the feed (False: its legs hold nominal).
-      stewart_bandwidth_hz: bandwidth of the estimator (an alpha-beta tracker, critically
-        damped) of the 100 Hz cabin pose measurement's deviation from the planned pose and of
-        its rate; the command leads by the latency plus the leg servo's lag kv/kp. Unfiltered,
-        the white noise moves the 2 t platform every tick and its reaction shakes the cabin's
-        lightly damped 0.3-0.65 Hz modes until the legs reach their stroke.
-      kp, kd, ki: cable-loop PID on the cabin pose error (1, s, 1/s): the commanded pose
-        correction is kp e + kd de/dt + ki int e, mapped to cable lengths by the Jacobian.
-        Integral only by default: with the 150 ms latency, proportional and derivative action
-        destabilize the cabin's 0.3-0.65 Hz modes (kp 0.2 with the stabilizer on at the
-        zenith, kd 0.1 at zenith angle 40 deg: found in simulation), and the slow integral
-        (0.02/s, 50 s) removes the drift the stabilizer would otherwise carry.
-      derivative_filter_s: time constant of the first-order filter on de/dt, s.
-      ab_integral_s: the A-B servo's integral time, s (removes what the gravity feed-forward
-        leaves).
-      leg_integral_s: the Stewart legs' integral time on their encoder error, s (removes the
-        servo droop under the platform's weight, 0.2-0.7 mm at kp = 2e7 N/m).
+    Why the defaults: the stabilizer's estimator is an alpha-beta tracker (critically damped)
+    of the 100 Hz cabin pose measurement's deviation from the planned pose and of its rate;
+    the command leads by the latency plus the leg servo's lag kv/kp. Unfiltered, the white
+    noise moves the 2 t platform every tick and its reaction shakes the cabin's lightly damped
+    0.3-0.65 Hz modes until the legs reach their stroke. The cable loop is integral only:
+    with the 150 ms latency, proportional and derivative action destabilize those modes (kp
+    0.2 with the stabilizer on at the zenith, kd 0.1 at zenith angle 40 deg: found in
+    simulation), and the slow integral (0.02/s, 50 s) removes the drift the stabilizer would
+    otherwise carry.
     """
 
-    stewart: bool = True
-    stewart_bandwidth_hz: float = 3.0
-    kp: float = 0.0
-    kd: float = 0.0
-    ki: float = 0.02
-    derivative_filter_s: float = 0.05
-    ab_integral_s: float = 1.0
-    leg_integral_s: float = 0.2
-
-    def __post_init__(self):
-        _check_options(self, positive=("stewart_bandwidth_hz", "ab_integral_s", "leg_integral_s"),
-                       non_negative=("kp", "kd", "ki", "derivative_filter_s"), what="controller option")
-        if self.stewart_bandwidth_hz >= 0.5 / CONTROL_DT:
-            raise ValueError(f"stewart_bandwidth_hz = {self.stewart_bandwidth_hz} must be < {0.5 / CONTROL_DT:g} Hz "
-                             f"(half the {1.0 / CONTROL_DT:g} Hz control tick)")
+    stewart: bool = param(True, "the Stewart stabilizer corrects the feed (false: its legs hold nominal)")
+    stewart_bandwidth_hz: float = param(3.0, "bandwidth of the stabilizer's pose estimator", "Hz", low=0.0,
+                                        low_open=True, high=0.5 / CONTROL_DT, high_open=True,
+                                        reason="below half the 100 Hz control rate")
+    kp: float = param(0.0, "cable-loop proportional gain on the cabin pose error", "", low=0.0,
+                      reason="a gain, not a sign change")
+    kd: float = param(0.0, "cable-loop derivative gain", "s", low=0.0, reason="a gain, not a sign change")
+    ki: float = param(0.02, "cable-loop integral gain (the pose correction is kp e + kd de/dt + ki int e, mapped "
+                      "to cable lengths by the Jacobian)", "1/s", low=0.0, reason="a gain, not a sign change")
+    derivative_filter_s: float = param(0.05, "time constant of the first-order filter on de/dt", "s", low=0.0,
+                                       reason="a time constant")
+    ab_integral_s: float = param(1.0, "the A-B servo's integral time (removes what the gravity feed-forward "
+                                 "leaves)", "s", low=0.0, low_open=True, reason="an integral time")
+    leg_integral_s: float = param(0.2, "the Stewart legs' integral time on their encoder error (removes the servo "
+                                  "droop under the platform's weight, 0.2-0.7 mm at kp = 2e7 N/m)", "s", low=0.0,
+                                  low_open=True, reason="an integral time")
 
 
 class FastSensors(Sensors):
@@ -774,7 +744,7 @@ class FastSensors(Sensors):
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
         o = self.options
         n = times.size
-        self._data = data = physics.data.ptr
+        self._data = physics.data.ptr
         self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
         rng = np.random.default_rng([seed, 0xFA57])
         self.true_pos = np.empty((n, 3))

@@ -35,7 +35,7 @@ from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
 from sims.params import Params, ParamError, ScenarioParams, param
 from sims.task import JointEncoders, plan_checked
-from sims.wind import MAX_MEAN_SPEED_M_S, BodyWindDrag
+from sims.wind import MAX_MEAN_SPEED_M_S, BodyWindDrag, horizontal_direction
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
 SETTLE_S = 1.0  # s simulated after the move: the integral action settles in ~0.5 s
@@ -359,10 +359,6 @@ class HexapodEvaluation:
         self.wind = wind
         self.own_times = [hexapod_planner.own_move_times(m) for m in self.moves]
 
-    @property
-    def problem(self) -> hexapod_planner.MoveProblem:
-        return self.moves[-1]
-
     def _strut_log(self, log: RunLog):
         p = self.physics
         return log.qpos[:, p.strut_qpos], log.qvel[:, p.strut_dofs]
@@ -398,8 +394,10 @@ class HexapodEvaluation:
     def _judge_move(self, log: RunLog, i: int, q, poses) -> dict:
         """One move's arrival, following error and settled pose error."""
         rows = self._window(log, i)
-        if rows.size == 0:
-            return {"arrived": False, "ended": False}
+        if rows.size == 0:  # the run ended before this move began
+            return {"arrived": False, "ended": False, "arrivals": np.zeros(6), "spread": 0.0, "late": 0.0,
+                    "move_end": self.planned[i], "during": rows, "following": np.zeros(6),
+                    "pose_error": float("nan"), "settled_at": self.starts[i] + self.planned[i] + SETTLE_S}
         ref = log.reference
         t = log.t[rows] - self.starts[i]
         window_ref = TrajectorySample(t, ref.position[rows], ref.velocity[rows], ref.acceleration[rows])
@@ -417,7 +415,6 @@ class HexapodEvaluation:
         return {
             "arrived": arrived,
             "ended": arrived and t[-1] >= move_end + SETTLE_S - 1e-9,
-            "moving": moving,
             "arrivals": arrivals,
             "spread": spread,
             "late": float(np.abs(arrivals - own)[moving].max()) if moving.any() else 0.0,
@@ -443,23 +440,23 @@ class HexapodEvaluation:
         a_cmd = np.abs(ref.acceleration).max()
         checks = []
 
-        def per_move(key, scale=1.0, fmt=".3g"):
-            return "; per move " + ", ".join(f"{scale * j[key]:{fmt}}" for j in judged) if several else ""
+        def per_move(key, fmt=".3g"):
+            return "; per move " + ", ".join(f"{j[key]:{fmt}}" for j in judged) if several else ""
 
         # Arrivals exist only if the run saw the whole commanded motion of a move, i.e. its
         # reference rests at the window's last tick (a short run's last tick would pass for
         # every strut's arrival); the settling window only comes after them.
         late_move = next((i for i, j in enumerate(judged) if not j["arrived"]), None)
         arrived = late_move is None
-        short = (f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion "
-                 + (f"of move {late_move} " if several and not arrived else "")
-                 + f"(planned to t = {self.starts[-1] + self.planned[-1] if arrived else self.starts[late_move] + self.planned[late_move]:.3f} s) came to rest")
+        short = "" if arrived else (
+            f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion"
+            + (f" of move {late_move}" if several else "")
+            + f" (planned to t = {self.starts[late_move] + self.planned[late_move]:.3f} s) came to rest")
         sync = [i for i, m in enumerate(self.moves) if m.synchronous]
         asyn = [i for i, m in enumerate(self.moves) if not m.synchronous]
         if sync:
             checks.append(Check("arrival_spread", max(judged[i]["spread"] for i in sync), ARRIVAL_SPREAD_LIMIT_S, "s",
-                                note="last minus first strut arrival of the commanded motion"
-                                     + (per_move("spread") if several else ""))
+                                note="last minus first strut arrival of the commanded motion" + per_move("spread"))
                           if arrived else
                           Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=short))
         if asyn:
@@ -471,10 +468,10 @@ class HexapodEvaluation:
                           Check.not_evaluated("arrival_vs_own_time", 2 * CONTROL_DT, "s", reason=short))
         ended_all = all(j["ended"] for j in judged)
         unsettled = next((i for i, j in enumerate(judged) if not j["ended"]), len(judged) - 1)
-        settled_at = judged[unsettled].get("settled_at", self.starts[unsettled] + self.planned[unsettled] + SETTLE_S)
+        settled_at = judged[unsettled]["settled_at"]
         last = judged[-1]
-        move_end = last.get("move_end", self.planned[-1])
-        following = max(float(j["following"].max()) for j in judged if j["arrived"] or "during" in j)
+        move_end = last["move_end"]
+        following = max(float(j["following"].max()) for j in judged)
         checks += [
             Check("strut_velocity", 1e6 * v_cmd, 1e6 * limits.strut_speed, "um/s",
                   note="commanded; measured peak "
@@ -498,14 +495,13 @@ class HexapodEvaluation:
         ]
         final_pose = poses[-1]
         pose_diff = final_pose - np.asarray(self.moves[-1].target_pose)
-        arrivals = last.get("arrivals", np.zeros(6))
-        during = last.get("during", np.arange(0))
+        arrivals, during = last["arrivals"], last["during"]
         window = log.t >= log.t[-1] - SETTLE_WINDOW_S - 1e-9
         metrics = {
             "elevation_deg": p.elevation_deg,
             "move_duration_s": move_end,
             "arrival_times_s": dict(zip(STRUT_LABELS, arrivals.round(4).tolist())),
-            "arrival_spread_s": last.get("spread", 0.0),
+            "arrival_spread_s": last["spread"],
             "final_translation_error_um": (1e6 * pose_diff[:3]).round(4).tolist(),
             "final_rotation_error_urad": (1e6 * pose_diff[3:]).round(4).tolist(),
             "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist() if during.size else [0.0] * 6)),
@@ -519,10 +515,10 @@ class HexapodEvaluation:
                 "start_s": float(self.starts[i]), "synchronous": bool(m.synchronous),
                 "target_pose_mm_deg": [*(1e3 * m.target_pose[:3]).round(6).tolist(), *np.degrees(m.target_pose[3:]).round(6).tolist()],
                 "arrived": j["arrived"],
-                "move_duration_s": j.get("move_end"), "arrival_spread_s": j.get("spread"),
-                "arrival_vs_own_time_s": None if m.synchronous else j.get("late"),
-                "following_error_um": float(j["following"].max()) if "following" in j else None,
-                "pose_error_um": j.get("pose_error") if j["ended"] else None,
+                "move_duration_s": j["move_end"], "arrival_spread_s": j["spread"],
+                "arrival_vs_own_time_s": None if m.synchronous else j["late"],
+                "following_error_um": float(j["following"].max()),
+                "pose_error_um": j["pose_error"] if j["ended"] else None,
             } for i, (m, j) in enumerate(zip(self.moves, judged))]
         if self.wind is not None and self.wind.speed is not None:
             n = log.t.size
@@ -576,8 +572,7 @@ def camera_area(physics: HexapodPhysics):
     """(physics) -> silhouette of the camera across the wind, m^2; the geom is looked up once."""
     geom = physics.model.ptr.geom("camera_body")
     diameter, length, gid = 2 * geom.size[0], 2 * geom.size[1], geom.id
-    az = np.radians(WIND_AZIMUTH_DEG)
-    dx, dy = float(np.cos(az)), float(np.sin(az))
+    dx, dy, _ = horizontal_direction(WIND_AZIMUTH_DEG)
     side, end = diameter * length, np.pi * diameter**2 / 4.0
 
     def area(physics) -> float:
@@ -679,6 +674,7 @@ def build(params: "HexapodParams", planner=None, controller=None) -> Setup:
         disturbance=wind,
         video_speed=1.0,
         seed=params.seed,
+        params=params,
         video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
         video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)",
     )

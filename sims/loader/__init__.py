@@ -288,6 +288,7 @@ def build(params: "LoaderParams", planner=None, controller=None) -> Setup:
         report=evaluation.report,
         video_speed=1.0,
         seed=params.seed,
+        params=params,
     )
 
 
