@@ -18,7 +18,7 @@ from sims import outputs, runner, scenarios
 from sims.task import check_controller, check_planner
 
 
-def run(scenario: str, *, planner=None, controller=None, params=None,
+def run(scenario: str, *, planner=None, controller=None, params=None, plant=None,
         out=None, video=None, quiet: bool = True) -> runner.RunResult:
     """Run the scenario ``scenario`` and return its ``runner.RunResult``.
 
@@ -28,6 +28,9 @@ def run(scenario: str, *, planner=None, controller=None, params=None,
       controller: your controller, None for ours.
       params: the scenario's parameters: a mapping of overrides (keys of
         ``planbench run NAME --help``), or its Params object; None for its defaults.
+      plant: the plant's uncertainty (README, "Campaigns"): a mapping of the mechanism's
+        plant fields, or its PlantParams object; None for the nominal plant. Your planner
+        and controller still get the nominal model.
       out: an output directory to write (summary.json, timeseries.npz, report.png) as
         ``planbench run --out`` does, or None to write nothing.
       video: a video file to render into (needs ``out``).
@@ -43,6 +46,9 @@ def run(scenario: str, *, planner=None, controller=None, params=None,
     params = spec.resolve(params) if params is None or isinstance(params, dict) else params
     if type(params) is not type(spec.params):
         raise TypeError(f"params of {spec.name} are {type(spec.params).__name__}, not {type(params).__name__}")
+    plant = spec.resolve_plant(plant) if plant is None or isinstance(plant, dict) else plant
+    if spec.plant is not None and type(plant) is not type(spec.plant):
+        raise TypeError(f"plant of {spec.name} is {type(spec.plant).__name__}, not {type(plant).__name__}")
     if controller is not None:
         check_controller(controller)
     if planner is not None:
@@ -52,20 +58,27 @@ def run(scenario: str, *, planner=None, controller=None, params=None,
     target = None if out is None else outputs.OutputDir(out)
     video_file = None if video is None else outputs.VideoFile(video, target)
     if target is None:
-        return _run(spec, params, planner, controller, quiet)[1]
+        return _run(spec, params, plant, planner, controller, quiet)[1]
     with target.reserved():
         if video_file is None:
-            return _run_and_write(spec, params, planner, controller, target, None, quiet)
+            return _run_and_write(spec, params, plant, planner, controller, target, None, quiet)
         with video_file.reserved():
-            return _run_and_write(spec, params, planner, controller, target, video_file, quiet)
+            return _run_and_write(spec, params, plant, planner, controller, target, video_file, quiet)
 
 
-def _run(spec, params, planner, controller, quiet):
-    setup = spec.build(params, planner=planner, controller=controller)
+def build(spec, params, plant=None, planner=None, controller=None):
+    """``spec.build`` with the plant passed only when it is perturbed (a mechanism without
+    plant uncertainty takes no ``plant``)."""
+    extra = {} if plant is None or plant.is_nominal else {"plant": plant}
+    return spec.build(params, planner=planner, controller=controller, **extra)
+
+
+def _run(spec, params, plant, planner, controller, quiet):
+    setup = build(spec, params, plant, planner, controller)
     return setup, runner.run(spec.name, setup, quiet=quiet)
 
 
-def _run_and_write(spec, params, planner, controller, target, video, quiet):
-    setup, result = _run(spec, params, planner, controller, quiet)
+def _run_and_write(spec, params, plant, planner, controller, target, video, quiet):
+    setup, result = _run(spec, params, plant, planner, controller, quiet)
     outputs.write_run(result, setup, target, video=video, camera=spec.camera, quiet=quiet)
     return result

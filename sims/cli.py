@@ -6,6 +6,8 @@
                 [--video FILE] [--camera overview|closeup] [--quiet]
   planbench run NAME --help      the scenario's parameters: units, defaults, ranges
   planbench plan NAME|FILE.toml [--PARAMETER VALUE ...] [--set KEY=VALUE ...] --out DIR
+  planbench sweep SPEC.toml [--out DIR] [--engine local|ray] [--workers N] [--address ADDR]
+                  [--rerun-worst K] [--quiet]
   planbench bench
   planbench demo [--out DIR]
 
@@ -52,6 +54,19 @@ def build_parser() -> argparse.ArgumentParser:
                    add_help=False)
     sub.add_parser("plan", help="write a scenario's planned motion, no physics", add_help=False)
     sub.add_parser("bench", help="benchmark table: realtime factors and loop/bare-mj_step ratios")
+    sweep = sub.add_parser("sweep", help="a campaign: many runs from a spec (grids, draws, seeds, plant "
+                           "uncertainty), a results table and a report")
+    sweep.add_argument("spec", metavar="SPEC.toml", help="the campaign spec (README, \"Campaigns\")")
+    sweep.add_argument("--out", help="campaign directory (default results/SPEC-NAME); the same spec again "
+                       "resumes it, another spec is refused")
+    sweep.add_argument("--engine", default="local", help="local (a process pool, the default) or ray")
+    sweep.add_argument("--workers", type=int, default=None,
+                       help="processes of the local pool, or CPUs of a local Ray instance (default: the cores)")
+    sweep.add_argument("--address", default=None, help="Ray cluster address (default RAY_ADDRESS, else a local "
+                       "Ray instance)")
+    sweep.add_argument("--rerun-worst", type=int, default=0, metavar="K",
+                       help="afterwards, simulate the K worst runs again with a video each (DIR/worst/)")
+    sweep.add_argument("--quiet", action="store_true", help="no progress bar")
     demo = sub.add_parser("demo", help="run every scenario with a video; one table of checks")
     demo.add_argument("--out", default="results",
                       help="directory of the scenarios' output directories (default results)")
@@ -184,7 +199,7 @@ def _scenario_help(command: str, argv: list[str]) -> int | None:
 
 
 def cmd_run(argv: list[str]) -> int:
-    from sims import outputs, runner
+    from sims import api, outputs, runner
     from sims import plugins as plugins_module
 
     shown = _scenario_help("run", argv)
@@ -211,7 +226,7 @@ def cmd_run(argv: list[str]) -> int:
         reserved.enter_context(out.reserved())
         if video is not None:
             reserved.enter_context(video.reserved())
-        setup = scenario.build(params, **made)
+        setup = api.build(scenario, params, source.plant, **made)
         result = runner.run(scenario.name, setup, quiet=args.quiet)
         result.plugins = plugins
         outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
@@ -243,6 +258,26 @@ def cmd_bench(args) -> int:
         print()
         print(text)
     return EXIT_OK
+
+
+def cmd_sweep(args) -> int:
+    from sims import campaign
+    from sims.params import ParamError
+
+    out = args.out if args.out is not None else Path("results") / Path(args.spec).stem
+    try:
+        outcome = campaign.sweep(args.spec, out, engine=args.engine, workers=args.workers, address=args.address,
+                                 rerun_worst=args.rerun_worst, quiet=args.quiet)
+    except ParamError as e:
+        raise BadInput(str(e)) from None
+    from sims.campaign.report import format_summary
+
+    print(format_summary(outcome.summary))
+    o = outcome.summary["overall"]
+    print(f"{'PASSED' if o['passed'] == o['counted'] else 'NOT ALL PASSED'}: {o['passed']} of {o['counted']} runs "
+          f"passed ({outcome.ran} run now, {outcome.skipped} resumed); table {Path(out) / 'results.parquet'}, "
+          f"report {Path(out) / 'campaign.png'}")
+    return EXIT_OK if o["passed"] == o["counted"] else EXIT_CHECK_FAILED
 
 
 def _demo_root(raw: str) -> Path:
@@ -292,7 +327,8 @@ def cmd_demo(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"list": cmd_list, "run": cmd_run, "plan": cmd_plan, "bench": cmd_bench, "demo": cmd_demo}
+COMMANDS = {"list": cmd_list, "run": cmd_run, "plan": cmd_plan, "bench": cmd_bench, "demo": cmd_demo,
+            "sweep": cmd_sweep}
 
 
 class _Interrupt:

@@ -665,6 +665,7 @@ def summary_dict(result) -> dict:
         "passed": result.passed,
         "seed": result.seed,
         "parameters": getattr(result, "parameters", None),
+        "plant": getattr(result, "plant", None),
         "versions": software_versions(),
         "sim_time_s": result.sim_time_s,
         "wall_time_s": round(result.wall_time_s, 4),

@@ -344,6 +344,24 @@ class ScenarioParams(Params):
                       high=2**63 - 1, reason="numpy's SeedSequence takes non-negative 64-bit integers")
 
 
+@dataclass(frozen=True)
+class PlantParams(Params):
+    """How the simulated machine differs from its nominal model: a mechanism's plant
+    uncertainty (masses, stiffness, geometry, sensor errors, actuator limits), for campaigns.
+
+    Every field's default is the nominal plant, so ``Cls()`` is the machine as modelled. Only
+    the plant is perturbed (its MjSpec edited before compiling, its sensors' true errors): the
+    planner and the controller keep the nominal model (``ControlContext.model`` and
+    ``nominal_physics``), as a real controller knows only its design values. A mechanism
+    declares its fields in a subclass and its ``build`` takes ``plant=``.
+    """
+
+    @property
+    def is_nominal(self) -> bool:
+        """True when every field has its nominal (default) value."""
+        return self == type(self)()
+
+
 @typing.no_type_check
 def field_types(cls) -> dict:
     """{field name: its parsed type} of a Params class (cached on the class)."""

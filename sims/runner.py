@@ -75,6 +75,9 @@ class Setup:
         (``ControlContext.nominal_physics``); default: a copy of ``physics`` as it is now.
       params: the scenario's parameters (sims.params) the run was built from, None for a
         setup built by hand; the result records them resolved (``RunResult.parameters``).
+      plant: the plant's uncertainty (sims.params.PlantParams) the physics was built with,
+        None for the nominal plant of a mechanism without one; recorded in ``RunResult.plant``.
+        ``nominal_physics`` must then be the unperturbed model.
       controlled: indices of the actuators a controller drives (the dm_control action), None
         for all (the antenna's deck drives are the sea's).
       reference_visible: False when ``trajectory`` is not a plan but the truth (the antenna's
@@ -102,6 +105,7 @@ class Setup:
     output_stride: int = 1
     nominal_physics: Callable | None = None
     params: object = None
+    plant: object = None
     controlled: np.ndarray | None = None
     reference_visible: bool = True
 
@@ -150,7 +154,8 @@ class RunResult:
     ``disturbance`` (None when there is none). ``plugins``: the ``MODULE:FACTORY`` of a user's
     planner or controller given on the command line. ``sensors``: each sensor's SensorSpec.
     ``parameters``: the setup's parameters, every one resolved (an unset duration is the one
-    the run took), written to summary.json (``planbench run DIR/summary.json`` repeats it)."""
+    the run took), written to summary.json (``planbench run DIR/summary.json`` repeats it);
+    ``plant``: its plant uncertainty's fields (None: a mechanism without them)."""
 
     scenario: str
     seed: int
@@ -163,6 +168,7 @@ class RunResult:
     plugins: dict = field(default_factory=dict)
     sensors: list = field(default_factory=list)
     parameters: dict | None = None
+    plant: dict | None = None
 
     @property
     def passed(self) -> bool:
@@ -418,7 +424,8 @@ def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
                                     ("controller", setup.controller), ("sensors", setup.sensors),
                                     ("disturbance", setup.disturbance))}
     return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall, components,
-                     sensors=setup.sensors.describe(), parameters=_resolved(setup))
+                     sensors=setup.sensors.describe(), parameters=_resolved(setup),
+                     plant=None if setup.plant is None else setup.plant.to_dict())
 
 
 def _resolved(setup: Setup) -> dict | None:

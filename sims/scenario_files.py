@@ -6,6 +6,8 @@
     planner = "my_planner.py:make"      # optional plug-ins, as --planner / --controller
     [parameters]                        # any of the scenario's parameters (``--help``)
     elevation = 30.0
+    [plant]                             # optional: the plant's uncertainty (README, "Campaigns")
+    payload_mass_error = 0.1
 
 ``planbench run DIR/summary.json`` reads the same three things from a run's summary, whose
 "parameters" hold every value resolved, and repeats that run. Both resolve to a ``Source``.
@@ -22,7 +24,7 @@ from pathlib import Path
 from sims.params import ParamError, Params, field_types, parse_value, set_overrides
 from sims.plugins import is_file, split_spec
 
-TOP_LEVEL_KEYS = ("scenario", "planner", "controller", "parameters")
+TOP_LEVEL_KEYS = ("scenario", "planner", "controller", "parameters", "plant")
 
 
 @dataclass(frozen=True)
@@ -35,6 +37,7 @@ class Source:
     plugins: dict
     origin: str
     recorded_versions: dict | None = None
+    plant: object = None
 
 
 def resolve(argument: str, get_scenario, known_names) -> Source:
@@ -43,7 +46,7 @@ def resolve(argument: str, get_scenario, known_names) -> Source:
     if argument in known_names or not (argument.endswith((".toml", ".json")) or "/" in argument
                                        or Path(argument).is_file()):
         scenario = get_scenario(argument)
-        return Source(scenario, scenario.params, {}, argument)
+        return Source(scenario, scenario.params, {}, argument, plant=scenario.plant)
     path = Path(argument)
     if not path.is_file():
         raise ParamError(f"scenario file {path} does not exist (or is not a file)")
@@ -54,6 +57,8 @@ def resolve(argument: str, get_scenario, known_names) -> Source:
                              "planbench run since scenario files exist)")
         # Every value as it ran (null: an optional value unset); plug-ins as they were given.
         run = {"scenario": data.get("scenario"), "parameters": data["parameters"], **(data.get("plugins") or {})}
+        if data.get("plant") is not None:
+            run["plant"] = data["plant"]
         return _from_data(path, run, get_scenario, data.get("versions"))
     return _from_data(path, _read(path, tomllib.loads, tomllib.TOMLDecodeError, "TOML"), get_scenario, None)
 
@@ -91,11 +96,15 @@ def _from_data(path: Path, data: dict, get_scenario, versions) -> Source:
     declared = {n: d for n, _, d, _ in type(scenario.params).declarations()}
     overrides = {k: (_beside(path, v) if k in declared and declared[k].path and isinstance(v, str) else v)
                  for k, v in overrides.items()}
+    plant = data.get("plant", {})
+    if not isinstance(plant, dict):
+        raise ParamError(f"{path}: key 'plant' must be a table, got {plant!r}")
     try:
         params = scenario.resolve(overrides)
+        plant = scenario.resolve_plant(plant)
     except ParamError as e:
         raise ParamError(f"{path}: {e}") from None
-    return Source(scenario, params, plugins, str(path), versions)
+    return Source(scenario, params, plugins, str(path), versions, plant)
 
 
 def _beside(path: Path, name: str) -> str:

@@ -42,6 +42,9 @@ class Scenario:
       control_dt: the control period, s (one tick: the shortest run).
       online_planner: the scenario's planner is an online one (the antenna's: ``reset`` and
         ``step``, sims.task.OnlinePlanner), not a ``plan(problem)`` that returns a Trajectory.
+      plant: the nominal plant (an instance of the mechanism's ``sims.params.PlantParams``:
+        its plant-uncertainty fields at their nominal values); ``build(..., plant=...)`` takes
+        a perturbed one. None: the mechanism declares no plant uncertainty.
     """
 
     name: str
@@ -56,11 +59,24 @@ class Scenario:
     demo_cameras: tuple = ()
     control_dt: float | None = None
     online_planner: bool = False
+    plant: object = None
 
     def resolve(self, overrides: dict | None = None, **changes):
         """The scenario's parameters with ``overrides`` (a mapping, as a scenario file's
         [parameters]) and ``changes`` applied and validated (a ParamError names a bad key)."""
         return type(self.params).from_mapping({**(overrides or {}), **changes}, base=self.params)
+
+    def resolve_plant(self, overrides: dict | None = None):
+        """The nominal plant with ``overrides`` (a scenario file's or a campaign's [plant]
+        table) applied and validated; a ParamError names a bad key, or says that this
+        scenario's mechanism declares no plant uncertainty."""
+        from sims.params import ParamError
+
+        if self.plant is None:
+            if overrides:
+                raise ParamError(f"plant: {self.name} declares no plant uncertainty, got {', '.join(overrides)}")
+            return None
+        return type(self.plant).from_mapping(dict(overrides or {}), base=self.plant, prefix="plant.")
 
 
 @functools.lru_cache(maxsize=1)

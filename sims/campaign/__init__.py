@@ -1,0 +1,138 @@
+"""Campaigns: many runs of a typed scenario, locally or on Ray (README, "Campaigns").
+
+``planbench sweep SPEC.toml --out DIR`` = ``sweep(...)``:
+  1. read and check the spec (sims.campaign.spec): every axis, value and distribution, and,
+     unless ``invalid = "skip"``, every run's parameters, before any run starts;
+  2. open DIR (sims.campaign.store): new, or the same spec resumed (finished runs skipped);
+  3. send chunks of runs to the engine (sims.campaign.engines: a spawned process pool or
+     Ray), and write each finished chunk's rows (one part file of the results table) and its
+     runs' summaries as they come, under a tqdm bar of runs done, failures and time left;
+  4. write results.parquet and the report (sims.campaign.report), print its table;
+  5. ``--rerun-worst K``: simulate the K worst runs again, with video, into DIR/worst/.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from tqdm import tqdm
+
+from sims.campaign import engines, report, spec as spec_module, store as store_module, worker
+
+#: Runs per task of a planner-only campaign (one vectorized judge_plans call each).
+PLAN_CHUNK = 5_000
+
+
+@dataclass
+class Outcome:
+    """What a campaign did: its summary (campaign.json), the runs run now, the table."""
+
+    summary: dict
+    ran: int
+    skipped: int
+    table: object
+    worst: list
+
+
+def context_of(spec) -> worker.Context:
+    return worker.Context(spec.scenario.name, spec.base_params.to_dict(),
+                          None if spec.base_plant is None else spec.base_plant.to_dict(),
+                          dict(spec.plugins), spec.mode, spec.save, tuple(a.column for a in spec.axes))
+
+
+def tasks_of(spec, runs) -> list[worker.RunTask]:
+    out = []
+    for run in runs:
+        params, plant = spec.overrides(run)
+        values = tuple(float(v) if a.leaf.kind == "float" else v for a, v in zip(spec.axes, run.values))
+        out.append(worker.RunTask(run.index, run.point, run.sample, run.replicate, run.seed, values, params, plant))
+    return out
+
+
+def check_runs(spec, runs, quiet: bool) -> None:
+    """Every run's parameters validated (a ParamError naming the first bad run)."""
+    for run in tqdm(runs, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False):
+        spec.resolve(run)
+
+
+def sweep(spec_path, out, engine: str = "local", workers: int | None = None, address: str | None = None,
+          rerun_worst: int = 0, quiet: bool = False, echo=print) -> Outcome:
+    """Run (or resume) the campaign of ``spec_path`` into ``out``; see the module's steps."""
+    from sims.params import ParamError
+
+    spec = spec_module.load(spec_path)
+    target = store_module.CampaignDir(out)
+    runner_engine = engines.make(engine, workers, address)
+    if rerun_worst < 0:
+        raise ParamError(f"--rerun-worst {rerun_worst} must be >= 0")
+    if rerun_worst and spec.mode == "plan":
+        raise ParamError("--rerun-worst replays simulated runs; a planner-only campaign has none")
+    runs = spec.runs()
+    if spec.invalid == "refuse":
+        check_runs(spec, runs, quiet)
+    with target.reserved():
+        target.open(spec, spec.path.read_text())
+        done = target.done()
+        pending = [r for r in runs if r.index not in done]
+        chunk_size = 1 if spec.mode == "simulate" else max(1, min(PLAN_CHUNK, math.ceil(
+            len(pending) / (4 * (runner_engine.workers or 1)))))
+        chunks = list(spec_module.iter_chunks(tasks_of(spec, pending), chunk_size))
+        if done and not quiet:
+            echo(f"resuming {target}: {len(done)} of {spec.size} runs done, {len(pending)} to go")
+        failed = errors = 0
+        bar = tqdm(total=spec.size, initial=len(done), unit="run", disable=quiet, desc="campaign", smoothing=0.1)
+        try:
+            for chunk, result in runner_engine.run(context_of(spec), chunks):
+                for index, files in result["files"].items():
+                    target.write_run_files(index, files, spec.scenario.name)
+                target.append(result["rows"], result["checks"])
+                failed += sum(r["status"] == "failed" for r in result["rows"])
+                errors += sum(r["status"] == "error" for r in result["rows"])
+                bar.set_postfix(failed=failed, errors=errors, refresh=False)
+                bar.update(len(result["rows"]))
+        finally:
+            bar.close()
+        table = target.table()
+        target.write_results(table)
+        summary = report.write(target, spec, table)
+        worst = []
+        if rerun_worst:
+            worst = rerun_worst_runs(spec, target, table, rerun_worst, quiet, echo)
+    return Outcome(summary, len(pending), len(done), table, worst)
+
+
+def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
+    """Simulate the ``k`` worst runs again with a video each, into DIR/worst/RANK-run-NNNNNN/;
+    the rerun's check values must equal the table's (the same parameters and seed)."""
+    import numpy as np
+
+    from sims import outputs, runner
+    from sims import plugins as plugin_module
+    from sims.api import build
+
+    picked = report.worst_runs(table, k, target.checks())
+    rows = {r["run"]: r for r in table.to_pylist() if r["run"] in set(picked)}
+    by_index = {run.index: run for run in spec.runs() if run.index in rows}
+    (target.path / "worst").mkdir(exist_ok=True)
+    out = []
+    for rank, index in enumerate(picked, start=1):
+        params, plant = spec.resolve(by_index[index])
+        made = {role: plugin_module.make(s, role, online_planner=spec.scenario.online_planner)
+                for role, s in spec.plugins.items()}
+        setup = build(spec.scenario, params, plant, **made)
+        result = runner.run(spec.scenario.name, setup, quiet=quiet)
+        result.plugins = dict(spec.plugins)
+        folder = target.path / "worst" / f"{rank:02d}-run-{index:06d}"
+        directory = outputs.OutputDir(folder, option="--rerun-worst")
+        outputs.write_run(result, setup, directory, video=folder / f"{spec.scenario.name}.mp4",
+                          camera=spec.scenario.camera, quiet=quiet)
+        row = rows[index]
+        differ = [c.name for c in result.checks
+                  if not np.array_equal(np.float64(c.value), np.float64(row.get(f"check.{c.name}", np.nan)),
+                                        equal_nan=True)]
+        note = "" if not differ else f" (differs from the campaign's row in {', '.join(differ)})"
+        echo(f"worst #{rank}: run {index} ({spec.describe(by_index[index])}): "
+             f"{'passed' if result.passed else 'FAILED'} -> {folder}{note}")
+        out.append((index, folder, differ))
+    return out

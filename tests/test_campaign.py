@@ -1,0 +1,310 @@
+"""Campaigns (planbench sweep): specs, engines, resume after SIGKILL, the report, bad specs.
+
+The campaign of these tests is 2 x 2 grid points x 2 seeds of hexapod-sync-move (8 runs of
+about a second each), run once on the local pool and once on Ray; the tables must be equal
+run for run (every column but the wall time).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from sims import cli
+from sims.campaign import report, spec as spec_module
+from sims.campaign.store import CampaignDir
+from sims.params import ParamError
+
+PLANBENCH = [sys.executable, "-m", "sims.cli"]
+
+SPEC = """\
+scenario = "hexapod-sync-move"
+seed = 11
+seeds = 2
+[grid]
+wind = [0.0, 6.0]
+elevation = [30.0, 90.0]
+"""
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
+
+
+def _comparable(table):
+    """The table without its timing columns (the only ones that may differ between runs)."""
+    return table.drop([c for c in ("wall_s",) if c in table.column_names])
+
+
+@pytest.fixture(scope="module")
+def local_campaign(tmp_path_factory):
+    root = tmp_path_factory.mktemp("campaign")
+    spec = _write(root / "spec.toml", SPEC)
+    out = root / "local"
+    code = cli.main(["sweep", str(spec), "--out", str(out), "--workers", "2", "--quiet"])
+    assert code == cli.EXIT_OK
+    return spec, out, pq.read_table(out / "results.parquet")
+
+
+def test_campaign_table_has_a_row_per_run(local_campaign):
+    spec_path, out, table = local_campaign
+    spec = spec_module.load(spec_path)
+    assert table.num_rows == spec.size == 8
+    assert table.column("run").to_pylist() == list(range(8))
+    # Run r of point p, replicate k: the grid in written order, seeds innermost.
+    assert table.column("wind").to_pylist() == [0.0] * 4 + [6.0] * 4
+    assert table.column("elevation").to_pylist() == [30.0, 30.0, 90.0, 90.0] * 2
+    seeds = table.column("seed").to_pylist()
+    assert seeds[0::2] == [seeds[0]] * 4 and seeds[1::2] == [seeds[1]] * 4 and seeds[0] != seeds[1]
+    assert set(table.column("status").to_pylist()) == {"passed"}
+    for name in ("pose_error_final", "strut_force", "following_error"):
+        assert np.all(np.isfinite(table.column(f"check.{name}").to_numpy()))
+    # Each run's summary.json is the run: its parameters and seed are the row's.
+    summary = json.loads((out / "runs" / "000005" / "summary.json").read_text())
+    assert summary["seed"] == seeds[5]
+    assert summary["parameters"]["wind"] == 6.0 and summary["parameters"]["elevation"] == 30.0
+    value = [c["value"] for c in summary["checks"] if c["name"] == "pose_error_final"][0]
+    assert value == table.column("check.pose_error_final")[5].as_py()
+    # The wind changes the strut forces' spread: the axis reaches the physics.
+    force = table.column("check.following_error").to_numpy()
+    assert force[4:].mean() > force[:4].mean()
+
+
+def test_campaign_report(local_campaign):
+    _, out, table = local_campaign
+    summary = json.loads((out / "campaign.json").read_text())
+    assert summary["overall"]["counted"] == 8 and summary["overall"]["passed"] == 8
+    low, high = summary["overall"]["pass_rate_ci95"]
+    # Wilson's interval of 8 of 8: [n / (n + z^2), 1].
+    z = 1.959963984540054
+    assert low == pytest.approx(8 / (8 + z * z), rel=1e-9) and high == pytest.approx(1.0)
+    point = summary["by_point"][3]
+    assert point["grid"] == {"wind": 6.0, "elevation": 90.0} and point["counted"] == 2
+    values = table.column("check.pose_error_final").to_numpy()[6:8]
+    assert point["checks"]["pose_error_final"]["median"] == pytest.approx(np.median(values))
+    assert point["checks"]["pose_error_final"]["p95"] == pytest.approx(np.percentile(values, 95))
+    assert summary["checks"]["pose_error_final"]["limit"] == 1.0
+    assert (out / "campaign.png").stat().st_size > 10_000
+    assert sorted(p.name for p in (out / "plots").iterdir()) == sorted(f"{n}.png" for n in summary["checks"])
+
+
+def test_wilson_interval_against_the_formula():
+    for k, n in ((0, 10), (3, 10), (7, 9), (50, 100)):
+        z = 1.959963984540054
+        p = k / n
+        centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+        half = z / (1 + z * z / n) * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+        low, high = report.wilson(k, n)
+        assert low == pytest.approx(max(0.0, centre - half), abs=1e-12)
+        assert high == pytest.approx(min(1.0, centre + half), abs=1e-12)
+    assert report.wilson(0, 0) == (None, None)
+
+
+def test_resume_skips_finished_runs_and_keeps_their_rows(local_campaign, capsys):
+    spec, out, table = local_campaign
+    before = {p.name: p.stat().st_mtime_ns for p in (out / "table").iterdir()}
+    code = cli.main(["sweep", str(spec), "--out", str(out), "--quiet"])
+    assert code == cli.EXIT_OK
+    assert "(0 run now, 8 resumed)" in capsys.readouterr().out
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "table").iterdir()} == before
+    assert _comparable(pq.read_table(out / "results.parquet")).equals(_comparable(table))
+
+
+def test_a_changed_spec_is_refused(local_campaign, tmp_path, capsys):
+    spec, out, _ = local_campaign
+    changed = _write(tmp_path / "spec.toml", SPEC.replace("seed = 11", "seed = 12"))
+    before = sorted(p.name for p in (out / "table").iterdir())
+    code = cli.main(["sweep", str(changed), "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert code == cli.EXIT_BAD_INPUT and len(err.splitlines()) == 1 and "another spec" in err
+    assert sorted(p.name for p in (out / "table").iterdir()) == before
+
+
+def test_ray_engine_gives_the_same_table(local_campaign, tmp_path):
+    ray = pytest.importorskip("ray", reason="the ray extra is not installed (pip install 'planbench[ray]')")
+    spec, _, table = local_campaign
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False)
+    try:
+        code = cli.main(["sweep", str(spec), "--out", str(tmp_path / "ray"), "--engine", "ray", "--quiet"])
+    finally:
+        ray.shutdown()
+    assert code == cli.EXIT_OK
+    assert _comparable(pq.read_table(tmp_path / "ray" / "results.parquet")).equals(_comparable(table))
+
+
+def test_sigkill_then_resume_loses_and_duplicates_nothing(local_campaign, tmp_path):
+    spec, _, table = local_campaign
+    out = tmp_path / "killed"
+    process = subprocess.Popen([*PLANBENCH, "sweep", str(spec), "--out", str(out), "--workers", "2", "--quiet"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.monotonic() + 120
+    try:
+        while time.monotonic() < deadline:
+            parts = list((out / "table").glob("part-*.parquet")) if (out / "table").is_dir() else []
+            if len(parts) >= 2 or process.poll() is not None:
+                break
+            time.sleep(0.05)
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)  # the campaign and its workers, mid-run
+        process.wait()
+    killed = CampaignDir(out)
+    done = killed.done()
+    assert 2 <= len(done) < 8, f"the kill came too late to test anything ({len(done)} rows)"
+    rows_before = killed.table()
+    assert len(rows_before.column("run").to_pylist()) == len(set(rows_before.column("run").to_pylist()))
+    code = cli.main(["sweep", str(spec), "--out", str(out), "--quiet"])
+    assert code == cli.EXIT_OK
+    after = pq.read_table(out / "results.parquet")
+    assert after.column("run").to_pylist() == list(range(8))
+    assert _comparable(after).equals(_comparable(table))
+    # The rows of the killed campaign are kept as they were written.
+    kept = after.filter(np.isin(after.column("run").to_numpy(), sorted(done)))
+    assert _comparable(kept).equals(_comparable(rows_before))
+
+
+def test_a_run_that_raises_is_a_row_not_a_crash(tmp_path, capsys):
+    planner = _write(tmp_path / "bad_planner.py", """
+from planners.hexapod import PaperMovePlanner
+
+class Picky(PaperMovePlanner):
+    def plan(self, problem):
+        if problem.target_pose[0] > 0.0015:
+            raise RuntimeError("refuses long moves")
+        return super().plan(problem)
+
+def make():
+    return Picky()
+""")
+    spec = _write(tmp_path / "spec.toml", """
+scenario = "hexapod-sync-move"
+planner = "bad_planner.py:make"
+[parameters]
+duration = 1.0
+[grid]
+"moves[0].target[0]" = [1.0, 2.0]
+""")
+    code = cli.main(["sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"])
+    assert code == cli.EXIT_CHECK_FAILED
+    table = pq.read_table(tmp_path / "out" / "results.parquet")
+    assert table.column("status").to_pylist()[1] == "error"
+    assert "refuses long moves" in table.column("error").to_pylist()[1]
+    assert table.column("status").to_pylist()[0] in ("passed", "failed")
+    assert "1 errors" in capsys.readouterr().out or True
+
+
+# ------------------------------------------------------------------------------ bad specs
+
+BAD_SPECS = {
+    "unknown parameter": ('scenario = "hexapod-sync-move"\n[grid]\nwindd = [1.0]\n', "unknown parameter 'windd'"),
+    "empty axis": ('scenario = "hexapod-sync-move"\n[grid]\nwind = []\n', "grid.wind is empty"),
+    "distribution outside the range": (
+        'scenario = "hexapod-sync-move"\nsamples = 4\n[random]\nwind = { distribution = "uniform", low = 10.0, high = 60.0 }\n',
+        "outside wind's range [0, 50] m/s"),
+    "untruncated normal on a bounded parameter": (
+        'scenario = "hexapod-sync-move"\nsamples = 4\n[random]\nwind = { distribution = "normal", mean = 4.0, std = 1.0 }\n',
+        "truncate it"),
+    "grid value out of range": ('scenario = "hexapod-sync-move"\n[grid]\nelevation = [20.0, 95.0]\n', "elevation = 95"),
+    "unknown key": ('scenario = "hexapod-sync-move"\nsed = 3\n', "unknown key 'sed'"),
+    "unknown scenario": ('scenario = "no-such"\n', "no-such"),
+    "plant of nothing": ('scenario = "hexapod-sync-move"\n[grid.plant]\nnot_a_field = [1.0]\n', "not_a_field"),
+    "seed as an axis": ('scenario = "hexapod-sync-move"\n[grid]\nseed = [1, 2]\n', "seeds = N"),
+    "index beyond the list": ('scenario = "hexapod-sync-move"\n[grid]\n"moves[3].target[0]" = [1.0]\n', "moves[3]"),
+    "plan mode without planner checks": ('scenario = "antenna-sea-state"\nmode = "plan"\n', "planner-only"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_SPECS))
+def test_bad_spec_exits_2_with_one_line_before_any_run(case, tmp_path):
+    text, expected = BAD_SPECS[case]
+    spec = _write(tmp_path / "spec.toml", text)
+    out = tmp_path / "out"
+    result = subprocess.run([*PLANBENCH, "sweep", str(spec), "--out", str(out), "--quiet"],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert expected in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
+def test_a_foreign_directory_is_refused(tmp_path):
+    spec = _write(tmp_path / "spec.toml", SPEC)
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep me")
+    with pytest.raises(Exception, match="not a planbench campaign"):
+        CampaignDir(out)
+    assert cli.main(["sweep", str(spec), "--out", str(out), "--quiet"]) == cli.EXIT_BAD_INPUT
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_an_invalid_combination_is_refused_or_skipped(tmp_path):
+    # Each axis value is valid on the base; together, run 1's target equals its start: a move
+    # of zero length, a limit between parameters.
+    text = ('scenario = "hexapod-sync-move"\n[parameters]\nmoves = [{ target = [3, 0, 0, 0, 0, 0] }]\n'
+            'start_pose = [2, 0, 0, 0, 0, 0]\n[grid]\n"start_pose[0]" = [1.0]\n"moves[0].target[0]" = [4.0, 1.0]\n')
+    spec = spec_module.load(_write(tmp_path / "refuse.toml", text))
+    spec.resolve(spec.runs()[0])
+    with pytest.raises(ParamError, match=r"run 1 \(start_pose\[0\] = 1, moves\[0\]\.target\[0\] = 1, .*zero length"):
+        spec.resolve(spec.runs()[1])
+    result = subprocess.run([*PLANBENCH, "sweep", str(tmp_path / "refuse.toml"), "--out", str(tmp_path / "out"),
+                             "--quiet"], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2 and "run 1" in result.stderr and not (tmp_path / "out").exists()
+    spec = spec_module.load(_write(tmp_path / "skip.toml", 'invalid = "skip"\n' + text))
+    from sims.campaign import context_of, tasks_of, worker
+
+    result = worker.run_chunk(context_of(spec), tasks_of(spec, spec.runs())[1:])
+    assert result["rows"][0]["status"] == "invalid" and "zero length" in result["rows"][0]["error"]
+
+
+# ------------------------------------------------------------------------------ determinism
+
+@settings(max_examples=30)
+@given(seed=st.integers(0, 2**63 - 1), samples=st.integers(1, 5), seeds=st.integers(1, 4),
+       winds=st.lists(st.floats(0.0, 50.0), min_size=1, max_size=3, unique=True))
+def test_the_same_spec_gives_the_same_runs(tmp_path_factory, seed, samples, seeds, winds):
+    folder = tmp_path_factory.mktemp("spec")
+    text = (f'scenario = "hexapod-sync-move"\nseed = {seed}\nseeds = {seeds}\nsamples = {samples}\n'
+            f'[grid]\nwind = {[float(w) for w in winds]}\n'
+            '[random]\nelevation = { distribution = "uniform", low = 20.0, high = 90.0 }\n')
+    a = spec_module.load(_write(folder / "a.toml", text))
+    b = spec_module.load(_write(folder / "b.toml", text))
+    runs_a, runs_b = a.runs(), b.runs()
+    assert runs_a == runs_b and a.fingerprint == b.fingerprint
+    assert len(runs_a) == len(winds) * samples * seeds
+    for run in runs_a:
+        assert run.index == (run.point * samples + run.sample) * seeds + run.replicate
+        assert run.values[0] == winds[run.point]
+        assert 20.0 <= run.values[1] <= 90.0
+    # Common random numbers: a sample's draw and seed are the same at every grid point.
+    by_place = {}
+    for run in runs_a:
+        by_place.setdefault((run.sample, run.replicate), set()).add((run.seed, run.values[1]))
+    assert all(len(v) == 1 for v in by_place.values())
+    assert len({r.seed for r in runs_a}) == samples * seeds
+
+
+def test_distributions_draw_what_they_name(tmp_path):
+    text = ('scenario = "hexapod-sync-move"\nseed = 3\nsamples = 20000\n[random]\n'
+            'wind = { distribution = "normal", mean = 5.0, std = 1.0, low = 3.0, high = 9.0 }\n'
+            'elevation = { distribution = "log-uniform", low = 20.0, high = 80.0 }\n'
+            '"start_pose[0]" = { distribution = "uniform", low = -1.0, high = 1.0 }\n')
+    spec = spec_module.load(_write(tmp_path / "s.toml", text))
+    wind, elevation, x = spec.draws()
+    assert wind.min() >= 3.0 and wind.max() <= 9.0
+    from scipy import stats
+
+    assert stats.kstest(wind, stats.truncnorm(-2.0, 4.0, loc=5.0, scale=1.0).cdf).pvalue > 1e-3
+    assert stats.kstest(np.log(elevation), stats.uniform(np.log(20), np.log(4)).cdf).pvalue > 1e-3
+    assert stats.kstest(x, stats.uniform(-1, 2).cdf).pvalue > 1e-3
