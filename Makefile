@@ -1,5 +1,6 @@
 # planbench: `make demo` runs every scenario with videos, `make test` runs the test suite.
-# Both create .venv and install the project into it when needed (pyproject.toml changed).
+# Both create .venv and install the project into it when needed (pyproject.toml changed),
+# with the optional Ray extra, so that the tests cover both campaign engines.
 
 PYTHON ?= python3
 VENV := .venv
@@ -10,7 +11,7 @@ STAMP := $(VENV)/.installed-stamp
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test,ray]'
 	@touch $(STAMP)
 
 demo: $(STAMP)

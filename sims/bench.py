@@ -125,6 +125,71 @@ def format_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+#: The campaign that ``planbench bench`` times: 2 x 2 grid points x 2 seeds of a hexapod
+#: move with 40 s simulated (about 2 s of wall time per run), so that the workers' start
+#: (spawning, importing MuJoCo) is a small part of it.
+CAMPAIGN_SPEC = """\
+scenario = "hexapod-sync-move"
+seed = 1
+seeds = 2
+[parameters]
+duration = 40.0
+[grid]
+wind = [0.0, 6.0]
+elevation = [30.0, 90.0]
+"""
+
+
+def campaign_throughput() -> list[dict]:
+    """Runs per second of the same 8-run campaign on the local engine with 1 and 2 workers
+    and on Ray with 2 CPUs, one after the other in this process. Each is timed from the
+    first run sent to the last row written (sims.campaign.Outcome.engine_wall_s): the local
+    pool's spawning of its workers is inside, Ray's own start (``ray.init``, a cluster that
+    is already up) is not. The tables must be equal run for run."""
+    import tempfile
+    from pathlib import Path
+
+    from sims import campaign
+    from sims.campaign.engines import ray_available
+
+    rows, tables = [], []
+    with tempfile.TemporaryDirectory(prefix="planbench-bench-") as tmp:
+        spec = Path(tmp) / "campaign.toml"
+        spec.write_text(CAMPAIGN_SPEC)
+        cases = [("local", 1), ("local", 2)] + ([("ray", 2)] if ray_available() else [])
+        for engine, workers in cases:
+            ray = None
+            if engine == "ray":
+                import ray
+
+                ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
+            try:
+                outcome = campaign.sweep(spec, Path(tmp) / f"{engine}-{workers}", engine=engine, workers=workers,
+                                         quiet=True, echo=lambda *_: None)
+            finally:
+                if ray is not None:
+                    ray.shutdown()
+            tables.append(outcome.table.drop(["wall_s"]))
+            rows.append({"engine": engine, "workers": workers, "runs": outcome.ran, "wall_s": outcome.engine_wall_s,
+                         "runs_per_s": outcome.ran / outcome.engine_wall_s})
+    same = all(t.equals(tables[0]) for t in tables[1:])
+    for r in rows:
+        r["same_table"] = same
+    return rows
+
+
+def format_campaign(rows: list[dict]) -> str:
+    base = {r["engine"]: r for r in rows if r["workers"] == 1}.get("local")
+    two = next((r for r in rows if r["engine"] == "local" and r["workers"] == 2), None)
+    lines = [f"{'campaign throughput (8 runs)':<30} {'wall s':>7} {'runs/s':>7} {'vs local x1':>11} {'vs local x2':>11}"]
+    for r in rows:
+        lines.append(f"{r['engine'] + ' x' + str(r['workers']):<30} {r['wall_s']:>7.2f} {r['runs_per_s']:>7.3f} "
+                     f"{r['runs_per_s'] / base['runs_per_s']:>11.2f} {r['runs_per_s'] / two['runs_per_s']:>11.2f}")
+    lines.append("targets: local x2 >= 1.7 x local x1; ray x2 >= 0.9 x local x2 (issue 15); tables equal run for run: "
+                 + ("yes" if rows and rows[0]["same_table"] else "NO"))
+    return "\n".join(lines)
+
+
 def planner_benchmarks() -> list[str]:
     """Each mechanism's planner rows (``sims/<mechanism>/bench.py``'s ``planner_benchmark``,
     where it has one), in the registry's order."""

@@ -257,6 +257,8 @@ def cmd_bench(args) -> int:
     for text in bench.planner_benchmarks():
         print()
         print(text)
+    print()
+    print(bench.format_campaign(bench.campaign_throughput()))
     return EXIT_OK
 
 

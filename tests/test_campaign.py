@@ -308,3 +308,48 @@ def test_distributions_draw_what_they_name(tmp_path):
     assert stats.kstest(wind, stats.truncnorm(-2.0, 4.0, loc=5.0, scale=1.0).cdf).pvalue > 1e-3
     assert stats.kstest(np.log(elevation), stats.uniform(np.log(20), np.log(4)).cdf).pvalue > 1e-3
     assert stats.kstest(x, stats.uniform(-1, 2).cdf).pvalue > 1e-3
+
+
+def test_rerun_worst_replays_the_worst_run_with_a_video(tmp_path, capsys):
+    spec = _write(tmp_path / "spec.toml", """
+scenario = "hexapod-sync-move"
+seed = 5
+[parameters]
+duration = 1.5
+[grid]
+wind = [0.0, 8.0]
+""")
+    out = tmp_path / "out"
+    code = cli.main(["sweep", str(spec), "--out", str(out), "--workers", "1", "--quiet", "--rerun-worst", "1"])
+    assert code in (cli.EXIT_OK, cli.EXIT_CHECK_FAILED)
+    table = pq.read_table(out / "results.parquet")
+    summary = json.loads((out / "campaign.json").read_text())
+    meta = {n: {"comparison": c["comparison"]} for n, c in summary["checks"].items()}
+    worst = report.worst_runs(table, 1, meta)
+    folder = out / "worst" / f"01-run-{worst[0]:06d}"
+    assert (folder / "hexapod-sync-move.mp4").stat().st_size > 10_000
+    rerun = json.loads((folder / "summary.json").read_text())
+    row = table.to_pylist()[worst[0]]
+    for check in rerun["checks"]:  # null in JSON is a check that could not be evaluated: NaN
+        value = math.nan if check["value"] is None else check["value"]
+        assert np.array_equal(value, row[f"check.{check['name']}"], equal_nan=True), check["name"]
+    assert "differs" not in capsys.readouterr().out
+
+
+def test_worst_runs_rank_by_the_ratio_to_the_limit():
+    import pyarrow as pa
+
+    table = pa.table({"run": [0, 1, 2, 3], "status": ["passed", "failed", "error", "passed"],
+                      "check.a": [0.5, 1.2, None, 0.9], "limit.a": [1.0, 1.0, None, 1.0],
+                      "check.b": [10.0, 10.0, None, 2.0], "limit.b": [5.0, 5.0, None, 5.0]})
+    meta = {"a": {"comparison": "<="}, "b": {"comparison": ">="}}
+    # run 3: b is 2 where it must be >= 5 (ratio 2.5); run 1: a is 1.2 of its limit; run 0: 0.5.
+    assert report.worst_runs(table, 4, meta) == [3, 1, 0]
+
+
+@pytest.mark.parametrize("example", sorted(str(p) for p in Path("examples").glob("*/*campaign*.toml")) +
+                         sorted(str(p) for p in Path("examples").glob("*/random_*.toml")))
+def test_example_campaign_specs_are_valid(example):
+    spec = spec_module.load(example)
+    assert spec.size >= 1 and spec.axes
+    spec.resolve(spec.runs()[0])

@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 from tqdm import tqdm
@@ -33,6 +34,7 @@ class Outcome:
     skipped: int
     table: object
     worst: list
+    engine_wall_s: float = 0.0  # from the first chunk sent to the last row written (workers' start included)
 
 
 def context_of(spec) -> worker.Context:
@@ -82,6 +84,7 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
             echo(f"resuming {target}: {len(done)} of {spec.size} runs done, {len(pending)} to go")
         failed = errors = 0
         bar = tqdm(total=spec.size, initial=len(done), unit="run", disable=quiet, desc="campaign", smoothing=0.1)
+        start = time.perf_counter()
         try:
             for chunk, result in runner_engine.run(context_of(spec), chunks):
                 for index, files in result["files"].items():
@@ -93,13 +96,14 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
                 bar.update(len(result["rows"]))
         finally:
             bar.close()
+        engine_wall = time.perf_counter() - start
         table = target.table()
         target.write_results(table)
         summary = report.write(target, spec, table)
         worst = []
         if rerun_worst:
             worst = rerun_worst_runs(spec, target, table, rerun_worst, quiet, echo)
-    return Outcome(summary, len(pending), len(done), table, worst)
+    return Outcome(summary, len(pending), len(done), table, worst, engine_wall)
 
 
 def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:

@@ -211,7 +211,7 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
                 xlabel = "run"
             else:
                 x, labels = _axis_values(table, axis.column)
-                xlabel = axis.column
+                xlabel = axis.column + (f" ({axis.unit})" if axis.unit else "")
             sel = np.flatnonzero(keep)[::stride]
             ax_plot.plot(x[sel], value[sel], ".", alpha=0.35 if sel.size > 200 else 0.7, ms=3, color="tab:blue",
                          label="runs" + (f" (every {stride}th)" if stride > 1 else ""))
@@ -287,11 +287,10 @@ def plot_page(spec, table: pa.Table, summary: dict, path) -> None:
                         for p in points])
         p5 = np.array([np.nan if p["checks"].get(name, {}).get("p5") is None else p["checks"][name]["p5"] for p in points])
         p95 = np.array([np.nan if p["checks"].get(name, {}).get("p95") is None else p["checks"][name]["p95"] for p in points])
-        ax.fill_between(x, p5, p95, alpha=0.25, step="mid" if len(points) > 1 else None)
-        ax.plot(x, med, "o-", ms=3)
+        ax.errorbar(x, med, yerr=[med - p5, p95 - med], fmt="o-", ms=3, capsize=3, lw=1)
         if meta.get("limit") is not None:
             ax.axhline(meta["limit"], color="tab:red", ls="--", lw=1)
-        ax.set_title(f"{name} ({meta.get('unit', '')})", fontsize=8)
+        ax.set_title(f"{name} ({meta.get('unit', '')}): median, 5-95 % per point", fontsize=8)
         ax.set_xticks(x, [str(i) for i in x], fontsize=6)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)

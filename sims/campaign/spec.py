@@ -238,6 +238,12 @@ class Axis:
         """Its column in the results table."""
         return ("plant." if self.plant else "") + self.key
 
+    @property
+    def unit(self) -> str:
+        from sims.params import unit_of
+
+        return unit_of(self.leaf.declared, self.leaf.column) if self.leaf.kind in ("float", "int") else ""
+
 
 @dataclass(frozen=True)
 class Run:
