@@ -42,6 +42,9 @@ class Scenario:
       control_dt: the control period, s (one tick: the shortest run).
       online_planner: the scenario's planner is an online one (the antenna's: ``reset`` and
         ``step``, sims.task.OnlinePlanner), not a ``plan(problem)`` that returns a Trajectory.
+      judge_plans: optional (list of params, planner=None) -> one list of checks per params:
+        the run's planner checks on the planned trajectory alone, no physics, vectorized
+        over the list (planner-only campaigns, ``mode = "plan"``).
       plant: the nominal plant (an instance of the mechanism's ``sims.params.PlantParams``:
         its plant-uncertainty fields at their nominal values); ``build(..., plant=...)`` takes
         a perturbed one. None: the mechanism declares no plant uncertainty.
@@ -60,6 +63,7 @@ class Scenario:
     control_dt: float | None = None
     online_planner: bool = False
     plant: object = None
+    judge_plans: Callable | None = None
 
     def resolve(self, overrides: dict | None = None, **changes):
         """The scenario's parameters with ``overrides`` (a mapping, as a scenario file's

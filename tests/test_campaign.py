@@ -226,16 +226,24 @@ BAD_SPECS = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD_SPECS))
-def test_bad_spec_exits_2_with_one_line_before_any_run(case, tmp_path):
+def test_bad_spec_exits_2_with_one_line_before_any_run(case, tmp_path, capsys):
     text, expected = BAD_SPECS[case]
     spec = _write(tmp_path / "spec.toml", text)
     out = tmp_path / "out"
-    result = subprocess.run([*PLANBENCH, "sweep", str(spec), "--out", str(out), "--quiet"],
-                            capture_output=True, text=True, timeout=120)
-    assert result.returncode == 2, result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
-    assert expected in result.stderr and "Traceback" not in result.stderr
+    code = cli.main(["sweep", str(spec), "--out", str(out), "--quiet"])
+    captured = capsys.readouterr()
+    assert code == cli.EXIT_BAD_INPUT, captured.err
+    assert len(captured.err.strip().splitlines()) == 1, captured.err
+    assert expected in captured.err and "Traceback" not in captured.err
     assert not out.exists()
+
+
+def test_bad_spec_from_the_shell_has_no_traceback(tmp_path):
+    spec = _write(tmp_path / "spec.toml", BAD_SPECS["empty axis"][0])
+    result = subprocess.run([*PLANBENCH, "sweep", str(spec), "--out", str(tmp_path / "out")],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1 and "grid.wind is empty" in result.stderr
+    assert not (tmp_path / "out").exists()
 
 
 def test_a_foreign_directory_is_refused(tmp_path):

@@ -9,11 +9,15 @@ the wind (turbulent drag on the camera).
 
 The hexapod frame is the model's body ``top_end`` (models/hexapod/hexapod.xml); the model is
 recompiled per elevation with the top end tilted (MjSpec), so gravity stays the world's -z.
+Plant uncertainty (``HexapodPlant``: camera mass and centre of mass, pivot circles, drive
+stiffness and force limit, encoder bias) perturbs the simulated hexapod only (``build(...,
+plant=)``, models/hexapod/README.md "Plant uncertainty").
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -33,8 +37,9 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
-from sims.params import Params, ParamError, ScenarioParams, param
-from sims.task import JointEncoders, plan_checked
+from sims.params import Params, ParamError, PlantParams, ScenarioParams, param
+from sims.plant import set_inertial
+from sims.task import JointEncoders, nominal_copy, plan_checked
 from sims.wind import MAX_MEAN_SPEED_M_S, BodyWindDrag, horizontal_direction
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
@@ -95,6 +100,20 @@ def check_elevation(elevation_deg: float) -> float:
 
 @functools.lru_cache(maxsize=16)
 def _compiled(elevation_deg: float) -> mujoco.MjModel:
+    """The nominal scene at ``elevation_deg`` (deg), compiled."""
+    return _spec(elevation_deg).compile()
+
+
+@functools.lru_cache(maxsize=16)
+def _compiled_plant(elevation_deg: float, plant: "HexapodPlant") -> mujoco.MjModel:
+    """The scene at ``elevation_deg`` (deg) perturbed into the plant ``plant``, compiled."""
+    spec = _spec(elevation_deg)
+    apply_plant(spec, plant, _compiled(elevation_deg))
+    return spec.compile()
+
+
+def _spec(elevation_deg: float) -> mujoco.MjSpec:
+    """The scene's MjSpec with the top end tilted to ``elevation_deg`` (deg)."""
     spec = mujoco.MjSpec.from_file(str(models.scene_path("hexapod")))
     top_end = spec.body("top_end")
     rotation = top_end_rotation(elevation_deg)
@@ -110,17 +129,76 @@ def _compiled(elevation_deg: float) -> mujoco.MjModel:
     qpos[-7:-4] = platform_pos
     qpos[-4:] = quat
     key.qpos = qpos
-    return spec.compile()
+    return spec
+
+
+def _radial(xyz, error: float) -> np.ndarray:
+    """``xyz`` (3,) with its (x, y) moved radially by ``error`` (m): a pivot on a circle about
+    the hexapod axis whose radius is ``error`` larger."""
+    xyz = np.array(xyz, dtype=float)
+    xyz[:2] *= 1.0 + error / math.hypot(xyz[0], xyz[1])
+    return xyz
+
+
+def apply_plant(spec: mujoco.MjSpec, plant: "HexapodPlant", nominal: mujoco.MjModel) -> None:
+    """Edit the hexapod's MjSpec into the plant ``plant`` (``nominal``: the same spec
+    compiled unperturbed). Each edit touches only its own elements:
+
+    * camera_mass_error, camera_com_offset: the camera body's mass and central inertia times
+      (1 + error), its centre of mass moved by the offset (m, hexapod frame = the camera body's
+      frame), its principal axes kept (``sims.plant.set_inertial``; the geoms stay);
+    * base_pivot_radius_error, platform_pivot_radius_error: the six base pivot sites and the
+      strut housings on them, or the six mirror-side pivot sites, moved radially (m). The
+      struts keep their built lengths (the rods' zero), so the loops close elsewhere;
+    * drive_stiffness_error: every strut drive's kp (gain and bias term) times (1 + error);
+    * drive_force_scale: every drive's force range times the scale;
+    * encoder_bias_um: the drives close their loop on the biased encoder, so the drive force
+      is kp (set-point - (q + b)) - kv qdot: affine bias term biasprm[0] = -kp b.
+    """
+    if plant.camera_mass_error or any(plant.camera_com_offset):
+        set_inertial(spec, nominal, "camera", 1.0 + plant.camera_mass_error, plant.camera_com_offset)
+    for i, name in enumerate(STRUT_LABELS):
+        if plant.base_pivot_radius_error:
+            site, housing = spec.site(f"base_pivot{i + 1}"), spec.body(f"{name}_housing")
+            site.pos = _radial(site.pos, plant.base_pivot_radius_error)
+            housing.pos = _radial(housing.pos, plant.base_pivot_radius_error)
+        if plant.platform_pivot_radius_error:
+            site = spec.site(f"platform_pivot{i + 1}")
+            site.pos = _radial(site.pos, plant.platform_pivot_radius_error)
+    bias = plant.encoder_bias_si()
+    for j, name in enumerate(STRUT_LABELS):
+        actuator = spec.actuator(name)
+        gain, biasprm = np.array(actuator.gainprm), np.array(actuator.biasprm)
+        if plant.drive_stiffness_error:
+            gain[0] *= 1.0 + plant.drive_stiffness_error
+            biasprm[1] = -gain[0]
+        if bias[j]:
+            biasprm[0] = -gain[0] * bias[j]
+        actuator.gainprm, actuator.biasprm = gain, biasprm
+        if plant.drive_force_scale != 1.0:
+            actuator.forcerange = plant.drive_force_scale * np.asarray(actuator.forcerange)
 
 
 class HexapodPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/hexapod/scene.xml at one telescope elevation."""
 
+    #: The pivots of the machine simulated (a perturbed plant's instance has its own) and its
+    #: encoders' biases (m; None: none).
+    geometry = RUBIN_CAMERA
+    encoder_bias = None
+
     @classmethod
-    def load(cls, elevation_deg: float = 90.0) -> "HexapodPhysics":
+    def load(cls, elevation_deg: float = 90.0, plant: "HexapodPlant | None" = None) -> "HexapodPhysics":
+        """The scene at ``elevation_deg`` (deg) at its home keyframe; ``plant`` (None: the
+        nominal plant) the true machine, perturbed as ``HexapodPlant`` says (``apply_plant``)."""
         elevation_deg = check_elevation(elevation_deg)
-        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(_compiled(elevation_deg))))
+        nominal = plant is None or plant.is_nominal
+        model = _compiled(elevation_deg) if nominal else _compiled_plant(elevation_deg, plant)
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(model)))
         physics.elevation_deg = elevation_deg
+        if not nominal:
+            physics.geometry = plant.geometry()
+            physics.encoder_bias = plant.encoder_bias_si()
         physics.reset(keyframe_id=0)
         return physics
 
@@ -165,6 +243,11 @@ class HexapodPhysics(dm_mujoco.Physics):
     def strut_positions(self) -> np.ndarray:
         """Encoder readings: strut length changes from the zero pose, m."""
         return self.data.qpos[self.strut_qpos].copy()
+
+    def drive_positions(self, strut_positions: np.ndarray) -> np.ndarray:
+        """What the drives' encoders read for true strut positions (m, (..., 6)): plus their
+        bias."""
+        return strut_positions if self.encoder_bias is None else strut_positions + self.encoder_bias
 
     def strut_velocities(self) -> np.ndarray:
         return self.data.qvel[self.strut_dofs].copy()
@@ -218,14 +301,14 @@ class HexapodPhysics(dm_mujoco.Physics):
         pose = np.asarray(pose, dtype=float)
         model, data = self.model.ptr, self.data.ptr
         origin, rotation = self.top_end_frame
-        position, r_pose = hexapod_planner.platform_frame(pose)
+        position, r_pose = hexapod_planner.platform_frame(pose, self.geometry)
         data.qpos[self._free_qpos:self._free_qpos + 3] = origin + rotation @ position
         data.qpos[self._free_qpos + 3:self._free_qpos + 7] = wxyz(rotation @ r_pose)
-        pivots = hexapod_planner.pivot_positions(pose)
+        pivots = hexapod_planner.pivot_positions(pose, self.geometry)
         for i, name in enumerate(STRUT_LABELS):
             housing = model.body(f"{name}_housing")
             r0 = Rotation.from_quat(np.roll(housing.quat, -1)).as_matrix()
-            leg = pivots[i] - RUBIN_CAMERA.base_pivots[i]
+            leg = pivots[i] - self.geometry.base_pivots[i]
             length = np.linalg.norm(leg)
             u = r0.T @ leg / length
             b = np.arcsin(np.clip(u[0], -1.0, 1.0))
@@ -236,6 +319,16 @@ class HexapodPhysics(dm_mujoco.Physics):
         data.qvel[:] = 0.0
         data.act[:] = data.qpos[self.strut_qpos]
         mujoco.mj_forward(model, data)
+
+    def set_struts(self, strut_positions, guess=None) -> None:
+        """Put the hexapod at rest with its struts at ``strut_positions`` (6,) m, length changes
+        from their built length (the rods' zero): the platform where the plant's pivots
+        (``geometry``) put it (forward kinematics from ``guess``, a pose), then ``set_pose``."""
+        model = self.model.ptr
+        built = np.array([model.body(f"{n}_rod").pos[2] for n in STRUT_LABELS])
+        pose, _ = hexapod_planner.forward_kinematics(np.asarray(strut_positions, dtype=float) + built,
+                                                     self.geometry, initial=guess)
+        self.set_pose(pose)
 
     def loop_closure_error(self) -> float:
         """Largest violation of the six ball constraints, m."""
@@ -250,6 +343,7 @@ def magnified_qpos(physics: HexapodPhysics, magnification: float):
     def frames(log: RunLog, ticks: np.ndarray) -> np.ndarray:
         scratch = HexapodPhysics.from_model(dm_mujoco.wrapper.MjModel(copy.copy(physics.model.ptr)))
         scratch.elevation_deg = physics.elevation_deg
+        scratch.geometry = physics.geometry
         poses = physics.poses_from_qpos(log.qpos[ticks])
         start = physics.poses_from_qpos(log.qpos[0])[0]
         out = np.empty((ticks.size, physics.model.nq))
@@ -433,7 +527,7 @@ class HexapodEvaluation:
         poses = p.poses_from_qpos(log.qpos)
         judged = [self._judge_move(log, i, q, poses) for i in range(len(self.moves))]
         several = len(self.moves) > 1
-        demanded = demanded_force(p.kp, p.kv, log.act[:, :6], q, qd)
+        demanded = demanded_force(p.kp, p.kv, log.act[:, :6], p.drive_positions(q), qd)
         force = np.abs(demanded).max()
         stroke = np.abs(q).max()
         v_cmd = np.abs(ref.velocity).max()
@@ -539,7 +633,7 @@ class HexapodEvaluation:
             "strut_velocity_actual": qd,
             "setpoint": log.act[:, :6],
             "drive_force": log.actuator_force[:, :6],
-            "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, :6], q, qd),
+            "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, :6], p.drive_positions(q), qd),
             "drive_force_limit": p.force_limit,
             "pose_actual": p.poses_from_qpos(log.qpos),
             "target_pose": (np.asarray(self.moves[0].target_pose) if len(self.moves) == 1
@@ -637,23 +731,49 @@ def log_bytes_per_tick(wind: bool = True) -> float:
 
 def sensors(physics: HexapodPhysics) -> JointEncoders:
     """The hexapod's sensors: the six strut encoders (length change from the zero pose),
-    exact, every tick (Rubin's encoders resolve far below the 1 um check; README.md)."""
+    exact, every tick (Rubin's encoders resolve far below the 1 um check; README.md), with the
+    plant's encoder bias (``physics.encoder_bias``) if it has one."""
     model = physics.model.ptr
     acts = [model.actuator(j).actadr[0] for j in range(6)]
-    return JointEncoders(physics.strut_qpos, physics.strut_dofs, acts,
-                         "strut encoders (length change from the zero pose)", "m", CONTROL_DT)
+    bias = physics.encoder_bias
+    encoders = JointEncoders(physics.strut_qpos, physics.strut_dofs, acts,
+                             "strut encoders (length change from the zero pose)", "m", CONTROL_DT,
+                             bias=0.0 if bias is None else bias)
+    if bias is not None and bias.any():
+        # The datasheet a controller is given (ControlContext.sensors) cannot state the true
+        # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").
+        encoders.specs[0] = dataclasses.replace(encoders.specs[0], bias="unknown zero offset (plant uncertainty)")
+    return encoders
 
 
-def build(params: "HexapodParams", planner=None, controller=None) -> Setup:
+def build(params: "HexapodParams", planner=None, controller=None, plant: "HexapodPlant | None" = None) -> Setup:
     """A hexapod run of the moves: ``planner`` (default the paper's generator) plans each,
     ``controller`` (default ``HexapodController()``) follows them from the start pose at rest;
     the checks judge every move's arrival and target pose and the limits on the trajectory the
-    planner returned."""
+    planner returned.
+
+    ``plant`` (None: the nominal plant) perturbs the simulated machine only: the planner and
+    the controller keep the nominal model (``Setup.nominal_physics``, at the start pose). The
+    plant starts at rest where its encoders read the start pose's strut positions (the
+    nominal kinematics'), as a previous move commanded by the same controller would have left
+    it: its struts at those minus the encoder bias, its platform wherever its own pivots put
+    it. The controller sees only the encoders; the checks judge the platform's true pose.
+    """
+    plant = HexapodPlant() if plant is None else plant
     trajectory, moves, starts, durations = plan_moves(params, planner)
     duration = params.duration if params.duration is not None else trajectory.duration + SETTLE_S
     run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(params.wind > 0))
-    physics = HexapodPhysics.load(params.elevation)
-    physics.set_pose(moves[0].start_pose)
+    physics = HexapodPhysics.load(params.elevation, plant)
+    start = moves[0].start_pose
+    nominal_physics = None  # the nominal plant: a copy of the physics, as it is now
+    if plant.is_nominal:
+        physics.set_pose(start)
+    else:
+        readings = hexapod_planner.strut_positions(np.asarray(start, dtype=float))
+        physics.set_struts(readings - physics.encoder_bias, guess=start)
+        nominal = HexapodPhysics.load(params.elevation)
+        nominal.set_pose(start)
+        nominal_physics = nominal_copy(nominal)
     wind = None
     if params.wind > 0:
         wind = BodyWindDrag("camera", params.wind, camera_area(physics), CAMERA_DRAG_COEFFICIENT,
@@ -674,7 +794,9 @@ def build(params: "HexapodParams", planner=None, controller=None) -> Setup:
         disturbance=wind,
         video_speed=1.0,
         seed=params.seed,
+        nominal_physics=nominal_physics,
         params=params,
+        plant=plant,
         video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
         video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)",
     )
@@ -748,7 +870,65 @@ class HexapodParams(ScenarioParams):
             run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.wind > 0))
 
 
-_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT)
+@dataclass(frozen=True)
+class HexapodPlant(PlantParams):
+    """The camera hexapod as built, against its model (plant uncertainty, for campaigns).
+
+    The defaults are the nominal plant (models/hexapod/README.md). The planner and the
+    controller keep the nominal model; ``apply_plant`` edits the plant's MjSpec, the encoders
+    take the bias, ``geometry`` gives the plant's pivots (for its start and the video).
+    """
+
+    camera_mass_error: float = param(
+        0.0, "true camera mass relative to the model's 3000 kg (its inertia scales with it)", "fraction",
+        low=-0.1, high=0.1,
+        reason="LSSTCam is 'about 3 t' (REFERENCE.md): +-10 % bounds that rounded figure (assumption)")
+    camera_com_offset: tuple[float, ...] = param(
+        (0.0, 0.0, 0.0), "offset of the camera's centre of mass from its axis and mid-length, x, y, z in the "
+        "hexapod frame (its mass and central inertia kept)", "m", low=-0.05, high=0.05, length=3,
+        reason="the camera's uniform density is an assumption (models/hexapod/README.md); its mass centre is "
+               "taken as known to +-50 mm per axis (cabling, cryostat, filter exchanger; assumption)")
+    base_pivot_radius_error: float = param(
+        0.0, "radial error of the six base pivots (their circle's radius, 0.692 m, is this much larger)", "m",
+        low=-0.001, high=0.001,
+        reason="machining and assembly of the pivot circles before a kinematic calibration, assumed +-1 mm; "
+               "ts_mthexapod's constants.py gives the calibrated pivots to 1 um")
+    platform_pivot_radius_error: float = param(
+        0.0, "radial error of the six mirror-side pivots (their circle's radius, 0.697 m, is this much larger)",
+        "m", low=-0.001, high=0.001,
+        reason="machining and assembly of the pivot circles before a kinematic calibration, assumed +-1 mm; "
+               "ts_mthexapod's constants.py gives the calibrated pivots to 1 um")
+    drive_stiffness_error: float = param(
+        0.0, "every strut's stiffness kp (servo and axial, 100 N/um in the model) relative to the model's",
+        "fraction", low=-0.3, high=0.3,
+        reason="the 100 N/um is an order-of-magnitude assumption (models/hexapod/README.md); ball-screw "
+               "preload, bearings and the flexures spread it by tens of %: +-30 % assumed")
+    drive_force_scale: float = param(
+        1.0, "every strut drive's force limit relative to its 50 kN rating", "fraction", low=0.5, high=1.0,
+        reason="a drive delivers at most its rated force; down to half of it when derated (heat, a low DC "
+               "bus); assumption")
+    encoder_bias_um: tuple[float, ...] = param(
+        (0.0,) * 6, "zero offset of each strut's encoder, strut1 ... strut6: the drive and the controller read "
+        "q + bias", "um", low=-10.0, high=10.0, length=6,
+        reason="a strut's length calibration, assumed within 10 um (ten times the 1 um end-of-move error); "
+               "the encoders resolve 0.1 um (REFERENCE.md: 10 counts/um)")
+
+    def encoder_bias_si(self) -> np.ndarray:
+        """(6,) the encoder biases, m."""
+        return 1e-6 * np.array(self.encoder_bias_um)
+
+    def geometry(self) -> hexapod_planner.HexapodGeometry:
+        """The plant's pivots: RUBIN_CAMERA's with the radial errors (hexapod frame, zero pose;
+        the mirror-side pivots' x, y there are those in the platform frame, which the rotation
+        pivot on the axis leaves)."""
+        if not (self.base_pivot_radius_error or self.platform_pivot_radius_error):
+            return RUBIN_CAMERA
+        base = np.array([_radial(p, self.base_pivot_radius_error) for p in RUBIN_CAMERA.base_pivots])
+        platform = np.array([_radial(p, self.platform_pivot_radius_error) for p in RUBIN_CAMERA.platform_pivots])
+        return hexapod_planner.HexapodGeometry(base, platform, RUBIN_CAMERA.rotation_pivot)
+
+
+_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT, plant=HexapodPlant())
 
 SCENARIOS = (
     Scenario(

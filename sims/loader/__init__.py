@@ -4,10 +4,15 @@ Scenarios:
   loader-supply  Table 1's key points through the cubic B-spline (the paper's supply stage).
   loader-direct  P2 to P3 as one straight joint-space move in the same time; it strikes the
                  breechblock and the seat ring, which is why the paper adds M1 ... M4.
+
+Plant uncertainty (``LoaderPlant``: shell and link masses, upper-arm length, joint friction,
+drive force limits, encoder bias) perturbs the simulated loader only (``build(..., plant=)``,
+models/loader/README.md "Plant uncertainty").
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass
 
@@ -23,8 +28,9 @@ from sims.checks import Check
 from sims.loader.collision import clearance, geoms_by_contype, obstacle_contact_pairs
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
-from sims.params import ScenarioParams, param
-from sims.task import JointEncoders, plan_checked
+from sims.params import PlantParams, ScenarioParams, param
+from sims.plant import set_inertial
+from sims.task import JointEncoders, nominal_copy, plan_checked
 
 #: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
 ROBOT_CONTYPE = 1
@@ -44,17 +50,26 @@ class LoaderPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/loader/scene.xml with readable accessors."""
 
     @classmethod
-    def load(cls, payload_mass: float = None) -> "LoaderPhysics":
+    def load(cls, payload_mass: float = None, plant: "LoaderPlant | None" = None) -> "LoaderPhysics":
         """The scene at its home keyframe; ``payload_mass`` (kg, None: the model's 45 kg) scales
         the shell's geoms' masses, so its inertia scales with them (same shape and density
-        distribution), edited with MjSpec before compiling."""
-        if payload_mass is None or payload_mass == shell_mass():
+        distribution), edited with MjSpec before compiling. ``plant`` (None: the nominal
+        plant): the true machine, perturbed as ``LoaderPlant`` says (``apply_plant``); its
+        ``payload_mass_error`` makes the shell's true mass payload_mass (1 + error)."""
+        nominal = plant is None or plant.is_nominal
+        if nominal and (payload_mass is None or payload_mass == shell_mass()):
             physics = cls.from_xml_path(str(models.scene_path("loader")))
         else:
             spec = mujoco.MjSpec.from_file(str(models.scene_path("loader")))
-            factor = payload_mass / shell_mass()
-            for geom in spec.body("shell").find_all(mujoco.mjtObj.mjOBJ_GEOM):
-                geom.mass = geom.mass * factor
+            mass = shell_mass() if payload_mass is None else payload_mass
+            if not nominal:
+                mass = mass * (1.0 + plant.payload_mass_error)
+            factor = mass / shell_mass()
+            if factor != 1.0:
+                for geom in spec.body("shell").find_all(mujoco.mjtObj.mjOBJ_GEOM):
+                    geom.mass = geom.mass * factor
+            if not nominal:
+                apply_plant(spec, plant)
             physics = cls.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
         physics.reset(keyframe_id=0)
         return physics
@@ -121,15 +136,86 @@ def _joint_dofs(physics: LoaderPhysics) -> np.ndarray:
     return np.array([model.joint(n).dofadr[0] for n in physics.joint_names])
 
 
+#: The arm's links, carriage to gripper: the bodies whose geoms' masses ``arm_mass_error``
+#: scales (the shell is the payload, ``payload_mass_error``).
+ARM_BODIES = ("carriage", "upper_arm", "forearm", "wrist_pitch_link", "wrist_yaw_link", "gripper")
+
+
+def apply_plant(spec: mujoco.MjSpec, plant: "LoaderPlant") -> None:
+    """Edit the loader's MjSpec into the plant ``plant`` (all but the payload's mass, which
+    ``LoaderPhysics.load`` scales). Each edit touches only its own elements:
+
+    * arm_mass_error: the mass and inertia of every body of ``ARM_BODIES`` times (1 + error),
+      its centre of mass and principal axes kept (``sims.plant.set_inertial``);
+    * upper_arm_length_error: the elbow axis (body ``forearm``) moved along the upper arm, m
+      (the beam's geom and mass are left: a bore position error, not another beam);
+    * joint_viscous_friction: each joint's damping (N s/m, N m s/rad) = fraction x its drive's
+      rated force / rated speed, so the friction at rated speed is that fraction of the rating;
+    * drive_force_scale: every drive's force range times the scale;
+    * encoder_bias: the drives close their loop on the biased encoder, so the drive force is
+      kp (set-point - (q + b)) - kv qdot: affine bias term biasprm[0] = -kp b.
+    """
+    chain = models.loader_spec()
+    if plant.arm_mass_error:
+        nominal = models.load("loader")  # the links' inertials as MuJoCo computes them from their geoms
+        for name in ARM_BODIES:
+            set_inertial(spec, nominal, name, 1.0 + plant.arm_mass_error)
+    if plant.upper_arm_length_error:
+        forearm = spec.body("forearm")
+        forearm.pos = np.asarray(forearm.pos) + np.array([plant.upper_arm_length_error, 0.0, 0.0])
+    bias = plant.encoder_bias_si()
+    for j, name in enumerate(chain.names):
+        if plant.joint_viscous_friction:
+            joint = spec.joint(name)
+            damping = np.array(joint.damping)
+            damping[0] = plant.joint_viscous_friction * chain.force_limit[j] / chain.rate_limit[j]
+            joint.damping = damping
+        actuator = spec.actuator(name)
+        if plant.drive_force_scale != 1.0:
+            actuator.forcerange = plant.drive_force_scale * np.asarray(actuator.forcerange)
+        if bias[j]:
+            biasprm = np.array(actuator.biasprm)
+            biasprm[0] = -actuator.gainprm[0] * bias[j]
+            actuator.biasprm = biasprm
+
+
+def plant_chain(plant: "LoaderPlant | None" = None) -> models.SerialChainSpec:
+    """The plant's kinematic chain (``models.loader_spec()`` with its upper-arm length error),
+    for the evaluation's shell tip: the checks judge the true machine."""
+    chain = models.loader_spec()
+    if plant is None or not plant.upper_arm_length_error:
+        return chain
+    bodies = tuple(dataclasses.replace(b, pos=b.pos + np.array([plant.upper_arm_length_error, 0.0, 0.0]))
+                   if b.name == "forearm" else b for b in chain.bodies)
+    return dataclasses.replace(chain, bodies=bodies)
+
+
 class LoaderEvaluation:
     """Checks and outputs of a loader run (keypoints are Table 1's, in SI units)."""
 
-    def __init__(self, physics: LoaderPhysics, key_times: np.ndarray, key_points: np.ndarray):
+    def __init__(self, physics: LoaderPhysics, key_times: np.ndarray, key_points: np.ndarray,
+                 plant: "LoaderPlant | None" = None):
         self.physics = physics
         self.spec = models.loader_spec()
         self.key_times = np.asarray(key_times)
         self.key_points = np.asarray(key_points)
         self._clearance = None
+        # The plant's drives and kinematics (equal to the nominal ones for the nominal plant):
+        # a weaker drive saturates at its own limit, which the joint_torque check judges.
+        model = physics.model.ptr
+        drives = [model.actuator(n).id for n in self.spec.names]
+        self.kp = model.actuator_gainprm[drives, 0].copy()
+        self.kv = -model.actuator_biasprm[drives, 2].copy()
+        self.force_limit = model.actuator_forcerange[drives, 1].copy()
+        plant = LoaderPlant() if plant is None else plant
+        self.chain = plant_chain(plant)
+        self.encoder_bias = plant.encoder_bias_si()
+
+    def _demanded(self, log: RunLog, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """(n, 6) force/torque the drives demand, N and N m: their PD on what their encoders
+        read (q + encoder bias)."""
+        q_drive = q + self.encoder_bias if self.encoder_bias.any() else q
+        return demanded_force(self.kp, self.kv, log.act, q_drive, qd)
 
     def clearance(self, log: RunLog):
         if self._clearance is None or self._clearance[0] is not log:
@@ -142,7 +228,7 @@ class LoaderEvaluation:
     def _shell_tip(self, log: RunLog) -> np.ndarray:
         """Shell nose position (m) at every logged tick, from the logged joint positions."""
         q, _ = self._joint_log(log)
-        return forward_kinematics(q, ["shell_tip"])["shell_tip"]
+        return forward_kinematics(q, ["shell_tip"], spec=self.chain)["shell_tip"]
 
     def _joint_log(self, log: RunLog):
         dofs = _joint_dofs(self.physics)
@@ -159,8 +245,8 @@ class LoaderEvaluation:
         ticks = np.searchsorted(log.t, self.key_times[reached] - 1e-9)
         key_err_deg = np.rad2deg(np.abs(q[ticks, 1:] - self.key_points[reached, 1:]))
         key_err_slide_mm = 1e3 * np.abs(q[ticks, 0] - self.key_points[reached, 0])
-        tau = demanded_force(self.spec.kp, self.spec.kv, log.act, q, qd)
-        torque_ratio = np.abs(tau) / self.spec.force_limit
+        tau = self._demanded(log, q, qd)
+        torque_ratio = np.abs(tau) / self.force_limit
         robot, obstacles = self.physics.robot_geoms(), self.physics.obstacle_geoms()
         pairs = obstacle_contact_pairs(log.contacts, robot, obstacles)
         clear, closest = self.clearance(log)
@@ -190,7 +276,7 @@ class LoaderEvaluation:
             "tracking_error_slide_mm": float(1e3 * np.abs(err[:, 0]).max()),
             "tracking_error_deg_per_joint": dict(zip(self.spec.names[1:], err_deg.max(0).round(6).tolist())),
             "peak_torque_per_joint": dict(zip(self.spec.names, np.abs(tau).max(0).round(3).tolist())),
-            "torque_limit_per_joint": dict(zip(self.spec.names, self.spec.force_limit.tolist())),
+            "torque_limit_per_joint": dict(zip(self.spec.names, self.force_limit.tolist())),
             "final_shell_tip_m": self._shell_tip(log)[-1].tolist(),
             "contact_ticks": int(sum(v[1] for v in pairs.values())),
         }
@@ -208,8 +294,8 @@ class LoaderEvaluation:
             "qd_actual": qd,
             "setpoint": log.act,
             "drive_force": log.actuator_force,
-            "drive_force_demanded": demanded_force(self.spec.kp, self.spec.kv, log.act, q, qd),
-            "drive_force_limit": self.spec.force_limit,
+            "drive_force_demanded": self._demanded(log, q, qd),
+            "drive_force_limit": self.force_limit,
             "shell_tip_pos": self._shell_tip(log),
             "clearance": clear,
             "key_times": self.key_times,
@@ -231,14 +317,22 @@ def log_bytes_per_tick() -> float:
     return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6)
 
 
-def sensors(physics: LoaderPhysics) -> JointEncoders:
+def sensors(physics: LoaderPhysics, bias=None) -> JointEncoders:
     """The loader's sensors: the drives' encoders on theta1 ... theta6, exact, every tick
-    (no encoder figures are published for it; an assumption, README.md)."""
+    (no encoder figures are published for it; an assumption, README.md). ``bias`` (6,) m and
+    rad: the plant's encoder zero offsets (``LoaderPlant.encoder_bias``), added to every
+    reading; None or zeros: none."""
     model = physics.model.ptr
     joints = [model.joint(n) for n in physics.joint_names]
-    return JointEncoders([j.qposadr[0] for j in joints], [j.dofadr[0] for j in joints],
-                         [model.actuator(n).actadr[0] for n in physics.joint_names],
-                         "encoders of theta1 (m) ... theta6 (rad)", "m|rad", CONTROL_DT)
+    encoders = JointEncoders([j.qposadr[0] for j in joints], [j.dofadr[0] for j in joints],
+                             [model.actuator(n).actadr[0] for n in physics.joint_names],
+                             "encoders of theta1 (m) ... theta6 (rad)", "m|rad", CONTROL_DT,
+                             bias=0.0 if bias is None else bias)
+    if bias is not None and np.any(bias):
+        # The datasheet a controller is given (ControlContext.sensors) cannot state the true
+        # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").
+        encoders.specs[0] = dataclasses.replace(encoders.specs[0], bias="unknown zero offset (plant uncertainty)")
+    return encoders
 
 
 def reference_controller() -> ServoFeedforwardController:
@@ -262,23 +356,36 @@ def plan(params: "LoaderParams"):
     return loader_planner.CubicBSplinePlanner().plan(problem(params))
 
 
-def build(params: "LoaderParams", planner=None, controller=None) -> Setup:
+def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderPlant | None" = None) -> Setup:
     """A loader run: ``planner`` (default the paper's cubic B-spline) plans the key points,
     ``controller`` (default ``reference_controller()``) follows it from the first key point, at
-    rest; the checks judge the key points, the obstacles and the drive limits."""
+    rest; the checks judge the key points, the obstacles and the drive limits.
+
+    ``plant`` (None: the nominal plant) perturbs the simulated machine only: the planner and
+    the controller keep the nominal model (``Setup.nominal_physics``). The plant starts at
+    rest where its encoders read the first key point, i.e. at key_points[0] - encoder bias
+    (the controller sees only the encoders); the checks judge its true joints.
+    """
+    plant = LoaderPlant() if plant is None else plant
     task = problem(params)
     planner = loader_planner.CubicBSplinePlanner() if planner is None else planner
     trajectory = plan_checked(planner, task, task.labels)
     duration = params.duration if params.duration is not None else trajectory.duration + params.settle
     run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
-    physics = LoaderPhysics.load(params.payload_mass)
-    physics.set_start(task.key_points[0])
-    evaluation = LoaderEvaluation(physics, task.key_times, task.key_points)
+    physics = LoaderPhysics.load(params.payload_mass, plant)
+    bias = plant.encoder_bias_si()
+    physics.set_start(task.key_points[0] - bias if bias.any() else task.key_points[0])
+    nominal_physics = None  # the nominal plant: a copy of the physics, as it is now
+    if not plant.is_nominal:
+        nominal = LoaderPhysics.load(params.payload_mass)
+        nominal.set_start(task.key_points[0])
+        nominal_physics = nominal_copy(nominal)
+    evaluation = LoaderEvaluation(physics, task.key_times, task.key_points, plant)
     return Setup(
         physics=physics,
         trajectory=trajectory,
         controller=reference_controller() if controller is None else controller,
-        sensors=sensors(physics),
+        sensors=sensors(physics, bias),
         problem=task,
         planner=planner,
         control_dt=CONTROL_DT,
@@ -288,7 +395,9 @@ def build(params: "LoaderParams", planner=None, controller=None) -> Setup:
         report=evaluation.report,
         video_speed=1.0,
         seed=params.seed,
+        nominal_physics=nominal_physics,
         params=params,
+        plant=plant,
     )
 
 
@@ -327,11 +436,63 @@ class LoaderParams(ScenarioParams):
         run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
 
 
+#: Each encoder's zero offset range, in Table 1's units (mm, deg).
+_BIAS_UNITS = ("mm", "deg", "deg", "deg", "deg", "deg")
+_BIAS_LIMIT = (1.0, 0.1, 0.1, 0.1, 0.1, 0.1)
+
+
+@dataclass(frozen=True)
+class LoaderPlant(PlantParams):
+    """The loader as built, against its model (plant uncertainty, for campaigns).
+
+    The paper gives no masses, dimensions or drive data: the nominal model's numbers are all
+    assumptions (models/loader/README.md), and so are these ranges; each states its reasoning.
+    The defaults are the nominal plant. The planner and the controller keep the nominal
+    model; ``apply_plant`` edits the plant's MjSpec, the encoders take the bias.
+    """
+
+    payload_mass_error: float = param(
+        0.0, "true shell mass relative to payload_mass (which the controller is told): m = payload_mass (1 + error); "
+        "its inertia scales with it", "fraction", low=-0.1, high=0.1,
+        reason="155 mm HE projectiles weigh 43-47 kg (+-4.4 % of 45 kg, models/loader/README.md); +-10 % "
+               "also covers a fuze or projectile lot the loader was not told of (assumption)")
+    arm_mass_error: float = param(
+        0.0, "mass (and inertia) of every arm link, carriage to gripper, relative to the model's", "fraction",
+        low=-0.05, high=0.05,
+        reason="welded beams and castings come within a few % of their drawing mass; +-5 % assumed (the "
+               "link masses are themselves assumptions, models/loader/README.md)")
+    upper_arm_length_error: float = param(
+        0.0, "error of the upper arm's shoulder-to-elbow axis distance (1.0 m in the model)", "m",
+        low=-0.002, high=0.002,
+        reason="a welded arm whose bores are machined after welding holds +-0.5 mm; +-2 mm allows an "
+               "unmachined weldment (assumption)")
+    joint_viscous_friction: float = param(
+        0.0, "viscous friction of every joint (reducer, bearings, seals): its force/torque at the drive's rated "
+        "speed as a fraction of the drive's rated force/torque; the model has none", "fraction", low=0.0, high=0.1,
+        reason="friction only takes energy (>= 0); servo gearboxes lose 5-10 % at rated speed (efficiency "
+               "90-95 %): up to 10 %, all of it taken as viscous (assumption: no drive data are published)")
+    drive_force_scale: float = param(
+        1.0, "every drive's force/torque limit relative to its rating (models/loader/README.md)", "fraction",
+        low=0.5, high=1.0,
+        reason="a drive delivers at most its rated force; down to half of it when derated (heat, a low DC bus, "
+               "an aged motor); assumption")
+    encoder_bias: tuple[float, ...] = param(
+        (0.0,) * 6, "zero offset of each drive's encoder, theta1 (mm), theta2 ... theta6 (deg): the drive and "
+        "the controller read q + bias", unit=_BIAS_UNITS, low=tuple(-b for b in _BIAS_LIMIT), high=_BIAS_LIMIT,
+        length=6,
+        reason="the joints' zero (mastering) offsets of a calibrated arm, assumed within the 0.1 deg key-point "
+               "limit and 1 mm of the slide's homing; no encoder data are published")
+
+    def encoder_bias_si(self) -> np.ndarray:
+        """(6,) the encoder biases in joint units, m and rad."""
+        return loader_planner.table1_to_si(np.array(self.encoder_bias))
+
+
 # ----------------------------------------------------------------------------- registry
 
 from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
 
-_RUN = dict(build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT)
+_RUN = dict(build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT, plant=LoaderPlant())
 
 SCENARIOS = (
     Scenario(
