@@ -28,7 +28,8 @@ from sims.cli import main
 from sims.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]
-EXAMPLES = sorted((ROOT / "examples").glob("*/*.toml"))
+#: Scenario files (campaign specs, *_campaign.toml, are tests/test_campaign.py's).
+EXAMPLES = sorted(p for p in (ROOT / "examples").glob("*/*.toml") if not p.name.endswith("_campaign.toml"))
 #: Shorter runs of the examples for the tests (make demo and users run them whole).
 EXAMPLE_DURATION_S = {"crab.toml": 30.0, "measured_wind.toml": 30.0, "indian_ocean.toml": 20.0}
 SLOW = settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -21,6 +21,7 @@ servo's velocity feed-forward.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from collections import deque
@@ -42,7 +43,8 @@ from sims.runner import RunLog, Setup
 from sims.task import ControlContext, JointEncoders, nominal_copy, RecordingPlanner, Sensors, SensorSpec, check_planner
 from sims.antenna.ship_motion import (SEA_HS_MAX_M, SEA_TP_RANGE_S, PaperShipMotion, SeaStateMotion, check_sea_state,
                                      world_from_ship)
-from sims.params import ParamError, ScenarioParams, override, param
+from sims.params import ParamError, PlantParams, ScenarioParams, override, param
+from sims.plant import set_inertial
 
 CONTROL_DT = 0.005  # s: the runner's tick; the IMU rate is a whole number of ticks
 DECK_JOINTS = ("heave", "yaw", "pitch", "roll")
@@ -93,8 +95,11 @@ class AntennaPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/antenna/scene.xml with named accessors."""
 
     @classmethod
-    def load(cls) -> "AntennaPhysics":
-        physics = cls.from_model(dm_mujoco.wrapper.MjModel(models.load("antenna")))
+    def load(cls, plant: "AntennaPlant | None" = None) -> "AntennaPhysics":
+        """The scene at its home keyframe; ``plant`` (None or nominal: the model as it is)
+        perturbs the compiled model (``AntennaPlant.model``)."""
+        model = models.load("antenna") if plant is None or plant.is_nominal else plant.model()
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(model))
         physics.reset(keyframe_id=0)
         return physics
 
@@ -281,6 +286,11 @@ class AntennaImu(Sensors):
     newest that has arrived by a tick is the one it sees). The first sample is taken and
     delivered at t = 0 (the run starts in steady tracking).
 
+    ``errors`` (an ``AntennaPlant``; None: none) are the true IMU's errors that its datasheet
+    (``imu``, the published SensorSpecs) does not state, so the controller does not know them:
+    a constant attitude error B = exp([imu_bias]x) in the IMU frame (measured = true B, before
+    the Gauss-Markov error).
+
     Observation keys:
       imu_attitude (3, 3): the measured deck attitude, world from IMU frame.
       imu_gyro (3,): the measured angular rate, rad/s, in the IMU frame.
@@ -291,11 +301,15 @@ class AntennaImu(Sensors):
         its drives' set-points, rad and rad/s.
     """
 
-    def __init__(self, physics: "AntennaPhysics", imu: ImuModel, control_dt: float):
+    def __init__(self, physics: "AntennaPhysics", imu: ImuModel, control_dt: float,
+                 errors: "AntennaPlant | None" = None):
         super().__init__()
         self.imu = imu
         self.dt = control_dt
         self.period, self.latency = imu.ticks(control_dt)
+        # The true sensor's error (None: the datasheet's sensor): the attitude bias, a
+        # rotation in the IMU frame.
+        self.bias_rotation = None if errors is None else errors.bias_rotation()
         self.encoders = JointEncoders(physics.antenna_qpos, physics.antenna_dofs,
                                       physics.model.ptr.actuator_actadr[physics.antenna_actuators],
                                       "antenna joint encoders theta1 ... theta4", "rad", control_dt)
@@ -307,6 +321,9 @@ class AntennaImu(Sensors):
             SensorSpec("imu_gyro", "angular rate of the pedestal IMU, IMU frame", "rad/s", imu.rate_hz,
                        imu.latency_s, f"white, {imu.gyro_noise_deg_s:g} deg/s 1-sigma per axis"),
         ] + self.encoders.specs
+        if errors is not None and any(errors.imu_bias):
+            # summary.json says the sensor has an error; the controller is not told its value.
+            self.specs[0] = dataclasses.replace(self.specs[0], bias="unknown constant attitude error (plant uncertainty)")
 
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
         imu = self.imu
@@ -334,6 +351,8 @@ class AntennaImu(Sensors):
         rotation = np.empty(9)
         mujoco.mju_quat2Mat(rotation, sd[self.quat_slice])
         rotation = rotation.reshape(3, 3)
+        if self.bias_rotation is not None:
+            rotation = rotation @ self.bias_rotation
         if self.att_sigma > 0:
             if tick > 0:
                 drive = self.att_sigma * math.sqrt(1.0 - self.att_decay**2)
@@ -624,6 +643,19 @@ def start_angles(motion, satellite: np.ndarray, azimuth: float, elevation: float
     return path.theta[-1]
 
 
+def tracked_start(motion, satellite: np.ndarray, theta: np.ndarray, plant: "AntennaPlant") -> np.ndarray:
+    """The joint angles an antenna holds at t = 0 when it has been tracking with ``plant``'s
+    biased IMU, from ``theta`` (those for the true attitude at 0): the attitude B^T bTe(0) eTs
+    that the biased deck attitude eTb B asks for (eq. 1 with the measurement), reached by
+    weighted Newton steps; ``theta`` itself without a bias."""
+    if not any(plant.imu_bias):
+        return theta
+    ship = motion.sample(0.0)
+    target = plant.bias_rotation().T @ ant.ship_attitude(ship.heading[0], ship.pitch[0], ship.roll[0]) @ satellite
+    path = ant.solve_joint_path(_slerp(ant.forward_kinematics(theta), target, 10), 1.0, theta, "crr-full")
+    return path.theta[-1]
+
+
 def _slerp(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
     rotvec = ant.rotation_log(b @ a.T)
     s = np.linspace(0.0, 1.0, n + 1)
@@ -662,19 +694,25 @@ def _model() -> mujoco.MjModel:
 
 def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_max_deg,
            rms_limit_deg, description, antenna_options: AntennaOptions,
-           video_length_s: float = 60.0, planner=None, controller=None, params=None) -> Setup:
-    physics = AntennaPhysics.load()
+           video_length_s: float = 60.0, planner=None, controller=None, params=None, plant=None) -> Setup:
+    perturbed = plant is not None and not plant.is_nominal
+    # The plant (perturbed or not) and the model the planner and the controller know, both
+    # at the same initial state; the deck's drive is the sea's, so it drives the plant.
+    physics = AntennaPhysics.load(plant if perturbed else None)
+    nominal = AntennaPhysics.load() if perturbed else physics
     satellite = ant.satellite_attitude(azimuth, elevation, polarization)
     theta0 = start_angles(motion, satellite, azimuth, elevation, polarization)
     reference = ideal_path(motion, satellite, duration, theta0)
     start = reference.sample(0.0)
+    theta_start = tracked_start(motion, satellite, start.position[0], plant) if perturbed else start.position[0]
     ship0 = motion.sample(0.0)
     deck_pos, deck_vel, _ = ship0.joint_arrays()
-    physics.set_state(deck_pos[0], deck_vel[0], start.position[0], start.velocity[0])
+    for p in {id(physics): physics, id(nominal): nominal}.values():
+        p.set_state(deck_pos[0], deck_vel[0], theta_start, start.velocity[0])
     drive = ShipMotionDrive(physics, motion)
     imu = antenna_options.imu
     problem = ant.AntennaProblem(satellite, float(azimuth), float(elevation), float(polarization),
-                                 start.position[0].copy(), ant.AntennaLimits(rate=physics.rate_limit()),
+                                 theta_start.copy(), ant.AntennaLimits(rate=nominal.rate_limit()),
                                  update_dt=1.0 / imu.rate_hz)
     if planner is None:
         planner = ant.CrrPlanner(antenna_options.method, antenna_options.omega_method)
@@ -700,7 +738,7 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
         physics=physics,
         trajectory=reference,
         controller=controller,
-        sensors=AntennaImu(physics, imu, CONTROL_DT),
+        sensors=AntennaImu(physics, imu, CONTROL_DT, plant if perturbed else None),
         problem=problem,
         planner=recorder,
         controlled=physics.antenna_actuators,
@@ -715,6 +753,8 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
         video_speed=max(1.0, duration / video_length_s),
         seed=seed,
         params=params,
+        nominal_physics=nominal_copy(nominal) if perturbed else None,  # None: a copy of physics
+        plant=plant if plant is not None else AntennaPlant(),
     )
 
 
@@ -750,11 +790,13 @@ def motion_of(params: "AntennaParams"):
 
 
 def build(params: "AntennaParams", planner=None, controller=None,
-          antenna_options: AntennaOptions | None = None) -> Setup:
+          antenna_options: AntennaOptions | None = None, plant: "AntennaPlant | None" = None) -> Setup:
     """An antenna run: the ship's motion, the satellite, the IMU; ``planner`` (default the
     paper's CRR) solves the joint angles online from the IMU's attitude, ``controller``
     (default ``AntennaController``) drives the axes. ``antenna_options``: the planner's
-    method and the controller's prediction for tests (default: from the parameters)."""
+    method and the controller's prediction for tests (default: from the parameters).
+    ``plant``: the plant's uncertainty (``AntennaPlant``; None or nominal: the model as it
+    is); the planner and the controller keep the nominal model and the IMU's datasheet."""
     if antenna_options is None:
         antenna_options = AntennaOptions(imu=imu_of(params), predict=params.prediction)
     run_limits.check_duration(params.duration, CONTROL_DT, log_bytes_per_tick(antenna_options.imu))
@@ -769,7 +811,8 @@ def build(params: "AntennaParams", planner=None, controller=None,
                        "satellite_az_el_pol_deg": np.degrees([az, el, pol]).round(4).tolist()}
         # A 30 s video: the 8 s and 10 s periods shown at 4 s and 5 s.
         return _setup(motion, az, el, pol, duration, params.seed, POINTING_MAX_PAPER_DEG, None, description,
-                      antenna_options, video_length_s=30.0, planner=planner, controller=controller, params=params)
+                      antenna_options, video_length_s=30.0, planner=planner, controller=controller, params=params,
+                      plant=plant)
     sd = motion.standard_deviation()
     description = {
         "ship_motion": f"JONSWAP Hs {params.hs:g} m, Tp {params.tp:g} s, gamma {motion.gamma:g}, waves {params.wave_heading:g} deg off the bow",
@@ -780,7 +823,7 @@ def build(params: "AntennaParams", planner=None, controller=None,
         "satellite_az_el_pol_deg": np.degrees([az, el, pol]).round(4).tolist(),
     }
     return _setup(motion, az, el, pol, duration, params.seed, POINTING_MAX_SEA_DEG, POINTING_RMS_DEG, description,
-                  antenna_options, planner=planner, controller=controller, params=params)
+                  antenna_options, planner=planner, controller=controller, params=params, plant=plant)
 
 
 def plan(params: "AntennaParams") -> ant.JointPathTrajectory:
@@ -948,6 +991,73 @@ class AntennaSeaParams(AntennaParams):
                              "over which the start position's look angles hold (0.045 deg)")
 
 
+#: The bodies the antenna drives move (their masses are the README's assumptions); the
+#: pedestal base is welded to the deck and the motors' armature is a separate, known value.
+MOVING_BODIES = ("azimuth", "elevation", "cross_elevation", "polarization", "reflector")
+
+
+@dataclass(frozen=True)
+class AntennaPlant(PlantParams):
+    """The antenna's plant uncertainty: how the real terminal differs from models/antenna and
+    its IMU from the datasheet the controller is set up with (models/antenna/README.md,
+    "Plant uncertainty").
+
+    Where each one acts: ``mass_error``, ``imbalance_offset``, ``joint_friction`` and
+    ``torque_limit_scale`` edit the MJCF (MjSpec) before compiling (``model``); ``imu_bias``
+    is the IMU's true error in the task's sensor (``AntennaImu``), which the published
+    SensorSpecs (the datasheet the controller reads) leave out. A run with a bias starts in
+    steady tracking of what that IMU reports (``tracked_start``), as an antenna that has been
+    tracking with it would; the checks still judge the true pointing.
+    """
+
+    mass_error: float = param(
+        0.0, "error of the moving antenna parts' masses and inertias (azimuth, elevation, cross-elevation, "
+        "polarization and reflector bodies, 98 kg) as a fraction; centres of mass unchanged", "fraction",
+        low=-0.2, high=0.2, reason="the masses are assumptions for a 1 m class terminal (models/antenna/README.md); "
+        "vendors' 100-150 kg span +/-20 % about 125 kg")
+    imbalance_offset: tuple[float, ...] = param(
+        (0.0, 0.0, 0.0), "shift of the polarization assembly's centre of mass (the polarization and reflector "
+        "bodies, 33 kg), antenna frame (x_a, y_a, z_a = boresight); the model's residual is (2, 0, 3) mm", "mm",
+        low=-10.0, high=10.0, length=3, reason="real pedestals are balanced to a few mm (models/antenna/README.md); "
+        "10 mm is 3.2 N m of static torque, a third of the polarization drive's 10 N m")
+    joint_friction: float = param(
+        0.0, "Coulomb friction of each antenna axis' bearings, seals and cable wrap (the model has none)", "N m",
+        low=0.0, high=5.0, reason="a few N m on real pedestals (models/antenna/README.md); at most half the smallest "
+        "drive limit (polarization, 10 N m)")
+    torque_limit_scale: float = param(
+        1.0, "the antenna drives' torque limits as a fraction of their ratings (40, 15, 12, 10 N m)", "fraction",
+        low=0.5, high=1.0, reason="the rating is what a drive guarantees; derating (heat, low supply voltage) only "
+        "lowers it; half the rating is still 5-10 times the torque the CRR path needs (README)")
+    imu_bias: tuple[float, ...] = param(
+        (0.0, 0.0, 0.0), "constant attitude error of the IMU (its AHRS's bias and its mounting misalignment), "
+        "a rotation vector about the IMU axes (x starboard, y bow, z up)", "deg", low=-2.0, high=2.0, length=3,
+        reason="marine AHRS: 0.01-0.1 deg in tilt, up to ~1 deg in heading (datasheets, assumed); 2 deg is a "
+        "badly aligned installation")
+
+    def bias_rotation(self) -> np.ndarray:
+        """B = exp([imu_bias]x), (3, 3): measured attitude = true attitude B (world from IMU)."""
+        return _exp_so3(np.radians(self.imu_bias))
+
+    def model(self) -> mujoco.MjModel:
+        """models/antenna/scene.xml with this plant's masses, balance, friction and torque
+        limits (MjSpec): body_mass and body_inertia of MOVING_BODIES times (1 + mass_error)
+        (explicit inertials with the same principal axes), body_ipos of the polarization and
+        reflector bodies moved by imbalance_offset, dof_frictionloss of the four antenna joints
+        = joint_friction, their drives' actuator_forcerange times torque_limit_scale. MuJoCo
+        derives the rest (subtree masses, qM at qpos0) from them."""
+        nominal = _model()
+        spec = mujoco.MjSpec.from_file(str(models.scene_path("antenna")))
+        shift = np.asarray(self.imbalance_offset) * 1e-3  # m; the reflector's axes are the antenna frame's
+        for body in MOVING_BODIES:
+            set_inertial(spec, nominal, body, 1.0 + self.mass_error,
+                         shift if body in ("polarization", "reflector") else None)
+        for name in JOINTS:
+            spec.joint(name).frictionloss = self.joint_friction
+            actuator = spec.actuator(name)
+            actuator.forcerange = nominal.actuator_forcerange[nominal.actuator(name).id] * self.torque_limit_scale
+        return spec.compile()
+
+
 SCENARIOS = (
     Scenario(
         "antenna-paper-motion",
@@ -959,6 +1069,7 @@ SCENARIOS = (
         plan_extras=write_method_comparison,
         control_dt=CONTROL_DT,
         online_planner=True,
+        plant=AntennaPlant(),
     ),
     Scenario(
         "antenna-sea-state",
@@ -969,6 +1080,7 @@ SCENARIOS = (
         kinds=joint_kinds,
         control_dt=CONTROL_DT,
         online_planner=True,
+        plant=AntennaPlant(),
     ),
 )
 #: The scenario ``planbench bench`` times, and how many runs it takes the best of.

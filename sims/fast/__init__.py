@@ -40,11 +40,11 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import demanded_force
 from sims.fast.physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
-                               FastController, FastPhysics, FastSensors, SensorOptions, _compiled,
-                               max_cable_segments, parked_command, winch_feedforward)
+                               FastController, FastPhysics, FastPlant, FastSensors, SensorOptions, _compiled,
+                               max_cable_segments, parked_command, perturbed_start, winch_feedforward)
 from sims.runner import RunLog, Setup
 from sims.params import ParamError, ScenarioParams, param
-from sims.task import plan_checked
+from sims.task import nominal_copy, plan_checked
 from sims.wind import MAX_MEAN_SPEED_M_S, SPECTRA, MeasuredWind, WindFileError
 
 #: The built-in catalogue: ICRS (J2000) RA and Dec, rad, of calibrators and pulsars FAST
@@ -295,10 +295,14 @@ def _rms(x: np.ndarray) -> float:
 
 
 class FastEvaluation:
-    """Checks, timeseries and report of a FAST run."""
+    """Checks, timeseries and report of a FAST run: ``physics`` is the plant (its log is
+    judged); ``planned_tower_tops`` (6, 3) m, the nominal model's cable exits from which the
+    plan's unstretched lengths are computed (default the plant's: the nominal plant)."""
 
-    def __init__(self, physics: FastPhysics, problem: fp.FastProblem, loads: CableLoads, description: dict):
+    def __init__(self, physics: FastPhysics, problem: fp.FastProblem, loads: CableLoads, description: dict,
+                 planned_tower_tops: np.ndarray | None = None):
         self.physics, self.problem, self.loads = physics, problem, loads
+        self.planned_tower_tops = planned_tower_tops
         self.goal = problem.goal
         self.description = description
         self._series = (None, None)  # (log, its series): checks, timeseries and report share it
@@ -320,7 +324,10 @@ class FastEvaluation:
         cabin = log.sensordata[:, p.sensor_block("cabin_pos")]
         legs = log.qpos[:, p.leg_qpos]
         kp, kv = p.drive_gains(p.leg_ids)
-        unstretched = winch_feedforward(state, p.tower_tops)
+        # The plan's unstretched lengths on the nominal geometry (what the winch feed-forward
+        # commands; the plant's tower tops may differ).
+        towers = p.tower_tops if self.planned_tower_tops is None else self.planned_tower_tops
+        unstretched = winch_feedforward(state, towers)
         return {
             "feed_goal": goal_feed,
             "feed_planned": log.reference.position[:, :3],
@@ -465,18 +472,27 @@ def problem(plan: fp.FastPlan) -> fp.FastProblem:
 
 
 def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_options: ControllerOptions | None = None,
-          planner=None, controller=None, sensor_options: SensorOptions = SensorOptions()) -> Setup:
+          planner=None, controller=None, sensor_options: SensorOptions = SensorOptions(),
+          plant: FastPlant | None = None) -> Setup:
     """A run of a session (``plan``: its goal plan, or the problem): ``planner`` (default the
     paper's, whose plan is the goal) plans it, ``controller`` (default ``FastController`` with
     ``controller_options``, else the stabilizer as ``params.stewart`` says) follows it, with
     the physics at the trajectory's first pose (at rest, in equilibrium), the cables
     (``params.cable_segments`` >= 2: discretized, sims.fast.physics.discretized_spec), the wind
-    of ``params`` and the sensors (``sensor_options``)."""
+    of ``params`` and the sensors (``sensor_options``).
+
+    ``plant`` (None or nominal: the model as it is) perturbs the simulated machine only
+    (``FastPlant``): the planner, the controller (``nominal_physics``) and the parked winch
+    lengths keep the nominal model; the plant starts where its own static equilibrium under
+    those commands lies (``perturbed_start``)."""
     session = plan if isinstance(plan, fp.FastProblem) else problem(plan)
     planner = fp.PaperPlanner() if planner is None else planner
     trajectory = plan_checked(planner, session, fp.PLAN_LABELS)
     duration = trajectory.duration if params.duration is None else params.duration
     segments = params.cable_segments
+    perturbed = plant is not None and not plant.is_nominal
+    if perturbed:
+        plant.check_segments(segments)
     run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
     measured = None
     if params.wind_file is not None:
@@ -485,25 +501,39 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
             measured.check_covers(duration)
         except WindFileError as e:
             raise ParamError(f"wind_file: {e}") from None
-    physics = FastPhysics.load(segments)
+    # The nominal model (the controller's) at the start; the plant is it, or a perturbed copy.
+    nominal = FastPhysics.load(segments)
     s0 = fp.reference_state(trajectory.sample(np.array([0.0])))
-    physics.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
+    nominal.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
                               s0.multifeed[0])
-    physics.data.ctrl[:] = parked_command(physics, s0)  # parked: the winches hold the start
+    nominal.data.ctrl[:] = parked_command(nominal, s0)  # parked: the winches hold the start
+    physics = nominal
+    if perturbed:
+        physics = FastPhysics.load(segments, plant)
+        physics.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
+                                  s0.multifeed[0])
+        physics.data.ctrl[:] = nominal.data.ctrl  # the operator parks it with the nominal model's lengths
+        perturbed_start(physics, nominal, plant)
     description = {}
     if controller is None:
         if controller_options is None:
             controller_options = ControllerOptions(stewart=params.stewart)
         controller = FastController(controller_options)
         description["stewart"] = "on" if controller_options.stewart else "off"
-    loads = (ChainCableLoads if segments else CableLoads)(
-        params.wind, params.wind_direction, params.wind_spectrum, params.turbulence_intensity, measured)
-    evaluation = FastEvaluation(physics, session, loads, description)
+    wind = dict(wind_speed=params.wind, wind_azimuth_deg=params.wind_direction, spectrum=params.wind_spectrum,
+                turbulence_intensity=params.turbulence_intensity, measured=measured)
+    if perturbed:
+        loads = plant.loads(segments, **wind)  # the true cables' EA and weight
+    else:
+        loads = (ChainCableLoads if segments else CableLoads)(**wind)
+    evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops)
     return Setup(physics=physics, trajectory=trajectory, controller=controller,
                  sensors=FastSensors(physics, sensor_options, CONTROL_DT), problem=session, planner=planner,
                  control_dt=CONTROL_DT, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
                  report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed, params=params,
-                 output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1)
+                 output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1,
+                 nominal_physics=nominal_copy(nominal) if perturbed else None,  # None: a copy of physics
+                 plant=plant if plant is not None else FastPlant())
 
 
 def goal_plan(params: "FastParams") -> fp.FastPlan:
@@ -528,8 +558,10 @@ def goal_plan(params: "FastParams") -> fp.FastPlan:
     raise TypeError(f"no session for {type(params).__name__}")
 
 
-def build_scenario(params: "FastParams", planner=None, controller=None) -> Setup:
-    return build(goal_plan(params), params, planner=planner, controller=controller)
+def build_scenario(params: "FastParams", planner=None, controller=None, plant: FastPlant | None = None) -> Setup:
+    """A FAST scenario's run: its session (``goal_plan``) built with ``build``; ``plant``: the
+    plant's uncertainty (None: nominal)."""
+    return build(goal_plan(params), params, planner=planner, controller=controller, plant=plant)
 
 
 # ----------------------------------------------------------------------------- parameters
@@ -653,7 +685,8 @@ class FastSwitchParams(FastParams):
 
 
 #: What the FAST runs share: plan plots and the paper's figures.
-_RUN = dict(build=build_scenario, plan=goal_plan, kinds=plan_kinds, plan_extras=write_figures, control_dt=CONTROL_DT)
+_RUN = dict(build=build_scenario, plan=goal_plan, kinds=plan_kinds, plan_extras=write_figures, control_dt=CONTROL_DT,
+            plant=FastPlant())
 
 SCENARIOS = (
     Scenario(

@@ -45,8 +45,9 @@ from planners.fast import plan as fast_plan
 from planners.errors import LimitError
 from planners.legs import leg_lengths, structure_matrix
 from planners.rotations import rot_y, rot_z, skew, vee, wxyz
-from sims.task import Sensors, SensorSpec
-from sims.params import Params, param
+from sims.task import Sensors, SensorSpec, nominal_copy
+from sims.params import ParamError, Params, PlantParams, param
+from sims.plant import set_inertial
 from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
 
 CONTROL_DT = 0.01  # s: the runner's tick, the Stewart stabilizer's 100 Hz
@@ -115,6 +116,139 @@ def catenary_tension(chord, unstretched, span, guess, iterations: int = 30,
     return t
 
 
+# ----------------------------------------------------------------------------- plant uncertainty
+
+#: Everything the cabin carries, 30 091.8 kg (CASPR, REFERENCE.md): the shell and structure,
+#: the A-B rotator, the Stewart legs, the feed platform and the receiver (models/fast/README.md).
+#: The lumped cable masses (anchor_mass*) belong to the cables.
+CABIN_BODIES = ("cabin", "ab_a", "ab_b", *(f"leg{i}_{part}" for i in range(1, 7) for part in ("housing", "rod")),
+                "feed_platform", "receiver")
+#: What bounds the tower tops' errors (assumed; no public figure): their survey and construction
+#: tolerance, the guide pulleys' exit points, the >100 m towers' deflection under the cables'
+#: pull (the model's towers are rigid): tens of mm; 0.1 m bounds it.
+_TOWER_ERROR = dict(unit="mm", low=-100.0, high=100.0,
+                    reason="survey and construction tolerance of the tower tops, the pulleys' exit points and the "
+                           "towers' deflection under load: tens of mm (assumed); 0.1 m bounds it")
+
+
+@dataclass(frozen=True)
+class FastPlant(PlantParams):
+    """FAST's plant uncertainty: how the real feed support differs from models/fast and the
+    planner's FastGeometry, which the controller keeps (models/fast/README.md, "Plant
+    uncertainty").
+
+    Where each one acts: the tower tops, the cabin's masses and centre of mass, the lumped
+    cable masses (``anchor_mass*``) and the Stewart legs' force limits edit the MJCF (MjSpec)
+    before compiling (``spec``); the cables' EA and weight per length are constants of the
+    plant's Python-side cable physics (``CableLoads``, ``ChainCableLoads``: the catenary law,
+    the applied half cable weights, the chain's springs and node masses). The controller's
+    winch feed-forward keeps the nominal EA and weight (``winch_feedforward``), its statics the
+    nominal masses (planners.fast.FAST). A perturbed plant starts where its own static
+    equilibrium lies under the nominal parked commands (``perturbed_start``).
+    """
+
+    cable_ea_error: float = param(
+        0.0, f"error of the cables' axial stiffness EA ({CABLE_EA / 1e6:g} MN nominal) as a fraction", "fraction",
+        low=-0.35, high=0.10, reason="steel wire rope's effective modulus is 100-160 GPa (REFERENCE.md): -33 % to "
+        "+7 % of the nominal 150 GPa, rounded out")
+    cable_mass_error: float = param(
+        0.0, f"error of the cables' mass per length ({fast.FAST.cable_mass_per_length:g} kg/m nominal) as a fraction",
+        "fraction", low=-0.2, high=0.2, reason="46 mm steel wire ropes weigh about 8.5 (six-strand) to 12 kg/m "
+        "(locked coil) (rope makers' tables, assumed), +/-20 % of 10 kg/m")
+    anchor_radial_error: float = param(
+        0.0, "every tower top's cable exit moved outward (away from the dish axis) by this", **_TOWER_ERROR)
+    anchor_height_error: float = param(0.0, "every tower top's cable exit moved up by this", **_TOWER_ERROR)
+    anchor_errors: tuple[tuple[float, ...], ...] = param(
+        ((0.0, 0.0, 0.0),) * 6, "each tower top's cable exit moved by (x east, y north, z up), one row per tower 1-6, "
+        "added to anchor_radial_error and anchor_height_error", length=3, min_items=6, max_items=6, **_TOWER_ERROR)
+    cabin_mass_error: float = param(
+        0.0, "error of the mass and inertia of everything the cabin carries (30 091.8 kg: shell, A-B rotator, "
+        "Stewart, feed platform, receiver) as a fraction, every part alike", "fraction", low=-0.1, high=0.1,
+        reason="CASPR's 30 091.8 kg against the public '30 t'; receivers and equipment change (assumed +/-10 %)")
+    cabin_com_offset: tuple[float, ...] = param(
+        (0.0, 0.0, 0.0), "shift of the whole cabin's centre of mass (the shell's moves by the cabin's mass over the "
+        "shell's, 1.295 times this), cabin frame (x, y, z)", "m", low=-0.5, high=0.5, length=3,
+        reason="its place 1 m below the anchor plane is an assumption (planners.fast); 0.5 m, under a tenth of the "
+        "cabin's 7.6 m height and 13 m diameter (assumed)")
+    stewart_force_scale: float = param(
+        1.0, "the Stewart legs' force limits as a fraction of their +/-30 kN rating", "fraction", low=0.5, high=1.0,
+        reason="the rating is what a drive guarantees; derating (heat, supply voltage) only lowers it; half still "
+        "carries the legs' largest static load, 12.4 kN (models/fast/README.md)")
+
+    @property
+    def cable_ea(self) -> float:
+        """The true cables' EA, N."""
+        return CABLE_EA * (1.0 + self.cable_ea_error)
+
+    @property
+    def cable_mass_per_length(self) -> float:
+        """The true cables' mass per length, kg/m."""
+        return fast.FAST.cable_mass_per_length * (1.0 + self.cable_mass_error)
+
+    def tower_top_errors(self) -> np.ndarray:
+        """(6, 3) how far each tower top's cable exit lies from its design position, m (world):
+        radially outward, up, and the per-tower table."""
+        radial = fast.FAST.tower_anchors[:, :2] / np.linalg.norm(fast.FAST.tower_anchors[:, :2], axis=1)[:, None]
+        error = np.asarray(self.anchor_errors, dtype=float).copy()
+        error[:, :2] += self.anchor_radial_error * radial
+        error[:, 2] += self.anchor_height_error
+        return 1e-3 * error
+
+    def spec(self) -> mujoco.MjSpec:
+        """models/fast/scene.xml edited into this plant (MjSpec): site_pos of ``tower{i}_top``
+        moved by ``tower_top_errors`` (the towers' bodies are not rotated); body_mass and
+        body_inertia of CABIN_BODIES times (1 + cabin_mass_error) (explicit inertials, the
+        same centres of mass and principal axes); the shell's (``cabin``) body_ipos moved by
+        cabin_com_offset times the cabin's mass over the shell's (the whole cabin's centre
+        of mass moves by cabin_com_offset); body_mass of ``anchor_mass1..3`` (a third of two
+        cables' mass each) times (1 + cable_mass_error); actuator_forcerange of the legs times
+        stewart_force_scale. MuJoCo derives the rest (subtree masses, qM at qpos0, the cable
+        tendons' lengths at qpos0) from them."""
+        nominal = _compiled(0)
+        spec = mujoco.MjSpec.from_file(str(models.scene_path("fast")))
+        for i, error in enumerate(self.tower_top_errors(), start=1):
+            site = spec.site(f"tower{i}_top")
+            site.pos = nominal.site_pos[nominal.site(f"tower{i}_top").id] + error
+        ids = [nominal.body(b).id for b in CABIN_BODIES]
+        ratio = nominal.body_mass[ids].sum() / nominal.body_mass[nominal.body("cabin").id]
+        for body in CABIN_BODIES:
+            set_inertial(spec, nominal, body, 1.0 + self.cabin_mass_error,
+                         ratio * np.asarray(self.cabin_com_offset) if body == "cabin" else None)
+        for i in range(1, 4):
+            spec.body(f"anchor_mass{i}").mass = nominal.body_mass[nominal.body(f"anchor_mass{i}").id] * (
+                1.0 + self.cable_mass_error)
+        for name in LEG_ACTUATORS:
+            spec.actuator(name).forcerange = nominal.actuator_forcerange[nominal.actuator(name).id] * \
+                self.stewart_force_scale
+        return spec
+
+    def model(self, cable_segments: int = 0) -> mujoco.MjModel:
+        """The plant's compiled model (``spec``); ``cable_segments`` >= 2: with its cables
+        discretized (``discretized_spec``, with this plant's EA and mass per length)."""
+        spec = self.spec()
+        if cable_segments:
+            spec = discretized_spec(cable_segments, spec, self.cable_ea, self.cable_mass_per_length)
+        return spec.compile()
+
+    def loads(self, cable_segments: int = 0, **wind) -> "CableLoads":
+        """The plant's cable physics and wind (CableLoads, or ChainCableLoads for the
+        discretized cables) with this plant's EA and mass per length; ``wind``: CableLoads'
+        wind arguments."""
+        kind = ChainCableLoads if cable_segments else CableLoads
+        return kind(**wind, ea=self.cable_ea, mass_per_length=self.cable_mass_per_length)
+
+    def check_segments(self, cable_segments: int) -> None:
+        """A ParamError naming the keys when the plant's stiffer or lighter cables vibrate beyond
+        the timestep's limit with ``cable_segments`` segments (``max_cable_segments``)."""
+        if cable_segments:
+            most = max_cable_segments(ea=self.cable_ea, mass_per_length=self.cable_mass_per_length)
+            if cable_segments > most:
+                raise ParamError(f"cable_segments = {cable_segments} with plant.cable_ea_error = "
+                                 f"{self.cable_ea_error:g} and plant.cable_mass_error = {self.cable_mass_error:g}: "
+                                 f"the segments vibrate beyond the timestep's limit omega dt <= "
+                                 f"{SEGMENT_OMEGA_DT_LIMIT:g}; use at most {most}")
+
+
 # ----------------------------------------------------------------------------- physics
 
 
@@ -152,7 +286,8 @@ STRING_MODE_HZ = 0.2
 SEGMENT_OMEGA_DT_LIMIT = 0.7
 
 
-def max_cable_segments(shortest_cable_m: float | None = None, timestep: float | None = None) -> int:
+def max_cable_segments(shortest_cable_m: float | None = None, timestep: float | None = None,
+                       ea: float = CABLE_EA, mass_per_length: float = fast.FAST.cable_mass_per_length) -> int:
     """The most segments a discretized cable may have: its segments' axial mode
     omega = 2 sqrt(EA / mu) n / L must keep omega dt <= SEGMENT_OMEGA_DT_LIMIT.
 
@@ -161,6 +296,8 @@ def max_cable_segments(shortest_cable_m: float | None = None, timestep: float | 
         at the model's home keyframe (what ``discretized_spec`` divides). A run checks its
         own cables at its start (``ChainCableLoads.reset``).
       timestep: the physics timestep dt, s; default the model's.
+      ea, mass_per_length: the cables' EA (N) and mass per length mu (kg/m); default the
+        nominal ones (a perturbed plant's: ``FastPlant``).
     """
     if shortest_cable_m is None or timestep is None:
         model = _compiled(0)
@@ -168,7 +305,7 @@ def max_cable_segments(shortest_cable_m: float | None = None, timestep: float | 
             shortest_cable_m = float(np.min(model.key("home").ctrl[:len(CABLE_ACTUATORS)]))
         if timestep is None:
             timestep = float(model.opt.timestep)
-    wave = 2.0 * math.sqrt(CABLE_EA / fast.FAST.cable_mass_per_length)  # omega l, m/s
+    wave = 2.0 * math.sqrt(ea / mass_per_length)  # omega l, m/s
     return int(math.floor(SEGMENT_OMEGA_DT_LIMIT * shortest_cable_m / (wave * timestep) + 1e-9))
 
 
@@ -181,8 +318,11 @@ def _compiled(cable_segments: int = 0) -> mujoco.MjModel:
     return discretized_spec(cable_segments).compile()
 
 
-def discretized_spec(segments: int) -> mujoco.MjSpec:
-    """models/fast with each cable discretized into ``segments`` elastic segments.
+def discretized_spec(segments: int, spec: mujoco.MjSpec | None = None, ea: float = CABLE_EA,
+                     mass_per_length: float = fast.FAST.cable_mass_per_length) -> mujoco.MjSpec:
+    """models/fast (or ``spec``, a perturbed plant's: ``FastPlant.spec``) with each cable
+    discretized into ``segments`` elastic segments of the cables' ``ea`` (N) and
+    ``mass_per_length`` (kg/m).
 
     Cable i becomes ``segments`` spatial tendons ``cable{i}_seg{k}`` joining the tower top,
     ``segments - 1`` point masses ``cable{i}_node{k}`` (three slide joints each, damped by
@@ -197,11 +337,12 @@ def discretized_spec(segments: int) -> mujoco.MjSpec:
     """
     if segments < 2:
         raise ValueError(f"cable segments {segments} must be >= 2 (0 for the lumped cables)")
-    spec = mujoco.MjSpec.from_file(str(models.scene_path("fast")))
+    if spec is None:
+        spec = mujoco.MjSpec.from_file(str(models.scene_path("fast")))
     home = spec.compile()  # the lumped model: its home keyframe and sites
     rest = home.key("home").ctrl[0] / segments  # the winches' unstretched length at home
-    mass = fast.FAST.cable_mass_per_length * rest
-    stiffness = CABLE_EA / rest
+    mass = mass_per_length * rest
+    stiffness = ea / rest
     for i in range(1, 4):
         body = spec.body(f"anchor_mass{i}")
         body.mass, body.inertia = 1e-6, [1e-6, 1e-6, 1e-6]
@@ -238,9 +379,14 @@ class FastPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/fast/scene.xml with FAST's accessors."""
 
     @classmethod
-    def load(cls, cable_segments: int = 0) -> "FastPhysics":
-        """The model at keyframe home; ``cable_segments`` >= 2 for the discretized cables."""
-        physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(_compiled(cable_segments))))
+    def load(cls, cable_segments: int = 0, plant: "FastPlant | None" = None) -> "FastPhysics":
+        """The model at keyframe home; ``cable_segments`` >= 2 for the discretized cables;
+        ``plant`` (None or nominal: the model as it is) perturbs it (``FastPlant.model``)."""
+        if plant is None or plant.is_nominal:
+            model = copy.copy(_compiled(cable_segments))
+        else:
+            model = plant.model(cable_segments)
+        physics = cls.from_model(dm_mujoco.wrapper.MjModel(model))
         physics.cable_segments = cable_segments
         physics.reset(keyframe_id=0)
         return physics
@@ -476,10 +622,17 @@ class CableLoads:
       turbulence_intensity: sigma_u / U; None: the spectrum's own (sims.wind.wind_speed_series).
       measured: a sims.wind.MeasuredWind record instead of the model (its speed, and its
         direction where it has one), resampled to the ticks.
+      ea, mass_per_length: the true cables' EA (N) and mass per length (kg/m) for the plant's
+        law and loads; default the nominal ones (a perturbed plant's: ``FastPlant``). The
+        controller's feed-forward keeps the nominal ones (``winch_feedforward``).
     """
 
     def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal",
-                 turbulence_intensity: float | None = None, measured=None):
+                 turbulence_intensity: float | None = None, measured=None, ea: float = CABLE_EA,
+                 mass_per_length: float = fast.FAST.cable_mass_per_length):
+        self.ea = float(ea)
+        self.mass_per_length = float(mass_per_length)
+        self.weight = self.mass_per_length * fast.GRAVITY  # N/m; CABLE_WEIGHT at the nominal mass
         self.mean_speed = check_mean_speed(wind_speed) if measured is None else float(np.mean(measured.speed))
         self.direction = horizontal_direction(wind_azimuth_deg)
         self.spectrum = spectrum
@@ -510,7 +663,8 @@ class CableLoads:
         self._xfrc = data.xfrc_applied[self._cabin]
         mujoco.mj_forward(model, data)
         chord, span, _ = self._geometry()
-        self.tension = catenary_tension(chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60)
+        self.tension = catenary_tension(chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60,
+                                        ea=self.ea, weight=self.weight)
         self.apply(physics)
 
     def _geometry(self):
@@ -528,19 +682,19 @@ class CableLoads:
         l0 = data.ctrl[self._cables]
         # One Newton step from the last tick's tension: it moves by a fraction of a percent in
         # 10 ms, and Newton's error squares (the tests compare with the converged solution).
-        t = catenary_tension(chord, l0, span, self.tension, iterations=1)
+        t = catenary_tension(chord, l0, span, self.tension, iterations=1, ea=self.ea, weight=self.weight)
         self.tension = t
         if tick is not None:
             self.tension_log[tick] = t
-        k = tangent_stiffness(t, span, l0)
-        g = chord_factor(t, span)
+        k = tangent_stiffness(t, span, l0, self.ea, self.weight)
+        g = chord_factor(t, span, self.ea, self.weight)
         ids = self._cables
         model.actuator_gainprm[ids, 0] = g * k
         model.actuator_biasprm[ids, 0] = -t + k * chord - g * k * l0
         model.actuator_biasprm[ids, 1] = -k
         model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
         anchor_force = np.zeros((6, 3))
-        anchor_force[:, 2] = -0.5 * CABLE_WEIGHT * chord
+        anchor_force[:, 2] = -0.5 * self.weight * chord
         com = data.xipos[self._cabin]
         arms = data.site_xpos[self._sites] - com
         u = 0.0 if tick is None else float(self.speed[tick])
@@ -593,14 +747,14 @@ class ChainCableLoads(CableLoads):
         rest = data.ctrl[physics.cable_ids] / n
         # A segment's axial mode, 2 sqrt(EA / mu) / l rad/s, must stay slow for the timestep
         # (the springs are explicit): ``max_cable_segments`` at this run's cables.
-        most = max_cable_segments(float(rest.min()) * n, float(model.opt.timestep))
+        most = max_cable_segments(float(rest.min()) * n, float(model.opt.timestep), self.ea, self.mass_per_length)
         if n > most:
-            omega = 2.0 * math.sqrt(CABLE_EA / fast.FAST.cable_mass_per_length) / rest.min()
+            omega = 2.0 * math.sqrt(self.ea / self.mass_per_length) / rest.min()
             raise LimitError(f"cable segments {n}: the shortest segment ({rest.min():.1f} m) vibrates at "
                              f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
                              f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most "
                              f"{most} segments")
-        mass = np.broadcast_to((fast.FAST.cable_mass_per_length * rest)[:, None], self._nodes.shape)
+        mass = np.broadcast_to((self.mass_per_length * rest)[:, None], self._nodes.shape)
         model.body_mass[self._nodes] = mass
         dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)
         model.dof_damping[dofs] = (2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[..., None]
@@ -610,7 +764,7 @@ class ChainCableLoads(CableLoads):
         model, data = self._model, self._data
         ids = self._cables
         self._rest = rest = data.ctrl[ids] / self._n  # (6,) every segment's unstretched length
-        k = CABLE_EA / np.maximum(rest, 1e-3)
+        k = self.ea / np.maximum(rest, 1e-3)
         model.actuator_gainprm[ids, 0] = k / self._n
         model.actuator_biasprm[ids, 0] = 0.0
         model.actuator_biasprm[ids, 1] = -k
@@ -624,7 +778,7 @@ class ChainCableLoads(CableLoads):
             self.tension_log[tick] = self.tension
         anchors = data.site_xpos[self._sites]
         anchor_force = np.zeros((6, 3))
-        anchor_force[:, 2] = -0.5 * CABLE_WEIGHT * self._rest
+        anchor_force[:, 2] = -0.5 * self.weight * self._rest
         u = 0.0 if tick is None else float(self.speed[tick])
         force, torque = np.zeros(3), np.zeros(3)
         if u != 0.0:
@@ -642,6 +796,73 @@ class ChainCableLoads(CableLoads):
         com = data.xipos[self._cabin]
         self._xfrc[:3] = anchor_force.sum(axis=0) + force
         self._xfrc[3:] = _moment(anchors - com, anchor_force) + torque
+
+
+# ----------------------------------------------------------------------------- a perturbed start
+
+#: Settling a plant into its static equilibrium (``static_equilibrium``): extra damping
+#: 2 omega M_ii on the cabin's six degrees of freedom, omega at its lowest mode (heave,
+#: 0.30 Hz, models/fast/README.md), and on the discretized cables' nodes at their string mode
+#: (STRING_MODE_HZ), M_ii the mass matrix's diagonal: every mode then decays at least as
+#: exp(-omega t). Damping acts on velocities only, so the plant comes to rest where it would
+#: without it. It is at rest when no joint moves faster than SETTLE_SPEED (m/s, rad/s: 1 um/s
+#: is a micrometre of creep per second), within SETTLE_MAX_S.
+SETTLE_CABIN_HZ = 0.30
+SETTLE_SPEED = 1e-6
+SETTLE_MAX_S = 60.0
+
+
+def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: float = SETTLE_MAX_S) -> np.ndarray:
+    """The qpos (nq,) where ``physics`` comes to rest from its present state under its present
+    commands (ctrl, act) and the cable physics of ``loads`` (made without wind): a copy of it
+    (``physics`` is not changed) stepped with the damping above until at rest. A LimitError
+    when it does not come to rest within ``max_duration`` s (a cable gone slack, a drive at
+    its limit)."""
+    scratch = nominal_copy(physics)()
+    model, data = scratch.model.ptr, scratch.data.ptr
+    n = int(round(max_duration / CONTROL_DT))
+    steps = int(round(CONTROL_DT / model.opt.timestep))
+    loads.reset(scratch, np.arange(n + 1) * CONTROL_DT, np.random.default_rng(0))  # sets the nodes' masses
+    mujoco.mj_forward(model, data)
+    dense = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, dense)
+    diagonal = np.diag(dense).copy()
+    cabin = model.jnt_dofadr[model.joint("cabin").id] + np.arange(6)
+    model.dof_damping[cabin] += 2 * (2 * math.pi * SETTLE_CABIN_HZ) * diagonal[cabin]
+    if physics.cable_segments:
+        nodes = (model.body_dofadr[scratch.node_bodies][..., None] + np.arange(3)).ravel()
+        model.dof_damping[nodes] += 2 * (2 * math.pi * STRING_MODE_HZ) * diagonal[nodes]
+    for tick in range(n):
+        loads(tick, scratch)
+        mujoco.mj_step(model, data, nstep=steps)
+        if tick % 100 == 99 and float(np.abs(data.qvel).max()) < SETTLE_SPEED:
+            return data.qpos.copy()
+    raise LimitError(f"the plant does not come to rest within {max_duration:g} s under the parked commands "
+                     f"(joint speeds up to {float(np.abs(data.qvel).max()):.3g}, more than {SETTLE_SPEED:g} m/s or "
+                     "rad/s): a cable slack or a drive at its limit")
+
+
+def perturbed_start(physics: FastPhysics, nominal: FastPhysics, plant: FastPlant) -> None:
+    """Move the perturbed plant ``physics``, put at ``nominal``'s state and commands (the
+    plan's first pose at rest, the parked winch lengths of the nominal model), to where its
+    perturbation moves that state's static equilibrium, at rest: qpos = the nominal start +
+    (the plant's equilibrium - the nominal model's), both under the same commands
+    (``static_equilibrium``; free joints composed, mj_differentiatePos / mj_integratePos).
+    A machine parked under the operator's nominal winch lengths stands there: a heavier cabin
+    lower, one on softer cables lower still. Released from the nominal pose it would instead
+    ring at its 0.3-0.65 Hz modes with a swing twice the offset, a start no real run has. The
+    difference, not the plant's own equilibrium, so that the start tends to the nominal one as
+    the perturbation vanishes (the discretized cables start off theirs by the chain's sag
+    error, ``discretized_spec``)."""
+    segments = physics.cable_segments
+    at_rest_nominal = static_equilibrium(nominal, FastPlant().loads(segments))
+    at_rest_plant = static_equilibrium(physics, plant.loads(segments))
+    model, data = physics.model.ptr, physics.data.ptr
+    shift = np.zeros(model.nv)
+    mujoco.mj_differentiatePos(model, shift, 1.0, at_rest_nominal, at_rest_plant)
+    mujoco.mj_integratePos(model, data.qpos, shift, 1.0)
+    data.qvel[:] = 0.0
+    mujoco.mj_forward(model, data)
 
 
 # ----------------------------------------------------------------------------- control
