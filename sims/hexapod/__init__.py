@@ -928,7 +928,14 @@ class HexapodPlant(PlantParams):
         return hexapod_planner.HexapodGeometry(base, platform, RUBIN_CAMERA.rotation_pivot)
 
 
-_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT, plant=HexapodPlant())
+def judge_plans(params_list, planner=None):
+    """The planner checks of each run, no physics (planner-only campaigns; sims/hexapod/plan_checks.py)."""
+    from sims.hexapod.plan_checks import judge_plans as judge  # it imports this package
+
+    return judge(params_list, planner=planner)
+
+
+_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT, plant=HexapodPlant(), judge_plans=judge_plans)
 
 SCENARIOS = (
     Scenario(

@@ -492,7 +492,14 @@ class LoaderPlant(PlantParams):
 
 from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
 
-_RUN = dict(build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT, plant=LoaderPlant())
+def judge_plans(params_list, planner=None):
+    """The planner checks of each run, no physics (planner-only campaigns; sims/loader/plan_checks.py)."""
+    from sims.loader.plan_checks import judge_plans as judge  # it imports this package
+
+    return judge(params_list, planner=planner)
+
+
+_RUN = dict(build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT, plant=LoaderPlant(), judge_plans=judge_plans)
 
 SCENARIOS = (
     Scenario(
