@@ -7,6 +7,7 @@ run for run (every column but the wall time).
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import os
@@ -204,6 +205,37 @@ duration = 1.0
     assert "1 errors" in capsys.readouterr().out or True
 
 
+def test_a_worker_that_dies_costs_only_its_run(tmp_path):
+    planner = _write(tmp_path / "fatal_planner.py", """
+import os
+from planners.hexapod import PaperMovePlanner
+
+class Fatal(PaperMovePlanner):
+    def plan(self, problem):
+        if problem.target_pose[0] > 0.0015:
+            os._exit(3)  # the process dies, as on an out-of-memory kill
+        return super().plan(problem)
+
+def make():
+    return Fatal()
+""")
+    spec = _write(tmp_path / "spec.toml", f"""
+scenario = "hexapod-sync-move"
+planner = "{planner.name}:make"
+[parameters]
+duration = 0.5
+[grid]
+"moves[0].target[0]" = [1.0, 2.0, 1.2]
+""")
+    code = cli.main(["sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"])
+    assert code == cli.EXIT_CHECK_FAILED
+    table = pq.read_table(tmp_path / "out" / "results.parquet")
+    assert table.column("run").to_pylist() == [0, 1, 2]
+    status = table.column("status").to_pylist()
+    assert status[1] == "error" and "died twice" in table.column("error").to_pylist()[1]
+    assert status[0] != "error" and status[2] != "error"
+
+
 # ------------------------------------------------------------------------------ bad specs
 
 BAD_SPECS = {
@@ -359,4 +391,11 @@ def test_worst_runs_rank_by_the_ratio_to_the_limit():
 def test_example_campaign_specs_are_valid(example):
     spec = spec_module.load(example)
     assert spec.size >= 1 and spec.axes
-    spec.resolve(spec.runs()[0])
+    resolved = 0
+    for run in itertools.islice(spec.iter_runs(), 50):
+        try:
+            spec.resolve(run)
+            resolved += 1
+        except ParamError:
+            assert spec.invalid == "skip"  # otherwise every run must be valid
+    assert resolved == min(50, spec.size) if spec.invalid == "refuse" else resolved >= 5

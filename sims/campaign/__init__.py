@@ -52,9 +52,10 @@ def tasks_of(spec, runs) -> list[worker.RunTask]:
     return out
 
 
-def check_runs(spec, runs, quiet: bool) -> None:
+def check_runs(spec, runs, quiet: bool, total: int | None = None) -> None:
     """Every run's parameters validated (a ParamError naming the first bad run)."""
-    for run in tqdm(runs, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False):
+    for run in tqdm(runs, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False,
+                    total=total):
         spec.resolve(run)
 
 
@@ -70,18 +71,19 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
         raise ParamError(f"--rerun-worst {rerun_worst} must be >= 0")
     if rerun_worst and spec.mode == "plan":
         raise ParamError("--rerun-worst replays simulated runs; a planner-only campaign has none")
-    runs = spec.runs()
     if spec.invalid == "refuse":
-        check_runs(spec, runs, quiet)
+        check_runs(spec, spec.iter_runs(), quiet, spec.size)
     with target.reserved():
         target.open(spec, spec.path.read_text())
         done = target.done()
-        pending = [r for r in runs if r.index not in done]
+        pending = spec.size - len(done)
         chunk_size = 1 if spec.mode == "simulate" else max(1, min(PLAN_CHUNK, math.ceil(
-            len(pending) / (4 * (runner_engine.workers or 1)))))
-        chunks = list(spec_module.iter_chunks(tasks_of(spec, pending), chunk_size))
+            pending / (4 * (runner_engine.workers or 1)))))
+        # Chunks are made as the engine asks for them: a campaign of 10^6 runs is never held whole.
+        chunks = (tasks_of(spec, runs) for runs in spec_module.iter_chunks(
+            (r for r in spec.iter_runs() if r.index not in done), chunk_size))
         if done and not quiet:
-            echo(f"resuming {target}: {len(done)} of {spec.size} runs done, {len(pending)} to go")
+            echo(f"resuming {target}: {len(done)} of {spec.size} runs done, {pending} to go")
         failed = errors = 0
         bar = tqdm(total=spec.size, initial=len(done), unit="run", disable=quiet, desc="campaign", smoothing=0.1)
         start = time.perf_counter()
@@ -103,7 +105,7 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
         worst = []
         if rerun_worst:
             worst = rerun_worst_runs(spec, target, table, rerun_worst, quiet, echo)
-    return Outcome(summary, len(pending), len(done), table, worst, engine_wall)
+    return Outcome(summary, pending, len(done), table, worst, engine_wall)
 
 
 def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
@@ -117,7 +119,7 @@ def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
 
     picked = report.worst_runs(table, k, target.checks())
     rows = {r["run"]: r for r in table.to_pylist() if r["run"] in set(picked)}
-    by_index = {run.index: run for run in spec.runs() if run.index in rows}
+    by_index = {run.index: run for run in spec.iter_runs() if run.index in rows}
     (target.path / "worst").mkdir(exist_ok=True)
     out = []
     for rank, index in enumerate(picked, start=1):

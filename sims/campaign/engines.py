@@ -12,7 +12,9 @@ no retries: a run is not repeated behind the campaign's back) to the cluster at 
 
 from __future__ import annotations
 
+import collections
 import concurrent.futures as cf
+import itertools
 import multiprocessing
 import os
 
@@ -45,36 +47,63 @@ class LocalEngine:
         self.workers = workers or os.cpu_count() or 1
 
     def run(self, context, chunks):
-        """Yield (chunk, result) as chunks finish. A worker that dies takes its pool with it:
-        the unfinished chunks are tried once more in a new pool, then given error rows."""
-        remaining = list(chunks)
-        for attempt in range(2):
-            if not remaining:
-                return
-            pool = cf.ProcessPoolExecutor(max_workers=min(self.workers, len(remaining)),
-                                          mp_context=multiprocessing.get_context("spawn"),
+        """Yield (chunk, result) as chunks finish, with at most two chunks per worker in
+        flight (``chunks`` may be a generator). A worker that dies (out of memory, a crash in
+        native code) takes its pool with it: the chunks in flight are tried once more, one at
+        a time, in a new pool, and one that breaks a pool again is given error rows; the rest
+        go on."""
+        source = iter(chunks)
+        retry = collections.deque()
+        broke_once = set()
+
+        def next_chunks(n):
+            out = []
+            while len(out) < n:
+                if retry:
+                    out.append(retry.popleft())
+                    continue
+                chunk = next(source, None)
+                if chunk is None:
+                    break
+                out.append(chunk)
+            return out
+
+        while True:
+            pool = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
                                           initializer=_init_worker, initargs=(context,))
             broken = []
             try:
-                futures = {pool.submit(_run_in_worker, chunk): chunk for chunk in remaining}
-                for future in cf.as_completed(futures):
-                    chunk = futures[future]
-                    try:
-                        result = future.result()
-                    except cf.process.BrokenProcessPool:
-                        broken.append(chunk)
-                        continue
-                    except Exception as e:  # noqa: BLE001  (pickling, a worker's import error)
-                        result = _lost(context, chunk, worker._exception_text(e))
-                    yield chunk, result
+                # Chunks that were in flight when a pool broke run one at a time, so the one
+                # that breaks it again is known; the others go on as usual.
+                futures = {pool.submit(_run_in_worker, c): c for c in next_chunks(1 if retry else 2 * self.workers)}
+                while futures:
+                    done, _ = cf.wait(futures, return_when=cf.FIRST_COMPLETED)
+                    for future in done:
+                        chunk = futures.pop(future)
+                        try:
+                            result = future.result()
+                        except cf.process.BrokenProcessPool:
+                            broken.append(chunk)
+                            continue
+                        except Exception as e:  # noqa: BLE001  (pickling, a worker's import error)
+                            result = _lost(context, chunk, worker._exception_text(e))
+                        yield chunk, result
+                    if not broken:
+                        for c in next_chunks((1 if retry else 2 * self.workers) - len(futures)):
+                            futures[pool.submit(_run_in_worker, c)] = c
             except BaseException:
                 _terminate(pool)
                 raise
-            else:
-                pool.shutdown(wait=True)
-            remaining = sorted(broken, key=lambda c: c[0].index)
-        for chunk in remaining:
-            yield chunk, _lost(context, chunk, "its worker process died twice (out of memory, or a crash in native code)")
+            pool.shutdown(wait=True)
+            if not broken:
+                return
+            for chunk in sorted(broken, key=lambda c: c[0].index, reverse=True):
+                if chunk[0].index in broke_once:
+                    yield chunk, _lost(context, chunk, "its worker process died twice running it (out of memory, "
+                                       "or a crash in native code)")
+                else:
+                    broke_once.add(chunk[0].index)
+                    retry.appendleft(chunk)
 
 
 def _terminate(pool) -> None:
@@ -110,9 +139,15 @@ class RayEngine:
                 ray.init(num_cpus=self.workers or os.cpu_count() or 1, **options)
             started = True
         try:
-            remote = ray.remote(num_cpus=1, max_retries=0)(worker.run_chunk)
+            # One BLAS thread, as in every planbench process (sims/__init__.py): the same
+            # numbers as the local engine's, bit for bit.
+            threads = {v: os.environ.get(v, "1") for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                                            "MKL_NUM_THREADS")}
+            remote = ray.remote(num_cpus=1, max_retries=0, runtime_env={"env_vars": threads})(worker.run_chunk)
             context_ref = ray.put(context)
-            pending = {remote.remote(context_ref, chunk): chunk for chunk in chunks}
+            source = iter(chunks)
+            in_flight = 2 * int(ray.cluster_resources().get("CPU", 1))
+            pending = {remote.remote(context_ref, chunk): chunk for chunk in itertools.islice(source, in_flight)}
             try:
                 while pending:
                     done, _ = ray.wait(list(pending), num_returns=1, timeout=1.0)
@@ -123,6 +158,8 @@ class RayEngine:
                         except Exception as e:  # noqa: BLE001  (a worker lost, a task error)
                             result = _lost(context, chunk, worker._exception_text(e))
                         yield chunk, result
+                    for chunk in itertools.islice(source, in_flight - len(pending)):
+                        pending[remote.remote(context_ref, chunk)] = chunk
             except BaseException:
                 for ref in pending:
                     ray.cancel(ref, force=True)

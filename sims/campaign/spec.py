@@ -310,19 +310,25 @@ class CampaignSpec:
         state = np.random.SeedSequence(self.seed, spawn_key=(2, sample, replicate)).generate_state(2, np.uint32)
         return int((int(state[0]) << 31) ^ int(state[1])) & (2**63 - 1)
 
-    def runs(self) -> list[Run]:
-        """Every run, in order of its index."""
+    def iter_runs(self):
+        """Every run, in order of its index, one at a time (a campaign of 10^6 runs is never
+        held in memory whole)."""
         draws = self.draws()
-        seeds = [[self.run_seed(s, r) for r in range(self.replicates)] for s in range(self.samples)]
-        out, index = [], 0
+        seeds = [[self.run_seed(s, r) for r in range(self.replicates)] for s in range(self.samples)] \
+            if self.samples * self.replicates <= 100_000 else None
+        index = 0
         for point in range(self.points):
             grid = self.grid_values(point)
             for s in range(self.samples):
                 drawn = tuple(float(d[s]) for d in draws)
                 for r in range(self.replicates):
-                    out.append(Run(index, point, s, r, seeds[s][r], grid + drawn))
+                    seed = seeds[s][r] if seeds is not None else self.run_seed(s, r)
+                    yield Run(index, point, s, r, seed, grid + drawn)
                     index += 1
-        return out
+
+    def runs(self) -> list[Run]:
+        """Every run, in order of its index."""
+        return list(self.iter_runs())
 
     def overrides(self, run: Run) -> tuple[dict, dict]:
         """(parameter overrides, plant overrides) of ``run``: the top-level keys its axes
@@ -546,28 +552,35 @@ def _thaw(value):
 
 
 def _check_axes(spec: CampaignSpec) -> None:
-    """Each grid value alone on the base, and each distribution's support ends: a value
-    outside its range is refused here, naming the axis."""
+    """Each grid value on the base alone: a value of the wrong type or out of its range is
+    refused here, naming the axis. With invalid = "skip" only the field itself is checked
+    (its combination with the base may break a limit that the runs' own values do not); a
+    distribution's support is checked against the range where it is parsed (``_axis``), and
+    the runs' combinations by ``CampaignSpec.resolve``."""
     for axis in spec.grid:
         for value in axis.values:
-            _try(spec, axis, _thaw(value))
-    for axis in spec.random:
-        for value in axis.distribution.support:
-            if math.isfinite(value):
-                _try(spec, axis, value)
+            _try(spec, axis, _thaw(value), whole=spec.invalid == "refuse")
 
 
-def _try(spec: CampaignSpec, axis: Axis, value) -> None:
+def _try(spec: CampaignSpec, axis: Axis, value, whole: bool) -> None:
     base = spec.base_plant if axis.plant else spec.base_params
     data = {axis.path[0]: copy.deepcopy(base.to_dict()[axis.path[0]])}
     if len(axis.path) == 1:
         data[axis.path[0]] = value
     else:
         set_path(data, axis.path, value, axis.column)
+    section = "grid" if axis.values is not None else "random"
     try:
-        type(base).from_mapping(data, base=base, prefix="plant." if axis.plant else "")
+        if whole:
+            type(base).from_mapping(data, base=base, prefix="plant." if axis.plant else "")
+        else:
+            from sims.params import _convert
+
+            name = axis.path[0]
+            declared = type(base).__dataclass_fields__[name].metadata["declared"]
+            _convert(field_types(type(base))[name], data[name], ("plant." if axis.plant else "") + name, declared)
     except ParamError as e:
-        raise ParamError(f"{'grid' if axis.values is not None else 'random'}.{axis.column} = {_show(value)}: {e}") from None
+        raise ParamError(f"{section}.{axis.column} = {_show(value)}: {e}") from None
 
 
 def iter_chunks(runs: list[Run], size: int):
