@@ -71,8 +71,8 @@ A planner of your own (``judge_plans(..., planner=...)``) is judged by sampling 
 trajectories it returns at the control ticks (``judge_trajectories``): slower, the same
 checks, the pose at every tick.
 
-Throughput (``python -m sims.hexapod.plan_checks``: ``benchmark``, one core of the 2-core
-development machine, with other jobs on it): 10^5 single-move runs, start and target uniform in
+Throughput (one core of the 2-core development machine, with other jobs on it; the campaign
+examples/hexapod/random_moves_campaign.toml measures it end to end): 10^5 single-move runs, start and target uniform in
 the limits, judged in 26 s of CPU (3800-4300 runs/s: 10^6 in about 4 min); building their
 ``HexapodParams`` took 40 s (10^6: about 7 min), longer than judging them.
 
@@ -88,7 +88,6 @@ Example::
 
 from __future__ import annotations
 
-import time
 from typing import Sequence
 
 import numpy as np
@@ -545,32 +544,3 @@ def judge_trajectories(moves: Sequence[hexapod_planner.MoveProblem], trajectorie
                   if c.name in ("arrival_spread", "arrival_vs_own_time") else c for c in checks]
     return checks
 
-
-# --------------------------------------------------------------------------- throughput
-
-
-def benchmark(n: int = 10_000, seed: int = 0) -> dict:
-    """Seconds to build ``n`` single-move HexapodParams (start and target uniform inside the
-    pose limits and the stroke, ``planners.hexapod.random_poses``; synchronous and
-    asynchronous alternating) and to judge them; the judging's rate, runs/s."""
-    from sims.hexapod import HexapodMove, pose_mm_deg
-
-    rng = np.random.default_rng(seed)
-    start, target = hexapod_planner.random_poses(n, rng), hexapod_planner.random_poses(n, rng)
-    t0, c0 = time.perf_counter(), time.process_time()
-    params = [HexapodParams(start_pose=pose_mm_deg(a), moves=(HexapodMove(pose_mm_deg(b), bool(i % 2 == 0)),))
-              for i, (a, b) in enumerate(zip(start, target))]
-    t1, c1 = time.perf_counter(), time.process_time()
-    checks = judge_plans(params)
-    t2, c2 = time.perf_counter(), time.process_time()
-    failed = {}
-    for run in checks:
-        for c in run:
-            if not c.passed:
-                failed[c.name] = failed.get(c.name, 0) + 1
-    return {"runs": n, "params_s": t1 - t0, "judge_s": t2 - t1, "params_cpu_s": c1 - c0, "judge_cpu_s": c2 - c1,
-            "runs_per_cpu_s": n / (c2 - c1), "failed": failed}
-
-
-if __name__ == "__main__":
-    print(benchmark())

@@ -80,8 +80,8 @@ How it is fast
     bounds are computed for all of them at once; each run's decisions depend on its own values
     only, so a run judged alone gives the same checks, bit for bit (tested).
 
-Throughput (``python -m sims.loader.plan_checks``: ``benchmark``, one core of the 2-core
-development machine, with other jobs on it): 6 key points at 0.5 s, uniform in the joint ranges
+Throughput (one core of the 2-core development machine, with other jobs on it; the campaign
+examples/loader/random_keypoints_campaign.toml measures it end to end): 6 key points at 0.5 s, uniform in the joint ranges
 (almost all strike something, most leave the ranges): 300 runs/s, 10^5 in about 6 min; Table 1's
 key points each moved by up to +/-3 deg (+/-15 mm), paths that pass the obstacles within
 centimetres: 150 runs/s, 10^5 in about 11 min. The clearance is nine tenths of it. Building
@@ -99,7 +99,6 @@ Example::
 from __future__ import annotations
 
 import functools
-import time
 from typing import Sequence
 
 import mujoco
@@ -627,7 +626,7 @@ def judge_trajectory(task: LoaderProblem, trajectory) -> list[Check]:
 
 
 def random_key_points(n: int, rng: np.random.Generator, keys: int = 6, spread_deg: float | None = None):
-    """``n`` key-point sets (Table 1's units: mm, deg), drawn for ``benchmark``: uniform in the
+    """``n`` key-point sets (Table 1's units: mm, deg), drawn for the tests: uniform in the
     joint ranges (``spread_deg`` None), or Table 1's points with each value moved by a uniform
     +/- spread_deg (deg; the slide by that many mm times 5), clipped to the ranges."""
     from planners.loader import TABLE1, si_to_table1
@@ -639,28 +638,3 @@ def random_key_points(n: int, rng: np.random.Generator, keys: int = 6, spread_de
     scale = np.array([5.0, 1, 1, 1, 1, 1]) * spread_deg
     base = TABLE1[np.linspace(0, len(TABLE1) - 1, keys).round().astype(int)]
     return np.clip(base + rng.uniform(-1, 1, size=(n, keys, 6)) * scale, low, high)
-
-
-def benchmark(n: int = 1000, seed: int = 0, spread_deg: float | None = None) -> dict:
-    """Seconds to build ``n`` LoaderParams of random key points (``random_key_points``, 6 per
-    set, Table 1's 0.5 s interval) and to judge them; the judging's rate, runs/s; how many
-    failed each check."""
-    rng = np.random.default_rng(seed)
-    sets = random_key_points(n, rng, spread_deg=spread_deg)
-    t0, c0 = time.perf_counter(), time.process_time()
-    params = [LoaderParams(key_points=tuple(tuple(float(v) for v in row) for row in s)) for s in sets]
-    t1, c1 = time.perf_counter(), time.process_time()
-    checks = judge_plans(params)
-    t2, c2 = time.perf_counter(), time.process_time()
-    failed: dict[str, int] = {}
-    for run in checks:
-        for c in run:
-            if not c.passed:
-                failed[c.name] = failed.get(c.name, 0) + 1
-    return {"runs": n, "params_s": t1 - t0, "judge_s": t2 - t1, "params_cpu_s": c1 - c0, "judge_cpu_s": c2 - c1,
-            "runs_per_cpu_s": n / (c2 - c1), "failed": failed}
-
-
-if __name__ == "__main__":
-    print(benchmark())
-    print(benchmark(spread_deg=3.0))
