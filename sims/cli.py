@@ -108,7 +108,8 @@ def scenario_parser(command: str, scenario, source: str) -> argparse.ArgumentPar
         group.add_argument(_flag(name), dest=f"param_{name}", metavar=metavar,
                            help=describe(kind, declared, getattr(scenario.params, name)).replace("%", "%%"))
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="set any parameter (TOML value syntax: --set 'moves=[{target=[1,0,0,0,0,0]}]')")
+                        help="set any parameter (TOML value syntax: --set 'moves=[{target=[1,0,0,0,0,0]}]'), "
+                             "or a field of the plant's uncertainty: --set plant.KEY=VALUE (README, \"Campaigns\")")
     if command == "run":
         parser.add_argument("--out", help="output directory (default results/NAME); replaced only if "
                             "planbench wrote it")
@@ -133,9 +134,10 @@ NAME is a scenario of `planbench list`; FILE.toml a scenario file (scenario = NA
 
 
 def _resolve_source(command: str, argv: list[str]):
-    """(Source, parsed options, resolved params) of ``planbench run|plan SOURCE ...``."""
+    """(Source, parsed options, resolved params, resolved plant) of ``planbench run|plan
+    SOURCE ...``; ``--set plant.KEY=VALUE`` sets a field of the plant's uncertainty."""
     from sims import scenarios, scenario_files
-    from sims.params import ParamError
+    from sims.params import ParamError, set_overrides
 
     get, names = ((scenarios.get, scenarios.SCENARIOS) if command == "run" else
                   (scenarios.get_plan, {**scenarios.SCENARIOS, **scenarios.PLANS}))
@@ -147,12 +149,19 @@ def _resolve_source(command: str, argv: list[str]):
     args = scenario_parser(command, scenario, argv[0]).parse_args(argv[1:])
     flags = {k[len("param_"):]: v for k, v in vars(args).items() if k.startswith("param_") and v is not None}
     cls = type(scenario.params)
+    plant_set = [a[len("plant."):] for a in args.set if a.startswith("plant.")]
     try:
-        overrides = scenario_files.overrides_from_flags(cls, flags, args.set)
+        overrides = scenario_files.overrides_from_flags(cls, flags, [a for a in args.set if not a.startswith("plant.")])
         params = cls.from_mapping(overrides, base=source.params)
+        plant = source.plant
+        if plant_set:
+            if plant is None:
+                raise ParamError(f"--set plant.{plant_set[0]}: {scenario.name} declares no plant uncertainty")
+            plant = type(plant).from_mapping(set_overrides(type(plant), plant_set, prefix="plant."), base=plant,
+                                             prefix="plant.")
     except ParamError as e:
         raise BadInput(str(e)) from None
-    return source, args, params
+    return source, args, params, plant
 
 
 def cmd_list(args) -> int:
@@ -205,7 +214,7 @@ def cmd_run(argv: list[str]) -> int:
     shown = _scenario_help("run", argv)
     if shown is not None:
         return shown
-    source, args, params = _resolve_source("run", argv)
+    source, args, params, plant = _resolve_source("run", argv)
     scenario = source.scenario
     camera = _camera(scenario, args.camera)
     plugins = dict(source.plugins)
@@ -226,7 +235,7 @@ def cmd_run(argv: list[str]) -> int:
         reserved.enter_context(out.reserved())
         if video is not None:
             reserved.enter_context(video.reserved())
-        setup = api.build(scenario, params, source.plant, **made)
+        setup = api.build(scenario, params, plant, **made)
         result = runner.run(scenario.name, setup, quiet=args.quiet)
         result.plugins = plugins
         outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
@@ -242,7 +251,7 @@ def cmd_plan(argv: list[str]) -> int:
     shown = _scenario_help("plan", argv)
     if shown is not None:
         return shown
-    source, args, params = _resolve_source("plan", argv)
+    source, args, params, _ = _resolve_source("plan", argv)
     out = outputs.OutputDir(args.out, kind="plan")
     with out.reserved():
         plans.write_plan(source.scenario, out, params)

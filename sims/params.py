@@ -405,17 +405,18 @@ def parse_value(kind: _Type, text: str):
             return stripped
 
 
-def set_overrides(cls: type[Params], assignments: list[str]) -> dict:
-    """``--set KEY=VALUE`` (repeatable) as a mapping for ``from_mapping``."""
+def set_overrides(cls: type[Params], assignments: list[str], prefix: str = "") -> dict:
+    """``--set KEY=VALUE`` (repeatable) as a mapping for ``from_mapping`` (``prefix``: how
+    the keys were written, for the errors: "plant.")."""
     hints = field_types(cls)
     out = {}
     for text in assignments:
         key, sep, value = text.partition("=")
         key = key.strip()
         if not sep or not key:
-            raise ParamError(f"--set {text!r} is not KEY=VALUE")
+            raise ParamError(f"--set {prefix}{text!r} is not KEY=VALUE")
         if key not in hints:
-            raise ParamError(f"--set: unknown parameter {key!r}; {cls.__name__} has: {', '.join(cls.names())}")
+            raise ParamError(f"--set: unknown parameter {prefix + key!r}; {cls.__name__} has: {', '.join(cls.names())}")
         out[key] = parse_value(hints[key], value)
     return out
 

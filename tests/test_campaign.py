@@ -400,3 +400,20 @@ def test_example_campaign_specs_are_valid(example):
         except ParamError:
             assert spec.invalid == "skip"  # otherwise every run must be valid
     assert resolved == min(50, spec.size) if spec.invalid == "refuse" else resolved >= 5
+
+
+def test_a_perturbed_run_repeats_from_its_summary(tmp_path, capsys):
+    first, again = tmp_path / "first", tmp_path / "again"
+    assert cli.main(["run", "hexapod-sync-move", "--set", "plant.camera_mass_error=0.1", "--duration", "1.0",
+                     "--out", str(first), "--quiet"]) in (cli.EXIT_OK, cli.EXIT_CHECK_FAILED)
+    summary = json.loads((first / "summary.json").read_text())
+    assert summary["plant"]["camera_mass_error"] == 0.1
+    cli.main(["run", str(first / "summary.json"), "--out", str(again), "--quiet"])
+    a, b = np.load(first / "timeseries.npz"), np.load(again / "timeseries.npz")
+    assert sorted(a) == sorted(b) and all(np.array_equal(a[k], b[k]) for k in a)
+    # ... and the plant acted: the struts carry 10 % more camera than the nominal run's.
+    nominal = tmp_path / "nominal"
+    cli.main(["run", "hexapod-sync-move", "--duration", "1.0", "--out", str(nominal), "--quiet"])
+    assert not np.array_equal(np.load(nominal / "timeseries.npz")["actuator_force"], a["actuator_force"])
+    assert cli.main(["run", "hexapod-sync-move", "--set", "plant.camera_mass_error=0.5", "--quiet"]) == 2
+    assert "plant.camera_mass_error = 0.5 fraction is outside [-0.1, 0.1]" in capsys.readouterr().err
