@@ -18,7 +18,7 @@ demo: $(STAMP)
 	$(BIN)/planbench demo --out results
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto
 
 bench: $(STAMP)
 	$(BIN)/planbench bench

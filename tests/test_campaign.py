@@ -417,3 +417,15 @@ def test_a_perturbed_run_repeats_from_its_summary(tmp_path, capsys):
     assert not np.array_equal(np.load(nominal / "timeseries.npz")["actuator_force"], a["actuator_force"])
     assert cli.main(["run", "hexapod-sync-move", "--set", "plant.camera_mass_error=0.5", "--quiet"]) == 2
     assert "plant.camera_mass_error = 0.5 fraction is outside [-0.1, 0.1]" in capsys.readouterr().err
+
+
+def test_saved_outputs_only_when_asked(tmp_path):
+    from sims.campaign import context_of, tasks_of, worker
+
+    text = ('scenario = "loader-supply"\n{save}[parameters]\nduration = 0.2\n[grid]\npayload_mass = [40.0]\n')
+    saved = spec_module.load(_write(tmp_path / "saved.toml", text.format(save='save = ["timeseries"]\n')))
+    files = worker.run_chunk(context_of(saved), tasks_of(saved, saved.runs()))["files"][0]
+    assert set(files) == {"summary.json", "timeseries.npz", "report.png"}
+    assert files["report.png"][:8] == b"\x89PNG\r\n\x1a\n"
+    plain = spec_module.load(_write(tmp_path / "plain.toml", text.format(save="")))
+    assert set(worker.run_chunk(context_of(plain), tasks_of(plain, plain.runs()))["files"][0]) == {"summary.json"}

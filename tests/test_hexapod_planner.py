@@ -1013,3 +1013,13 @@ def test_random_single_moves(start, target, sync):
     else:
         assert move.duration >= max(optimum, 2 * t_hex) * (1 - 1e-12)
         assert move.duration < max(optimum, 2 * t_hex) + 2 * DT
+
+
+def test_a_pose_change_below_the_struts_round_off_is_a_move_of_zero_length():
+    # Found by hypothesis: rz = 5e-222 deg changes no strut length, and its plan had duration 0.
+    from sims.hexapod import HexapodMove, HexapodParams
+    from sims.params import ParamError
+
+    with pytest.raises(ParamError, match=r"moves\[0\]\.target equals the pose before it \(no strut length changes\)"):
+        HexapodParams(moves=(HexapodMove((0.0, 0.0, 0.0, 0.0, 0.0, 5.0165313870954834e-222), False),))
+    HexapodParams(moves=(HexapodMove((1e-9, 0.0, 0.0, 0.0, 0.0, 0.0), False),))  # 0.5 pm of strut: a move
