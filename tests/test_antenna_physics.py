@@ -178,3 +178,27 @@ def test_dm_control_environment_with_an_imu_driven_controller():
         step = env.step(np.zeros(4))
         idle.append(step.reward)
     assert min(idle) < 0.01
+
+
+def test_a_half_turn_to_the_start_attitude_plans():
+    # Found by hypothesis: heading 180 deg with no ship motion makes the turn from the level
+    # attitude to the start one a half turn, which the matrix log refused.
+    import numpy as np
+
+    from sims import scenarios
+
+    scenario = scenarios.get("antenna-paper-motion")
+    params = scenario.resolve(satellite_lon=None, satellite_look=(223.49, 60.0, -28.8), ship_heading=180.0,
+                              heading_amplitude=0.0, pitch_amplitude=0.0, roll_amplitude=0.0, duration=5.0)
+    trajectory = scenario.plan(params)
+    assert np.all(np.isfinite(trajectory.sample(np.array([0.0, 5.0])).position))
+    # The start angles give the attitude the ship at heading 180 deg needs (eq. 1).
+    import planners.antenna as ant
+    from sims import antenna
+
+    look = antenna.satellite_of(params)
+    motion, satellite = antenna.motion_of(params), ant.satellite_attitude(*look)
+    ship = motion.sample(0.0)
+    target = ant.ship_attitude(ship.heading[0], ship.pitch[0], ship.roll[0]) @ satellite
+    theta = antenna.start_angles(motion, satellite, *look)
+    assert np.abs(ant.forward_kinematics(theta) - target).max() < 1e-9

@@ -657,7 +657,15 @@ def tracked_start(motion, satellite: np.ndarray, theta: np.ndarray, plant: "Ante
 
 
 def _slerp(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
-    rotvec = ant.rotation_log(b @ a.T)
+    """n + 1 attitudes turning from ``a`` to ``b`` (3, 3) about one fixed axis."""
+    relative = b @ a.T
+    if (np.trace(relative) - 1.0) / 2.0 < math.cos(math.pi - 1e-6):
+        # A half turn (ship heading 180 deg with no motion, found by hypothesis): the matrix
+        # log of planners.antenna refuses it; scipy's Slerp picks one of its two axes.
+        from scipy.spatial.transform import Rotation, Slerp
+
+        return Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([a, b])))(np.linspace(0.0, 1.0, n + 1)).as_matrix()
+    rotvec = ant.rotation_log(relative)
     s = np.linspace(0.0, 1.0, n + 1)
     return np.stack([_exp_so3(f * rotvec) @ a for f in s])
 
