@@ -204,29 +204,6 @@ def test_the_controller_gets_the_nominal_model_and_its_feedforward_stays_nominal
     assert setup.plant == FastPlant(**EVERYTHING) and reference.plant == FastPlant()
 
 
-def _arrays(result, setup) -> dict:
-    out = {k: getattr(result.log, k) for k in ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata")}
-    out.update({f"timeseries/{k}": v for k, v in setup.timeseries(result.log).items()})
-    return out
-
-
-def test_the_nominal_plant_runs_bit_for_bit_as_without_one():
-    params = SPEC.resolve(duration=2.0)  # 200 ticks of the switch from park, in the 4 m/s wind
-    setups = [SPEC.build(params), SPEC.build(params, plant=FastPlant()), api.build(SPEC, params, SPEC.resolve_plant({}))]
-    # (Before the runs: the cable law rewrites the winches' gain and bias every tick.)
-    assert all(changed_fields(fast_physics._compiled(0), setup.physics.model.ptr) == {} for setup in setups)
-    results = [runner.run(SPEC.name, setup) for setup in setups]
-    first = _arrays(results[0], setups[0])
-    assert results[0].log.t.size == 201
-    for result, setup in zip(results[1:], setups[1:]):
-        other = _arrays(result, setup)
-        assert other.keys() == first.keys()
-        for key, value in first.items():
-            np.testing.assert_array_equal(other[key], value, err_msg=key)
-        assert [c.value for c in result.checks] == [c.value for c in results[0].checks]
-    assert results[0].plant == FastPlant().to_dict()
-
-
 # ------------------------------------------------------------------ each perturbation acts as computed by hand
 
 

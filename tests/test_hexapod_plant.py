@@ -178,29 +178,6 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start():
     assert setup.plant == hexapod.HexapodPlant(**EVERYTHING)
 
 
-def arrays(result, setup) -> dict:
-    """Every array of a run: the log's and timeseries.npz's."""
-    out = {k: getattr(result.log, k) for k in ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata")}
-    out.update({f"timeseries/{k}": v for k, v in setup.timeseries(result.log).items()})
-    return out
-
-
-def test_the_nominal_plant_runs_bit_for_bit_as_without_one():
-    params = SPEC.resolve(duration=1.5)  # 300 ticks of the move, in the default 5 m/s wind
-    setups = [SPEC.build(params), SPEC.build(params, plant=hexapod.HexapodPlant()),
-              api.build(SPEC, params, SPEC.resolve_plant({}))]
-    results = [runner.run(SPEC.name, setup) for setup in setups]
-    first = arrays(results[0], setups[0])
-    assert results[0].log.t.size == 301
-    for result, setup in zip(results[1:], setups[1:]):
-        other = arrays(result, setup)
-        assert other.keys() == first.keys()
-        for key, value in first.items():
-            np.testing.assert_array_equal(other[key], value, err_msg=key)
-        np.testing.assert_array_equal([c.value for c in result.checks], [c.value for c in results[0].checks])
-        assert result.plant == hexapod.HexapodPlant().to_dict()
-
-
 # ------------------------------------------------------------------ the perturbations act
 
 

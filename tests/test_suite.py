@@ -173,3 +173,26 @@ def test_a_hold_still_plugin_controller_runs_and_is_judged(name, tmp_path):
         assert c.evaluated or c.note.startswith(NOT_EVALUATED), c
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["components"]["controller"] == f"{__name__}.HoldStill"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_nominal_plant_runs_bit_for_bit_as_without_one(name):
+    # A scenario's nominal plant, given explicitly, is the machine built without one (issue
+    # 15: plant uncertainty perturbs only when it is set).
+    from sims import api
+
+    scenario = scenarios.get(name)
+    assert scenario.plant is not None and scenario.plant.is_nominal
+    setup, result = short_run(name, 1)
+    params = scenario.resolve(duration=SHORT_S, seed=1)
+    for other_setup in (scenario.build(params, plant=type(scenario.plant)()),
+                        api.build(scenario, params, scenario.resolve_plant({}))):
+        other = runner.run(name, other_setup)
+        for key in LOGGED:
+            np.testing.assert_array_equal(getattr(other.log, key), getattr(result.log, key), err_msg=key)
+        ours, theirs = setup.timeseries(result.log), other_setup.timeseries(other.log)
+        assert ours.keys() == theirs.keys()
+        for key in ours:
+            np.testing.assert_array_equal(theirs[key], ours[key], err_msg=key)
+        np.testing.assert_array_equal([c.value for c in other.checks], [c.value for c in result.checks])
+        assert other.plant == type(scenario.plant)().to_dict() == result.plant
