@@ -429,3 +429,33 @@ def test_saved_outputs_only_when_asked(tmp_path):
     assert files["report.png"][:8] == b"\x89PNG\r\n\x1a\n"
     plain = spec_module.load(_write(tmp_path / "plain.toml", text.format(save="")))
     assert set(worker.run_chunk(context_of(plain), tasks_of(plain, plain.runs()))["files"][0]) == {"summary.json"}
+
+
+def test_a_planner_only_campaign_judges_the_plans_without_physics(tmp_path):
+    spec = _write(tmp_path / "spec.toml", """
+scenario = "hexapod-sync-move"
+mode = "plan"
+seed = 4
+samples = 60
+invalid = "skip"
+[grid]
+"moves[0].synchronous" = [true, false]
+[random]
+"moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
+"moves[0].target[5]" = { distribution = "uniform", low = -0.05, high = 0.05 }
+""")
+    out = tmp_path / "out"
+    assert cli.main(["sweep", str(spec), "--out", str(out), "--workers", "1", "--quiet"]) == cli.EXIT_OK
+    table = pq.read_table(out / "results.parquet")
+    assert table.num_rows == 120 and set(table.column("status").to_pylist()) == {"passed"}
+    assert not (out / "runs").exists() or not any((out / "runs").iterdir())  # no physics, no run outputs
+    # Each row is the judge's verdict on that run's own plan.
+    from sims.hexapod.plan_checks import judge_plans
+
+    loaded = spec_module.load(spec)
+    run = loaded.runs()[70]
+    [checks] = judge_plans([loaded.resolve(run)[0]])
+    row = table.to_pylist()[70]
+    assert row["moves[0].synchronous"] is False
+    for c in checks:
+        assert np.array_equal(c.value, row[f"check.{c.name}"], equal_nan=True), c.name
