@@ -42,6 +42,14 @@ def _classes():
     return seen
 
 
+def _plant_classes():
+    """{each mechanism's PlantParams class: a scenario declaring it}."""
+    seen = {}
+    for s in scenarios.SCENARIOS.values():
+        seen.setdefault(type(s.plant), s)
+    return seen
+
+
 def _fraction(draw, low, high, inner=1.0):
     mid, half = 0.5 * (low + high), 0.5 * (high - low) * inner
     return draw(st.floats(mid - half, mid + half, allow_nan=False))
@@ -177,9 +185,11 @@ def _out_of_range(declared, column=None):
     return low - max(1.0, abs(low))
 
 
-@pytest.mark.parametrize("cls", list(_classes()), ids=lambda c: c.__name__)
+@pytest.mark.parametrize("cls", [*_classes(), *_plant_classes()], ids=lambda c: c.__name__)
 def test_every_single_out_of_range_field_is_refused_with_its_name(cls):
-    base = _classes()[cls].params
+    scenario = {**_classes(), **_plant_classes()}[cls]
+    plant = cls in _plant_classes()
+    base = scenario.plant if plant else scenario.params
     checked = 0
     for name, kind, declared, default in cls.declarations():
         if declared.low is None and declared.high is None and declared.choices is None:
@@ -202,6 +212,9 @@ def test_every_single_out_of_range_field_is_refused_with_its_name(cls):
         with pytest.raises(ParamError) as refused:
             base.replace(**{name: bad})
         assert str(refused.value).startswith(name), (name, str(refused.value))
+        if plant:  # through a scenario file's, a campaign's or --set's [plant]: named as plant.KEY
+            with pytest.raises(ParamError, match=rf"^plant\.{name}"):
+                scenario.resolve_plant({name: bad})
         checked += 1
     assert checked >= 3
 

@@ -31,14 +31,13 @@ def wilson(passed: int, n: int, confidence: float = 0.95) -> tuple[float, float]
     return float(ci.low), float(ci.high)
 
 
-def _column(table: pa.Table, name: str, dtype=float) -> np.ndarray:
+def _column(table: pa.Table, name: str) -> np.ndarray:
+    """A numeric column as floats, NaN where it is null (or absent: a check no run of a part had)."""
     if name not in table.column_names:
         return np.full(table.num_rows, np.nan)
     values = table.column(name).to_numpy(zero_copy_only=False)
-    if dtype is float:
-        return np.array([np.nan if v is None else v for v in values], dtype=float) if values.dtype == object \
-            else values.astype(float)
-    return values
+    return np.array([np.nan if v is None else v for v in values], dtype=float) if values.dtype == object \
+        else values.astype(float)
 
 
 def _percentiles(values: np.ndarray) -> dict:

@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from sims.params import ParamError, Params, field_types
+from sims.params import ParamError, Params, _bound, field_types
 
 SPEC_KEYS = ("scenario", "planner", "controller", "mode", "seed", "seeds", "samples", "invalid", "save",
              "parameters", "plant", "grid", "random")
@@ -530,12 +530,6 @@ def _axis(section: str, key: str, value, plant: bool, cls) -> Axis:
         raise ParamError(f"random.{shown} = {distribution.text()} reaches [{s_low:g}, {s_high:g}], outside "
                          f"{shown}'s range {range_text(declared, column)}{hint}")
     return Axis(key, plant, path, leaf, distribution=distribution)
-
-
-def _bound(bound, column):
-    if isinstance(bound, tuple):
-        return None if column is None else bound[column]
-    return bound
 
 
 def _freeze(value):

@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import time
 from pathlib import Path
 
@@ -116,7 +117,10 @@ class CampaignDir(outputs._Target):
         for folder in (self.path, self.table_dir):
             for entry in folder.glob(f"{_TMP}*"):
                 with contextlib.suppress(OSError):
-                    entry.unlink()
+                    if entry.is_dir() and not entry.is_symlink():
+                        shutil.rmtree(entry)  # the report's plots, staged
+                    else:
+                        entry.unlink()
 
     # ---------------------------------------------------------------- the table
 
