@@ -15,6 +15,7 @@ the feed's distance from its goal path (FAST).
 from __future__ import annotations
 
 import collections
+import dataclasses
 
 import mujoco
 import numpy as np
@@ -142,12 +143,17 @@ def antenna_environment(sea_state: bool = True, duration: float = 60.0) -> contr
     return make("antenna-sea-state" if sea_state else "antenna-paper-motion", duration=duration)
 
 
-def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0) -> control.Environment:
+def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0,
+                     cable_segments: int | None = None) -> control.Environment:
     """FAST's feed support: ``duration`` s of tracking 3C 286 (no switch: the episode starts
-    on the source at rest), in ``wind`` m/s. The action is every actuator's ctrl: the six
-    winches' unstretched lengths (m), the A-B set-points (rad), the six Stewart legs'
-    set-point rates (m/s) and the multi-beam angle (rad)."""
+    on the source at rest), in ``wind`` m/s, on the cables of ``cable_segments`` (None: the
+    default, sims.fast.FastParams). The action is every actuator's ctrl: the six winches'
+    unstretched lengths (m), the A-B set-points (rad), the six Stewart legs' set-point rates
+    (m/s) and the multi-beam angle (rad)."""
     from sims import fast
 
-    setup = fast.build(fast.observation_plan(duration), fast.FastParams(wind=wind, seed=seed))
+    params = fast.FastParams(wind=wind, seed=seed)
+    if cable_segments is not None:
+        params = dataclasses.replace(params, cable_segments=cable_segments)
+    setup = fast.build(fast.observation_plan(duration), params)
     return environment(setup, fast.environment_reward(setup))

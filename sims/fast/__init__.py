@@ -260,6 +260,10 @@ DEFAULT_WIND_M_S = 4.0  # the observing case (REFERENCE.md); 8 m/s is the stress
 #: The wind blows toward +x (east) by default (--wind-direction): across the cables of towers
 #: 1, 3, 4 and 6.
 WIND_AZIMUTH_DEG = 0.0
+#: The default cables: chains of two segments, the fewest that carry the cables' first string mode
+#: and with it the cabin-cable mode the telescope shows at 0.12-0.2 Hz (REFERENCE.md; the
+#: lumped straight cables have their lowest at 0.30 Hz). models/fast/README.md, "The cables".
+DEFAULT_CABLE_SEGMENTS = 2
 #: Feed accuracy after the Stewart stabilizer: 10 mm RMS (REFERENCE.md; Adv. Mech. Eng. 2019).
 FEED_RMS_LIMIT_MM = 10.0
 #: No public figure for the largest feed error: three times the RMS requirement (what a
@@ -587,8 +591,10 @@ class FastParams(ScenarioParams):
         None, "measured wind instead of the model: CSV rows t (s), speed (m/s)[, direction (deg)], covering the "
         "run; resampled to the 10 ms control ticks (a relative path is the scenario file's directory's)", path=True)
     stewart: bool = param(True, "the Stewart stabilizer in the cabin on (off: the feed rides the A-B rotator)")
-    cable_segments: int = param(0, "each cable as a chain of this many elastic segments; 0: straight cables with "
-                                "the lumped catenary law", low=0, high=max_cable_segments(),
+    cable_segments: int = param(DEFAULT_CABLE_SEGMENTS, "each cable as a chain of this many elastic segments (2: "
+                                "the measured 0.19 Hz cabin-cable mode, models/fast/README.md); 0: straight cables "
+                                "with the lumped catenary law (faster, lowest mode 0.30 Hz)", low=0,
+                                high=max_cable_segments(),
                                 reason="more segments vibrate beyond the 2 ms timestep's limit omega dt <= "
                                        f"{SEGMENT_OMEGA_DT_LIMIT:g}")
     duration: float | None = param(None, "simulated time; none: the whole session", "s", low=CONTROL_DT,

@@ -276,8 +276,35 @@ def cable_drag_force(wind: np.ndarray, vectors: np.ndarray, lengths) -> np.ndarr
 #: Damping of the discretized cables' nodes, as the ratio it gives their first string modes
 #: (~0.2 Hz): 0.5 %, the lower bound measured for the cable-cabin system (REFERENCE.md); the
 #: cables' internal friction and the still air's drag are not known better.
-NODE_DAMPING_RATIO = 0.005
+NODE_DAMPING_RATIO = 0.006
 STRING_MODE_HZ = 0.2
+
+
+def node_mass_factor(segments: int) -> float:
+    """A node's mass over its segment's mu L0 / n: (2 n sin(pi / 2n) / pi)^2, so that the
+    beaded string's first mode, 2 sqrt(T n / (M L)) sin(pi / 2n), is the continuous string's
+    pi sqrt(T / mu) / L (0.81 for two segments, 0.99 for ten)."""
+    return (2 * segments * math.sin(math.pi / (2 * segments)) / math.pi) ** 2
+
+
+def node_load_factor(segments: int) -> float:
+    """A node's weight over its segment's mu g L0 / n: sqrt(n^2 / (n^2 - 1)), so that the
+    chain's sag lengthens it as much as the uniformly loaded cable's, w^2 l_h^2 L0 / (24 T^2)
+    (equal point loads W / n give that times 1 - 1 / n^2)."""
+    return math.sqrt(segments**2 / (segments**2 - 1.0))
+
+
+def node_gravcomp(segments: int) -> float:
+    """The nodes' gravcomp: gravity pulls a node with node_load_factor / node_mass_factor of
+    its weight."""
+    return 1.0 - node_load_factor(segments) / node_mass_factor(segments)
+
+
+def end_fraction(segments: int, load: bool) -> float:
+    """The part of a cable's weight (``load``) or mass at each of its ends: what the nodes
+    leave, halved."""
+    node = node_load_factor(segments) if load else node_mass_factor(segments)
+    return 0.5 * (1.0 - (segments - 1) * node / segments)
 
 
 #: Stability of the discretized cables' explicit springs: a segment's axial mode omega
@@ -341,7 +368,7 @@ def discretized_spec(segments: int, spec: mujoco.MjSpec | None = None, ea: float
         spec = mujoco.MjSpec.from_file(str(models.scene_path("fast")))
     home = spec.compile()  # the lumped model: its home keyframe and sites
     rest = home.key("home").ctrl[0] / segments  # the winches' unstretched length at home
-    mass = mass_per_length * rest
+    mass = node_mass_factor(segments) * mass_per_length * rest
     stiffness = ea / rest
     for i in range(1, 4):
         body = spec.body(f"anchor_mass{i}")
@@ -353,7 +380,8 @@ def discretized_spec(segments: int, spec: mujoco.MjSpec | None = None, ea: float
         anchor = home_data.site_xpos[home.site(f"anchor{i}").id]
         sites = [f"tower{i}_top"]
         for k in range(1, segments):
-            node = spec.worldbody.add_body(name=f"cable{i}_node{k}", pos=top + (anchor - top) * k / segments)
+            node = spec.worldbody.add_body(name=f"cable{i}_node{k}", pos=top + (anchor - top) * k / segments,
+                                           gravcomp=node_gravcomp(segments))
             for axis, label in zip(np.eye(3), "xyz"):
                 node.add_joint(name=f"cable{i}_node{k}_{label}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=axis,
                                damping=2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)
@@ -552,13 +580,15 @@ class FastPhysics(dm_mujoco.Physics):
         tension = fast.cable_tensions(origin, rotation, g, ab_rotation=r_ab)
         anchors = origin + g.cabin_anchors @ rotation.T
         n = self.cable_segments
+        # The funicular of n - 1 equal loads lies on the parabola of their mean load.
+        load = node_load_factor(n) * CABLE_WEIGHT
         x = np.linspace(0.0, 1.0, 2001)
         for i in range(6):
             top, chord = g.tower_anchors[i], anchors[i] - g.tower_anchors[i]
             length, span = np.linalg.norm(chord), np.hypot(chord[0], chord[1])
             horizontal = tension[i] * span / length
             curve = top + x[:, None] * chord
-            curve[:, 2] -= CABLE_WEIGHT * length / span * (x * span) * ((1 - x) * span) / (2 * horizontal)
+            curve[:, 2] -= load * length / span * (x * span) * ((1 - x) * span) / (2 * horizontal)
             arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(curve, axis=0), axis=1))])
             for k, share in enumerate(np.arange(1, n) / n, start=1):
                 point = np.array([np.interp(share * arc[-1], arc, curve[:, j]) for j in range(3)])
@@ -754,8 +784,13 @@ class ChainCableLoads(CableLoads):
                              f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
                              f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most "
                              f"{most} segments")
-        mass = np.broadcast_to((self.mass_per_length * rest)[:, None], self._nodes.shape)
+        mass = np.broadcast_to((node_mass_factor(n) * self.mass_per_length * rest)[:, None], self._nodes.shape)
         model.body_mass[self._nodes] = mass
+        # The ends' share of the mass at the anchors (two cables each), gravity-compensated.
+        ends = end_fraction(n, load=False) * self.mass_per_length * rest * n
+        for i in range(3):
+            body = model.body(f"anchor_mass{i + 1}").id
+            model.body_mass[body] = ends[2 * i] + ends[2 * i + 1]
         dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)
         model.dof_damping[dofs] = (2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[..., None]
         super().reset(physics, times, rng)
@@ -778,7 +813,7 @@ class ChainCableLoads(CableLoads):
             self.tension_log[tick] = self.tension
         anchors = data.site_xpos[self._sites]
         anchor_force = np.zeros((6, 3))
-        anchor_force[:, 2] = -0.5 * self.weight * self._rest
+        anchor_force[:, 2] = -end_fraction(self._n, load=True) * self.weight * self._rest * self._n
         u = 0.0 if tick is None else float(self.speed[tick])
         force, torque = np.zeros(3), np.zeros(3)
         if u != 0.0:
