@@ -319,7 +319,12 @@ class Params:
             raise ParamError(f"unknown parameter '{prefix}{unknown[0]}'; {cls.__name__} has: {', '.join(names)}")
         values = {} if base is None else {n: getattr(base, n) for n in names}
         declared = {n: d for n, _, d, _ in cls.declarations()}
+        kinds = {n: k for n, k, _, _ in cls.declarations()}
         for key, value in mapping.items():
+            current = values.get(key)
+            if kinds[key].kind == "nested" and isinstance(value, dict) and isinstance(current, Params):
+                # A table changes the fields it names of the base's table, not all of them.
+                value = type(current).from_mapping(value, base=current, prefix=f"{prefix}{key}.")
             values[key] = value
             for other in declared[key].excludes:
                 if other not in mapping:
@@ -415,6 +420,12 @@ def set_overrides(cls: type[Params], assignments: list[str], prefix: str = "") -
         key = key.strip()
         if not sep or not key:
             raise ParamError(f"--set {prefix}{text!r} is not KEY=VALUE")
+        head, dot, rest = key.partition(".")
+        nested = {n: k.cls for n, k, _, _ in cls.declarations() if k.kind == "nested"}
+        if dot and head in nested:  # a field of a nested table: --set sensors.ts_latency_s=0.15
+            inner = set_overrides(nested[head], [f"{rest}={value}"], prefix=f"{prefix}{head}.")
+            out.setdefault(head, {}).update(inner)
+            continue
         if key not in hints:
             raise ParamError(f"--set: unknown parameter {prefix + key!r}; {cls.__name__} has: {', '.join(cls.names())}")
         out[key] = parse_value(hints[key], value)
@@ -447,7 +458,10 @@ def markdown_table(cls: type[Params]) -> str:
     for name, kind, declared, default in cls.declarations():
         rng = _range_and_length(declared)
         meaning = declared.help + (f" ({declared.reason})" if declared.reason else "")
-        default_text = "none" if default is None else _format(default)
+        if kind.kind == "nested" and default is not None:
+            default_text = f"{type(default).__name__}()"  # its own table follows (readme_tables)
+        else:
+            default_text = "none" if default is None else _format(default)
         lines.append(f"| `{name}` | {unit_of(declared)} | `{default_text}` | {rng} | {meaning} |".replace("  ", " "))
     return "\n".join(lines)
 
@@ -463,8 +477,11 @@ def readme_tables() -> str:
     parts = []
     for cls, names in by_class.items():
         nested = [k.item.cls for _, k, _, _ in cls.declarations() if k.kind == "vector" and k.item.kind == "nested"]
+        tables = [(name, k.cls) for name, k, _, _ in cls.declarations() if k.kind == "nested"]
         parts.append(f"#### `{cls.__name__}`: {', '.join(f'`{n}`' for n in names)}\n\n{markdown_table(cls)}")
         parts += [f"Each of `{cls.__name__}`'s list items, `{c.__name__}`:\n\n{markdown_table(c)}" for c in nested]
+        parts += [f"`{cls.__name__}`'s table `{key}`, `{c.__name__}` (`--set {key}.KEY=VALUE`):\n\n{markdown_table(c)}"
+                  for key, c in tables if f"`{c.__name__}`" not in "\n".join(parts)]
     return "\n\n".join(parts)
 
 

@@ -41,7 +41,6 @@ import mujoco
 import numpy as np
 import pytest
 
-import models
 from planners import antenna as ant
 from planners.fast import plan as fp
 from planners.fast import sky as sky
@@ -151,9 +150,10 @@ def write(tmp_path_factory, name: str, setup, duration: float, plan, model=None)
 def scenario_run(tmp_path_factory, name: str) -> Written:
     scenario = scenarios.get(name)
     setup = scenario.build(scenario.resolve(duration=DURATIONS[name]))
-    # FAST's cable actuators are re-linearized in the run's model every tick: read FAST runs
-    # with the compiled model (the same sensors, sites and leg drives).
-    model = models.load("fast") if name.startswith("fast") else None
+    # FAST's cable actuators are re-linearized (or, with the chains, re-sprung) in the run's
+    # model every tick: read FAST runs with the compiled model of their cables (the same
+    # sensors, sites and leg drives).
+    model = fast_physics._compiled(setup.params.cable_segments) if name.startswith("fast") else None
     return write(tmp_path_factory, name, setup, setup.duration, lambda: scenario.plan(scenario.params), model)
 
 
@@ -598,7 +598,8 @@ def fast_observation(tmp_path_factory):
     termination, 4 m/s wind, Stewart on; its observing window is the middle 10 s."""
     plan = fast_sim.observation_plan(10.0)
     setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0))
-    return write(tmp_path_factory, "fast-observation", setup, setup.duration, plan, models.load("fast"))
+    return write(tmp_path_factory, "fast-observation", setup, setup.duration, plan,
+                 fast_physics._compiled(setup.params.cable_segments))
 
 
 @pytest.fixture(scope="module")
@@ -606,7 +607,8 @@ def fast_scan(tmp_path_factory):
     """A short motion scan: its observing window is the legs and the transition between."""
     plan = _short_scan_plan()
     setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0, seed=1))
-    return write(tmp_path_factory, "fast-scan", setup, setup.duration, plan, models.load("fast"))
+    return write(tmp_path_factory, "fast-scan", setup, setup.duration, plan,
+                 fast_physics._compiled(setup.params.cable_segments))
 
 
 FAST_RUNS = ["fast-tracking", "fast-ra-scan", "fast-source-switch", "fast-observation", "fast-scan"]
@@ -701,18 +703,30 @@ def _catenary_tension(chord, l0, span):
 
 
 def test_fast_cable_tension_max(fast_run):
-    """Highest cable tension (kN) of the catenary law before the winch's clamp: the law
+    """Highest cable tension (kN) before the winch's clamp. Chains: the winch segment's spring
+    at its length in each logged pose. Lumped cables: the catenary law
     re-solved at every tick the plant applied it (all but the last, where no physics runs),
     with the chord from the cable-length sensors (the state the plant saw), the winch's
     unstretched length from the logged ctrl and the span from the logged pose's kinematics."""
     w = fast_run
     model = w.model
+    l0 = w.ts["ctrl"][:, [model.actuator(c).id for c in CABLES]]
+    segments = w.summary["parameters"]["cable_segments"]
+    if segments:
+        # The chains: the winch's segment, a spring EA / (L0 / n) of rest length L0 / n
+        # (ChainCableLoads), at its length in the logged pose.
+        first = [model.tendon(f"{c}_seg1").id for c in CABLES]
+        length = kinematics_rows(model, w.ts["qpos"][:-1], lambda d: (mujoco.mj_fwdPosition(model, d),
+                                                                      d.ten_length[first])[1])
+        rest = l0[:-1] / segments
+        tension = np.maximum(fast_physics.CABLE_EA / rest * (length - rest), 0.0)
+        assert_value(w, "cable_tension_max", float(tension.max()) / 1e3, LAW)
+        return
     towers = [model.site(f"tower{i}_top").id for i in range(1, 7)]
     anchors = [model.site(f"anchor{i}").id for i in range(1, 7)]
     vectors = kinematics_rows(model, w.ts["qpos"], lambda d: d.site_xpos[anchors] - d.site_xpos[towers])
     span = np.hypot(vectors[..., 0], vectors[..., 1])
     chord = np.column_stack([w.sensor(f"{c}_length")[:, 0] for c in CABLES])
-    l0 = w.ts["ctrl"][:, [model.actuator(c).id for c in CABLES]]
     tension = _catenary_tension(chord[:-1], l0[:-1], span[:-1])
     assert_value(w, "cable_tension_max", float(tension.max()) / 1e3, LAW)
 

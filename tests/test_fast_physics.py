@@ -12,8 +12,13 @@ from planners.fast import plan as fplan
 from sims import fast as fast_sim
 from sims import runner
 from sims.fast import physics as fast_physics
-from sims.fast.physics import (CableLoads, ControllerOptions, FastController, FastPhysics, SensorOptions,
+from sims.fast.measurement import SensorOptions
+from sims.fast.physics import (CableLoads, ControllerOptions, FastController, FastPhysics,
                                tangent_stiffness, winch_feedforward)
+
+#: The idealized cabin-pose measurements (the earlier sensors: tests of the statics and of the
+#: chains that want the feed still to a millimetre).
+IDEAL = SensorOptions(system="ideal")
 
 #: The measured lowest cabin-cable mode (REFERENCE.md: Universe 10:450, 2024).
 MEASURED_LOWEST_MODE_HZ = (0.12, 0.2)
@@ -42,7 +47,7 @@ def test_static_tensions_equal_the_planner(elevation_deg):
     """At rest at the zenith and at zenith angle 40 deg (the planner's tilt split), MuJoCo's
     cable tensions equal the planner's static distribution within 1 %."""
     plan = hold_plan(30.0, elevation_deg, 10.0)
-    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0, cable_segments=0))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0, cable_segments=0, sensors=IDEAL))
     result = runner.run("hold", setup)
     planned = setup.controller.state.tension[-1]
     measured = -result.log.actuator_force[-1, setup.physics.cable_ids]
@@ -200,8 +205,8 @@ def test_dm_control_environment_with_the_winch_feedforward():
 
     def run(extra_length: float):
         step = env.reset()
-        assert {"cabin_pose_position", "cabin_pose_ts_position", "ab_angles", "leg_positions",
-                "reference_positions"} <= set(step.observation)
+        assert {"cabin_estimate_position", "platform_estimate_position", "cabin_imu_gyro", "platform_ts_points",
+                "ab_angles", "leg_positions", "reference_positions"} <= set(step.observation)
         rewards = []
         action = env.physics.data.ctrl.copy()  # the parked commands
         while not step.last():
@@ -366,6 +371,6 @@ def test_chains_bring_the_lowest_cabin_mode_into_the_measured_band(segments, ele
 
 def test_discretized_cables_run_with_the_stabilizer():
     plan = fast_sim.observation_plan(30.0)
-    on = runner.run("chain", fast_sim.build(plan, fast_sim.FastParams(wind=4.0, cable_segments=SEGMENTS)))
+    on = runner.run("chain", fast_sim.build(plan, fast_sim.FastParams(wind=4.0, cable_segments=SEGMENTS, sensors=IDEAL)))
     assert on.passed and check(on, "feed_error_rms").value < 2.0
     assert on.metrics["cables"] == f"{SEGMENTS} segments each"

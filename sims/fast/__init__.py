@@ -40,8 +40,9 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import demanded_force
 from sims.fast.physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
-                               FastController, FastPhysics, FastPlant, FastSensors, SensorOptions, _compiled,
+                               FastController, FastPhysics, FastPlant, _compiled,
                                max_cable_segments, parked_command, perturbed_start, winch_feedforward)
+from sims.fast.measurement import FusedSensors, SensorOptions, floats_per_tick, make_sensors
 from sims.runner import RunLog, Setup
 from sims.params import ParamError, ScenarioParams, param
 from sims.task import nominal_copy, plan_checked
@@ -452,21 +453,21 @@ class FastEvaluation:
         fast_report(self.timeseries(log), log.t, checks, path, fast.FAST_LIMITS.tension_min)
 
 
-#: Doubles per tick that a FAST run preallocates besides the runner's log: the controller's
-#: plan state at every tick (FastPlanSample less its t: 53, of which the feed, its velocity
-#: and acceleration and the multi-feed angle, 10, are views of the reference: 43), its winch
-#: feed-forward (6), platform rotation and position (9 + 3), A-B reference and set-point
-#: (2 + 2): 65; the sensors' true cabin pose (3 + 9) and the noise of their two measurements
-#: (2 x (3 + 9)): 36; the plant's wind speed, wind force and catenary tensions (1 + 3 + 6).
-PER_TICK_FLOATS = 65 + 36 + 10
+#: Doubles per tick that a FAST run preallocates besides the runner's log and its sensors: the
+#: controller's plan state at every tick (FastPlanSample less its t: 53, of which the feed, its
+#: velocity and acceleration and the multi-feed angle, 10, are views of the reference: 43), its
+#: winch feed-forward (6), platform rotation and position (9 + 3), A-B reference and set-point
+#: (2 + 2), the fused stabilizer's planned legs (6): 71; the plant's wind speed, wind force and
+#: catenary tensions (1 + 3 + 6).
+PER_TICK_FLOATS = 71 + 10
 
 
-def log_bytes_per_tick(cable_segments: int = 0) -> float:
+def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: SensorOptions = SensorOptions()) -> float:
     """Bytes a FAST run preallocates per control tick: the runner's log of the compiled model
-    (13 planned channels; the discretized cables add their nodes' joints) and
-    PER_TICK_FLOATS."""
+    (13 planned channels; the discretized cables add their nodes' joints), PER_TICK_FLOATS and
+    the sensors' (``sims.fast.measurement.floats_per_tick``)."""
     return run_limits.floats(run_limits.runlog_floats_per_tick(_compiled(cable_segments), len(fp.PLAN_LABELS))
-                             + PER_TICK_FLOATS)
+                             + PER_TICK_FLOATS + floats_per_tick(sensors))
 
 
 def problem(plan: fp.FastPlan) -> fp.FastProblem:
@@ -476,14 +477,14 @@ def problem(plan: fp.FastPlan) -> fp.FastProblem:
 
 
 def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_options: ControllerOptions | None = None,
-          planner=None, controller=None, sensor_options: SensorOptions = SensorOptions(),
+          planner=None, controller=None, sensor_options: SensorOptions | None = None,
           plant: FastPlant | None = None) -> Setup:
     """A run of a session (``plan``: its goal plan, or the problem): ``planner`` (default the
     paper's, whose plan is the goal) plans it, ``controller`` (default ``FastController`` with
     ``controller_options``, else the stabilizer as ``params.stewart`` says) follows it, with
     the physics at the trajectory's first pose (at rest, in equilibrium), the cables
     (``params.cable_segments`` >= 2: discretized, sims.fast.physics.discretized_spec), the wind
-    of ``params`` and the sensors (``sensor_options``).
+    of ``params`` and the sensors (``sensor_options``, default ``params.sensors``).
 
     ``plant`` (None or nominal: the model as it is) perturbs the simulated machine only
     (``FastPlant``): the planner, the controller (``nominal_physics``) and the parked winch
@@ -497,7 +498,7 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     perturbed = plant is not None and not plant.is_nominal
     if perturbed:
         plant.check_segments(segments)
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments))
+    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments, params.sensors))
     measured = None
     if params.wind_file is not None:
         measured = MeasuredWind(params.wind_file)
@@ -532,7 +533,8 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
         loads = (ChainCableLoads if segments else CableLoads)(**wind)
     evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops)
     return Setup(physics=physics, trajectory=trajectory, controller=controller,
-                 sensors=FastSensors(physics, sensor_options, CONTROL_DT), problem=session, planner=planner,
+                 sensors=make_sensors(physics, params.sensors if sensor_options is None else sensor_options,
+                                      CONTROL_DT), problem=session, planner=planner,
                  control_dt=CONTROL_DT, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
                  report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed, params=params,
                  output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1,
@@ -591,6 +593,8 @@ class FastParams(ScenarioParams):
         None, "measured wind instead of the model: CSV rows t (s), speed (m/s)[, direction (deg)], covering the "
         "run; resampled to the 10 ms control ticks (a relative path is the scenario file's directory's)", path=True)
     stewart: bool = param(True, "the Stewart stabilizer in the cabin on (off: the feed rides the A-B rotator)")
+    sensors: SensorOptions = param(SensorOptions(), "the measurement system (sims.fast.measurement.SensorOptions: "
+                                   "fused, FAST's, or ideal; its rates, latencies, noises and biases)")
     cable_segments: int = param(DEFAULT_CABLE_SEGMENTS, "each cable as a chain of this many elastic segments (2: "
                                 "the measured 0.19 Hz cabin-cable mode, models/fast/README.md); 0: straight cables "
                                 "with the lumped catenary law (faster, lowest mode 0.30 Hz)", low=0,
@@ -610,7 +614,7 @@ class FastParams(ScenarioParams):
             except WindFileError as e:
                 raise ParamError(f"wind_file: {e}") from None
         if self.duration is not None:
-            run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.cable_segments))
+            run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.cable_segments, self.sensors))
         start = getattr(self, "start_utc", None)
         if start is not None:
             try:

@@ -11,11 +11,16 @@ per control tick (100 Hz), MuJoCo takes the physics steps between them:
   the same for the discretized cables (``discretized_spec``), whose chains carry sag and
   weight themselves.
 * ``FastController``: winch commands (planned cable lengths less the elastic stretch and the
-  sag under the planned tensions, plus feedback on the cabin pose measured at 10 Hz with
-  150 ms latency and noise: integral only by default), the A-B rotator servo (gravity
-  feed-forward and integral action), the multi-beam rotation, and the Stewart stabilizer (at
-  100 Hz: an alpha-beta estimate of the cabin pose, led by its latency and the legs' lag, and
-  the inverse kinematics from the base to the planned feed pose).
+  sag under the planned tensions, plus feedback on the cabin pose: integral only by
+  default), the A-B rotator servo (gravity feed-forward and integral action), the multi-beam
+  rotation, and the Stewart stabilizer. With FAST's fused measurement system
+  (sims.fast.measurement, the default) the cable loop reads the cabin's fused estimate at
+  each GPS/RTK fix, and the stabilizer is an integral loop at 100 Hz on the platform's fused
+  estimate (its planned pose less the estimate, through the legs' Jacobian, added to the
+  legs' planned lengths). With the idealized sensors (``system = "ideal"``) it reads the
+  10 Hz total-station fix with 150 ms latency, and the stabilizer leads an alpha-beta
+  estimate of the cabin pose by its latency and the legs' lag into the inverse kinematics
+  from the base to the planned feed pose.
 
 Elastic catenary (Irvine, "Cable Structures", 1981; parabolic sag, small sag-to-span): a cable
 of unstretched length L0, axial stiffness EA and weight w per length, with horizontal span
@@ -904,28 +909,6 @@ def perturbed_start(physics: FastPhysics, nominal: FastPhysics, plant: FastPlant
 
 
 @dataclass(frozen=True)
-class SensorOptions(Params):
-    """FAST's sensors of the cabin pose (the task's, not the controller's: a user's controller
-    gets the same readings). Typed and ranged as the scenarios' parameters (sims.params)."""
-
-    pose_rate_hz: float = param(10.0, "rate of the cable loop's cabin pose fixes (total stations; the issue's "
-                                "10 Hz)", "Hz", low=0.1, high=1.0 / CONTROL_DT,
-                                reason="a fix at least every 10 s (assumed), at most one per 10 ms control tick")
-    pose_latency_s: float = param(0.15, "their latency (the issue's 150 ms)", "s", low=0.0, high=10.0,
-                                  reason="total stations lag 150-240 ms (REFERENCE.md); 10 s is an assumed bound")
-    pose_noise_m: float = param(1e-3, "their white position noise per axis, 1 sigma (assumed: a total station's "
-                                "class at 150-300 m)", "m", low=0.0, high=1.0, reason="an assumed bound")
-    pose_noise_rad: float = param(20e-6, "their white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
-                                  high=0.1, reason="an assumed bound")
-    stewart_latency_s: float = param(0.01, "latency of the 100 Hz pose measurement the stabilizer corrects with "
-                                     "(assumed: IMU-aided)", "s", low=0.0, high=10.0, reason="an assumed bound")
-    stewart_noise_m: float = param(0.5e-3, "its white position noise per axis, 1 sigma (assumed)", "m", low=0.0,
-                                   high=1.0, reason="an assumed bound")
-    stewart_noise_rad: float = param(10e-6, "its white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
-                                     high=0.1, reason="an assumed bound")
-
-
-@dataclass(frozen=True)
 class ControllerOptions(Params):
     """The FAST controller's settings (typed and ranged as sims.params declares).
 
@@ -953,99 +936,13 @@ class ControllerOptions(Params):
                                        reason="a time constant")
     ab_integral_s: float = param(1.0, "the A-B servo's integral time (removes what the gravity feed-forward "
                                  "leaves)", "s", low=0.0, low_open=True, reason="an integral time")
+    platform_bandwidth_hz: float = param(2.0, "with the fused measurement system: bandwidth of the stabilizer's "
+                                         "integral loop on the platform's fused pose estimate", "Hz", low=0.0,
+                                         low_open=True, high=0.5 / CONTROL_DT, high_open=True,
+                                         reason="below half the 100 Hz control rate")
     leg_integral_s: float = param(0.2, "the Stewart legs' integral time on their encoder error (removes the servo "
                                   "droop under the platform's weight, 0.2-0.7 mm at kp = 2e7 N/m)", "s", low=0.0,
                                   low_open=True, reason="an integral time")
-
-
-class FastSensors(Sensors):
-    """FAST's sensors (``SensorOptions``): two measurements of the cabin pose, and encoders.
-
-    The true cabin pose is recorded every tick; a measurement reports the pose of ``latency``
-    ticks ago with its own white noise (position, and a small rotation I + [w]x), seeded from
-    the run's seed.
-
-    Observation keys:
-      cabin_pose_ts_position (3,) m, cabin_pose_ts_rotation (3, 3), cabin_pose_ts_time (1,) s,
-        cabin_pose_ts_count (1,): the total stations' fix (every 1 / pose_rate_hz, a new one
-        when the count changes), for the cable loop.
-      cabin_pose_position (3,), cabin_pose_rotation (3, 3), cabin_pose_time (1,): the 100 Hz
-        measurement (IMU-aided), for the stabilizer.
-      ab_angles (2,) rad and ab_rotation (3, 3): the A-B rotator's encoders and the B frame's
-        orientation in the cabin frame that they give (exact).
-      leg_positions (6,) m and leg_setpoints (6,) m: the Stewart legs' encoders (exact) and
-        their drives' set-points.
-    """
-
-    def __init__(self, physics: "FastPhysics", options: SensorOptions = SensorOptions(),
-                 control_dt: float = CONTROL_DT):
-        super().__init__()
-        o = self.options = options
-        self.dt = control_dt
-        self.every = max(1, int(round(1.0 / (o.pose_rate_hz * control_dt))))
-        self.pose_lag = int(round(o.pose_latency_s / control_dt))
-        self.stewart_lag = int(round(o.stewart_latency_s / control_dt))
-        rate = 1.0 / control_dt
-        self.specs = [
-            SensorSpec("cabin_pose_ts", "cabin pose by the total stations (position and attitude)", "m|rad",
-                       o.pose_rate_hz, o.pose_latency_s,
-                       f"white, {1e3 * o.pose_noise_m:g} mm and {1e6 * o.pose_noise_rad:g} urad 1-sigma per axis"),
-            SensorSpec("cabin_pose", "cabin pose for the stabilizer (IMU-aided)", "m|rad", rate, o.stewart_latency_s,
-                       f"white, {1e3 * o.stewart_noise_m:g} mm and {1e6 * o.stewart_noise_rad:g} urad 1-sigma per axis"),
-            SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate),
-            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate),
-            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate),
-        ]
-
-    def reset(self, physics, times: np.ndarray, seed: int) -> dict:
-        o = self.options
-        n = times.size
-        self._data = physics.data.ptr
-        self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
-        rng = np.random.default_rng([seed, 0xFA57])
-        self.true_pos = np.empty((n, 3))
-        self.true_rot = np.empty((n, 3, 3))
-        # Noise of each measurement: position (n, 3) and a small rotation I + [w]x (n, 3, 3).
-        self.pose_noise = (rng.normal(0.0, o.pose_noise_m, (n, 3)),
-                           np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
-        self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
-                              np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
-        self._ab_qpos, self._leg_qpos, self._leg_act = physics.ab_qpos, physics.leg_qpos, physics.leg_act
-        self.observation = obs = {
-            "cabin_pose_ts_position": np.zeros(3), "cabin_pose_ts_rotation": np.eye(3),
-            "cabin_pose_ts_time": np.zeros(1), "cabin_pose_ts_count": np.zeros(1, dtype=int),
-            "cabin_pose_position": np.zeros(3), "cabin_pose_rotation": np.eye(3), "cabin_pose_time": np.zeros(1),
-            "ab_angles": np.zeros(2), "ab_rotation": np.eye(3), "leg_positions": np.zeros(6),
-            "leg_setpoints": np.zeros(6),
-        }
-        self._views = (obs["ab_angles"], obs["leg_positions"], obs["leg_setpoints"])
-        self(0, physics)
-        return obs
-
-    def _measured(self, tick: int, lag: int, noise, position: np.ndarray, rotation: np.ndarray) -> int:
-        j = max(0, tick - lag)
-        np.add(self.true_pos[j], noise[0][j], out=position)
-        np.matmul(noise[1][j], self.true_rot[j], out=rotation)
-        return j
-
-    def __call__(self, tick: int, physics) -> None:
-        data, obs = self._data, self.observation
-        self.true_pos[tick] = data.xpos[self._cabin]
-        cabin = data.xmat[self._cabin].reshape(3, 3)
-        self.true_rot[tick] = cabin
-        if tick % self.every == 0:
-            j = self._measured(tick, self.pose_lag, self.pose_noise, obs["cabin_pose_ts_position"],
-                               obs["cabin_pose_ts_rotation"])
-            obs["cabin_pose_ts_time"][0] = j * self.dt
-            obs["cabin_pose_ts_count"][0] += 1
-        j = self._measured(tick, self.stewart_lag, self.stewart_noise, obs["cabin_pose_position"],
-                           obs["cabin_pose_rotation"])
-        obs["cabin_pose_time"][0] = j * self.dt
-        ab, legs, setpoints = self._views
-        np.take(data.qpos, self._ab_qpos, out=ab)
-        np.take(data.qpos, self._leg_qpos, out=legs)
-        np.take(data.act, self._leg_act, out=setpoints)
-        np.matmul(cabin.T, data.xmat[self._ab_b].reshape(3, 3), out=obs["ab_rotation"])
 
 
 def ab_gravity_torque(state, geometry: fast.FastGeometry = fast.FAST) -> np.ndarray:
@@ -1096,9 +993,11 @@ class FastController:
     It follows the reference's feed and multi-beam channels (planners.fast.plan.PLAN_LABELS);
     the cabin pose, the A-B angles, the cable lengths and the tensions that go with them come
     from the planners' kinematics and statics (``planners.fast.plan.reference_state``), so
-    any FAST trajectory can be followed. It reads the task's observation (``FastSensors``):
-    the total stations' fix for the cable loop, the 100 Hz pose for the stabilizer, the
-    encoders; rates and latencies from the sensors' specs.
+    any FAST trajectory can be followed. It reads the task's observation: with the fused
+    measurement system (``sims.fast.measurement.FusedSensors``) the cabin's estimate for the
+    cable loop and the platform's for the stabilizer; with the idealized one
+    (``IdealSensors``) the total stations' fix and the 100 Hz pose; the encoders; rates and
+    latencies from the sensors' specs.
 
     Args:
       options: ControllerOptions.
@@ -1122,7 +1021,9 @@ class FastController:
         self.p_platform = state.feed - np.einsum("nij,j->ni", self.r_platform, g.r_s_feed)
         self.nominal_legs = fast.stewart_leg_lengths()
         # s between two total-station fixes (a whole number of ticks)
-        self.pose_dt = max(1, int(round(1.0 / (specs["cabin_pose_ts"].rate_hz * control_dt)))) * control_dt
+        fused = "platform_estimate" in specs
+        if not fused:
+            self.pose_dt = max(1, int(round(1.0 / (specs["cabin_pose_ts"].rate_hz * control_dt)))) * control_dt
         self.seen = -1
         self.correction = np.zeros(6)  # commanded pose correction, m and rad
         self.length_correction = np.zeros(6)  # its cable lengths, m
@@ -1138,7 +1039,8 @@ class FastController:
         self.cable_ids, self.ab_ids = nominal.cable_ids, nominal.ab_ids
         self.leg_ids, self.multifeed_id = nominal.leg_ids, nominal.multifeed_id
         kp_leg, kv_leg = nominal.drive_gains(self.leg_ids)
-        self.stewart_lead = specs["cabin_pose"].latency_s + float(np.mean(kv_leg / kp_leg))
+        if not fused:
+            self.stewart_lead = specs["cabin_pose"].latency_s + float(np.mean(kv_leg / kp_leg))
         self.ab_integral = np.zeros(2)
         self._ab_gain = control_dt / o.ab_integral_s
         self.leg_integral = np.zeros(6)
@@ -1148,6 +1050,12 @@ class FastController:
         self.ab_reference = np.column_stack([state.theta_a, state.theta_b])
         kp_ab, _ = nominal.drive_gains(self.ab_ids)
         self.ab_setpoint = self.ab_reference - ab_gravity_torque(state) / kp_ab
+        # The fused measurement system (sims.fast.measurement.FusedSensors): the cable loop on
+        # the cabin's fused estimate at its fixes' rate, the stabilizer closed on the
+        # platform's; otherwise the idealized pair of cabin-pose measurements.
+        self.fused = fused
+        if fused:
+            self._setup_fused(specs, control_dt)
         self.command = command = context.command
         command[self.cable_ids] = self.l0_ff[0]
         command[self.ab_ids] = self.ab_setpoint[0]
@@ -1168,7 +1076,75 @@ class FastController:
         self.integral += error * dt
         self.correction = o.kp * error + o.kd * self.derivative + o.ki * self.integral
 
+    def _setup_fused(self, specs, control_dt: float) -> None:
+        """The fused path's plan and gains: the legs' planned lengths along the plan (the
+        planned platform pose in the planned base frame), the legs' Jacobian at the nominal
+        pose, dl = J dx for a platform motion dx = (dp, dtheta) in the base frame (J = -A^T,
+        A the structure matrix, planners.legs), and the integral gain 2 pi f dt."""
+        s, g = self.state, fast.FAST
+        r_base = np.einsum("nij,njk->nik", s.cabin_rotation, fast.ab_rotation(s.theta_a, s.theta_b, g.alpha))
+        p_base = s.cabin_origin + np.einsum("nij,j->ni", s.cabin_rotation, g.ab_center)
+        position = np.einsum("nji,nj->ni", r_base, self.p_platform - p_base)
+        rotation = np.einsum("nji,njk->nik", r_base, self.r_platform)
+        self.legs_plan = leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
+                                     rotation) - self.nominal_legs
+        self.platform_jacobian = -structure_matrix(fast.STEWART.base_anchors, fast.STEWART.platform_anchors,
+                                                   g.r_ab_s, np.eye(3)).T
+        self._platform_gain = 2 * math.pi * self.options.platform_bandwidth_hz * control_dt
+        self.platform_correction = np.zeros(6)
+        self.cabin_fix_dt = max(1, int(round(1.0 / (specs["cabin_rtk"].rate_hz * control_dt)))) * control_dt
+
+    def _fused_cable_feedback(self, obs, tick: int) -> None:
+        """Integral (and optional proportional-derivative) action on the cabin's fused
+        estimate, at each GPS/RTK fix's arrival: the estimate of the present tick."""
+        o, s = self.options, self.state
+        pos, rot = obs["cabin_estimate_position"], obs["cabin_estimate_rotation"]
+        error = np.concatenate([s.cabin_origin[tick] - pos, vee(s.cabin_rotation[tick] @ rot.T)])
+        dt = self.cabin_fix_dt
+        if self.last_error is not None:
+            alpha = dt / (o.derivative_filter_s + dt)
+            self.derivative += alpha * ((error - self.last_error) / dt - self.derivative)
+        self.last_error = error
+        self.integral += error * dt
+        self.correction = o.kp * error + o.kd * self.derivative + o.ki * self.integral
+
+    def _fused_stewart_legs(self, obs, nxt: int) -> np.ndarray:
+        """Leg length changes (6,): the planned ones plus an integral of the platform's error
+        (its planned pose less the fused estimate, in the base frame of the cabin's estimate
+        and the A-B encoders) through the legs' Jacobian, bounded by the stroke."""
+        pos, rot = obs["platform_estimate_position"], obs["platform_estimate_rotation"]
+        r_base = obs["cabin_estimate_rotation"] @ obs["ab_rotation"]
+        error = np.concatenate([r_base.T @ (self.p_platform[nxt] - pos), r_base.T @ vee(self.r_platform[nxt] @ rot.T)])
+        stroke = fast.STEWART.stroke
+        self.platform_correction = np.clip(self.platform_correction + self._platform_gain *
+                                           (self.platform_jacobian @ error), -stroke, stroke)
+        return self.legs_plan[nxt] + self.platform_correction
+
+    def _fused_call(self, tick: int, obs) -> None:
+        s, command = self.state, self.command
+        nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
+        count = int(obs["cabin_rtk_count"][0])
+        if count != self.seen:
+            self.seen = count
+            self._fused_cable_feedback(obs, tick)
+            a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[tick],
+                                 s.cabin_rotation[tick])
+            self.length_correction = -a.T @ self.correction
+        command[self.cable_ids] = self.l0_ff[nxt] + self.length_correction
+        self.ab_integral += self._ab_gain * (self.ab_reference[tick] - obs["ab_angles"])
+        command[self.ab_ids] = self.ab_setpoint[nxt] + self.ab_integral
+        command[self.multifeed_id] = s.multifeed[nxt]
+        if self.options.stewart:
+            setpoint = self._fused_stewart_legs(obs, nxt)
+        else:  # the legs hold nominal, with integral action on their encoders as below
+            self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (-obs["leg_positions"]),
+                                        -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
+            setpoint = self.leg_integral
+        command[self.leg_ids] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
+
     def __call__(self, tick: int, obs) -> None:
+        if self.fused:
+            return self._fused_call(tick, obs)
         s, command = self.state, self.command
         nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
         count = int(obs["cabin_pose_ts_count"][0])

@@ -1,0 +1,580 @@
+"""FAST's measurement system: inertial units, total stations and GPS/RTK fused by Kalman filters.
+
+FAST measures the feed cabin and the Stewart platform by fusing a strapdown inertial system
+(SINS), GPS/RTK and total stations with a Kalman filter (Li M.-H. et al., RAA 20, 140, 2020;
+REFERENCE.md). Its fused errors are 14.56 mm and 0.095 deg RMS for the cabin and 2.99 mm and
+0.093 deg for the Stewart platform. The total stations lag 150-240 ms and sample at about
+8 Hz; the inertial part alone diverges. This module simulates such a system for the task (a
+user's controller gets the same observation as ours):
+
+* an IMU on the cabin and one on the feed platform, read every control tick: the specific
+  force of the tick from the velocity increment of MuJoCo's ``velocimeter`` at the IMU's site
+  (a strapdown unit integrates its accelerometers internally; fast.xml says why not a sampled
+  ``accelerometer``) and the rate of its ``gyro`` (models/fast/fast.xml: ``cabin_imu_*``,
+  ``platform_imu_*``), with white noise, a turn-on bias and a bias random walk of a
+  navigation-grade fibre-optic SINS (``SensorOptions``; the telescope's own is not public);
+* GPS/RTK antennas on the cabin roof (sites ``rtk1..3``) and total-station prisms on the feed
+  platform (sites ``prism1..3``), each fix the three points' world positions with white noise
+  and a slowly varying (first-order Gauss-Markov) error per coordinate: multipath for RTK,
+  refraction for the total stations. The slow part is what no filter can remove, so it sets
+  the fused error;
+* per body, a Kalman filter at the control rate: the IMU propagates position, velocity and
+  attitude (strapdown), every fix corrects them and the biases with the steady-state gains of
+  the per-axis error model (``scipy.linalg.solve_discrete_are``), at the fix's own time: the
+  correction is carried to the present through the error model's transition (exact for the
+  linear filter), so a 200 ms old fix corrects without lag.
+
+The defaults are set so that the estimates' errors against the truth match the published
+fused errors (tests/test_fast_measurement.py measures them on a 60 s run).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+import scipy.signal
+from scipy.spatial.transform import Rotation
+
+from planners.rotations import skew, vee
+from sims.fast.physics import CONTROL_DT
+from sims.params import Params, param
+from sims.task import Sensors, SensorSpec
+
+@dataclass(frozen=True)
+class SensorOptions(Params):
+    """FAST's measurement system (the task's, not the controller's: a user's controller gets
+    the same readings). Typed and ranged as the scenarios' parameters (sims.params).
+
+    ``system = "fused"`` (default): the measurement system of the module doc, whose defaults
+    give the published fused errors. ``system = "ideal"``: the earlier, idealized pair of
+    cabin-pose measurements (``IdealSensors``: ``pose_*`` and ``stewart_*``), kept to compare.
+    """
+
+    system: str = param("fused", "the measurement system: fused (IMUs, total stations and GPS/RTK through Kalman "
+                        "filters, FAST's published errors) or ideal (the idealized cabin-pose measurements pose_* "
+                        "and stewart_*)", choices=("fused", "ideal"))
+    imu_gyro_noise: float = param(1.45e-6, "the SINS gyros' angle random walk, per axis (0.005 deg/sqrt(h), a "
+                                  "navigation-grade fibre-optic gyro; FAST's own is not public: assumed)",
+                                  "rad/sqrt(s)", low=0.0, high=1e-3, reason="up to a consumer MEMS gyro's")
+    imu_gyro_bias: float = param(9.7e-8, "their turn-on bias, 1 sigma per axis (0.02 deg/h; assumed as above)",
+                                 "rad/s", low=0.0, high=1e-3, reason="up to a consumer MEMS gyro's")
+    imu_gyro_bias_walk: float = param(1e-9, "their bias random walk (assumed)", "rad/s/sqrt(s)", low=0.0, high=1e-5,
+                                      reason="an assumed bound")
+    imu_accel_noise: float = param(4.9e-4, "the SINS accelerometers' white noise density, per axis (50 ug/sqrt(Hz), "
+                                   "navigation grade; assumed)", "m/s^2/sqrt(Hz)", low=0.0, high=0.1,
+                                   reason="up to a consumer MEMS accelerometer's")
+    imu_accel_bias: float = param(9.8e-4, "their turn-on bias, 1 sigma per axis (100 ug; assumed)", "m/s^2", low=0.0,
+                                  high=0.5, reason="up to a consumer MEMS accelerometer's")
+    imu_accel_bias_walk: float = param(1e-5, "their bias random walk (assumed)", "m/s^2/sqrt(s)", low=0.0, high=1e-2,
+                                       reason="an assumed bound")
+    ts_rate_hz: float = param(8.0, "the total stations' fixes of the feed platform's three prisms", "Hz", low=0.1,
+                              high=1.0 / CONTROL_DT, reason="a fix at least every 10 s, at most one per 10 ms tick "
+                              "(about 8 Hz at 500 m: REFERENCE.md)")
+    ts_latency_s: float = param(0.2, "their latency (150-240 ms measured: REFERENCE.md)", "s", low=0.0, high=1.0,
+                                reason="the filter keeps a second of its past for late fixes")
+    ts_noise_m: float = param(1e-3, "their white noise per prism and coordinate, 1 sigma (about 2 mm uncertainty "
+                              "at 150-300 m: SPIE 6280)", "m", low=0.0, high=0.1, reason="an assumed bound")
+    ts_common_m: float = param(1.5e-3, "their slowly varying error common to the three prisms (refraction, the "
+                               "stations' orientation), 1 sigma per coordinate (set so that the fused platform "
+                               "error is the published 2.99 mm)", "m", low=0.0, high=0.1, reason="an assumed bound")
+    ts_point_m: float = param(1.5e-3, "their slowly varying error of each prism alone, 1 sigma per coordinate (set "
+                              "so that the fused platform attitude error is the published 0.093 deg)", "m", low=0.0,
+                              high=0.1, reason="an assumed bound")
+    ts_drift_time_s: float = param(5.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
+                                   "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
+    rtk_rate_hz: float = param(10.0, "GPS/RTK fixes of the cabin's three roof antennas (a common RTK output rate; "
+                               "assumed)", "Hz", low=0.1, high=1.0 / CONTROL_DT,
+                               reason="a fix at least every 10 s, at most one per 10 ms tick")
+    rtk_latency_s: float = param(0.05, "their latency (assumed)", "s", low=0.0, high=1.0,
+                                 reason="the filter keeps a second of its past for late fixes")
+    rtk_noise_m: float = param(5e-3, "their white noise per antenna and coordinate, 1 sigma (assumed)", "m",
+                               low=0.0, high=0.5, reason="an assumed bound")
+    rtk_common_m: float = param(7e-3, "their slowly varying error common to the three antennas (base station, "
+                                "atmosphere), 1 sigma per coordinate (set so that the fused cabin error is the "
+                                "published 14.56 mm)", "m", low=0.0, high=0.5, reason="an assumed bound")
+    rtk_point_m: float = param(7.7e-3, "their slowly varying error of each antenna alone (multipath), 1 sigma per "
+                               "coordinate (set so that the fused cabin attitude error is the published 0.095 deg)",
+                               "m", low=0.0, high=0.5, reason="an assumed bound")
+    rtk_drift_time_s: float = param(5.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
+                                    "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
+
+    pose_rate_hz: float = param(10.0, "ideal system: rate of the cable loop's cabin pose fixes (total stations; the issue's "
+                                "10 Hz)", "Hz", low=0.1, high=1.0 / CONTROL_DT,
+                                reason="a fix at least every 10 s (assumed), at most one per 10 ms control tick")
+    pose_latency_s: float = param(0.15, "their latency (the issue's 150 ms)", "s", low=0.0, high=10.0,
+                                  reason="total stations lag 150-240 ms (REFERENCE.md); 10 s is an assumed bound")
+    pose_noise_m: float = param(1e-3, "their white position noise per axis, 1 sigma (assumed: a total station's "
+                                "class at 150-300 m)", "m", low=0.0, high=1.0, reason="an assumed bound")
+    pose_noise_rad: float = param(20e-6, "their white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
+                                  high=0.1, reason="an assumed bound")
+    stewart_latency_s: float = param(0.01, "ideal system: latency of the 100 Hz pose measurement the stabilizer corrects with "
+                                     "(assumed: IMU-aided)", "s", low=0.0, high=10.0, reason="an assumed bound")
+    stewart_noise_m: float = param(0.5e-3, "its white position noise per axis, 1 sigma (assumed)", "m", low=0.0,
+                                   high=1.0, reason="an assumed bound")
+    stewart_noise_rad: float = param(10e-6, "its white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
+                                     high=0.1, reason="an assumed bound")
+
+
+
+class IdealSensors(Sensors):
+    """The idealized sensors (``SensorOptions(system="ideal")``): two measurements of the cabin
+    pose, and encoders.
+
+    The true cabin pose is recorded every tick; a measurement reports the pose of ``latency``
+    ticks ago with its own white noise (position, and a small rotation I + [w]x), seeded from
+    the run's seed.
+
+    Observation keys:
+      cabin_pose_ts_position (3,) m, cabin_pose_ts_rotation (3, 3), cabin_pose_ts_time (1,) s,
+        cabin_pose_ts_count (1,): the total stations' fix (every 1 / pose_rate_hz, a new one
+        when the count changes), for the cable loop.
+      cabin_pose_position (3,), cabin_pose_rotation (3, 3), cabin_pose_time (1,): the 100 Hz
+        measurement (IMU-aided), for the stabilizer.
+      ab_angles (2,) rad and ab_rotation (3, 3): the A-B rotator's encoders and the B frame's
+        orientation in the cabin frame that they give (exact).
+      leg_positions (6,) m and leg_setpoints (6,) m: the Stewart legs' encoders (exact) and
+        their drives' set-points.
+    """
+
+    def __init__(self, physics: "FastPhysics", options: SensorOptions = SensorOptions(),
+                 control_dt: float = CONTROL_DT):
+        super().__init__()
+        o = self.options = options
+        self.dt = control_dt
+        self.every = max(1, int(round(1.0 / (o.pose_rate_hz * control_dt))))
+        self.pose_lag = int(round(o.pose_latency_s / control_dt))
+        self.stewart_lag = int(round(o.stewart_latency_s / control_dt))
+        rate = 1.0 / control_dt
+        self.specs = [
+            SensorSpec("cabin_pose_ts", "cabin pose by the total stations (position and attitude)", "m|rad",
+                       o.pose_rate_hz, o.pose_latency_s,
+                       f"white, {1e3 * o.pose_noise_m:g} mm and {1e6 * o.pose_noise_rad:g} urad 1-sigma per axis"),
+            SensorSpec("cabin_pose", "cabin pose for the stabilizer (IMU-aided)", "m|rad", rate, o.stewart_latency_s,
+                       f"white, {1e3 * o.stewart_noise_m:g} mm and {1e6 * o.stewart_noise_rad:g} urad 1-sigma per axis"),
+            SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate),
+            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate),
+            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate),
+        ]
+
+    def reset(self, physics, times: np.ndarray, seed: int) -> dict:
+        o = self.options
+        n = times.size
+        self._data = physics.data.ptr
+        self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
+        rng = np.random.default_rng([seed, 0xFA57])
+        self.true_pos = np.empty((n, 3))
+        self.true_rot = np.empty((n, 3, 3))
+        # Noise of each measurement: position (n, 3) and a small rotation I + [w]x (n, 3, 3).
+        self.pose_noise = (rng.normal(0.0, o.pose_noise_m, (n, 3)),
+                           np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
+        self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
+                              np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
+        self._ab_qpos, self._leg_qpos, self._leg_act = physics.ab_qpos, physics.leg_qpos, physics.leg_act
+        self.observation = obs = {
+            "cabin_pose_ts_position": np.zeros(3), "cabin_pose_ts_rotation": np.eye(3),
+            "cabin_pose_ts_time": np.zeros(1), "cabin_pose_ts_count": np.zeros(1, dtype=int),
+            "cabin_pose_position": np.zeros(3), "cabin_pose_rotation": np.eye(3), "cabin_pose_time": np.zeros(1),
+            "ab_angles": np.zeros(2), "ab_rotation": np.eye(3), "leg_positions": np.zeros(6),
+            "leg_setpoints": np.zeros(6),
+        }
+        self._views = (obs["ab_angles"], obs["leg_positions"], obs["leg_setpoints"])
+        self(0, physics)
+        return obs
+
+    def _measured(self, tick: int, lag: int, noise, position: np.ndarray, rotation: np.ndarray) -> int:
+        j = max(0, tick - lag)
+        np.add(self.true_pos[j], noise[0][j], out=position)
+        np.matmul(noise[1][j], self.true_rot[j], out=rotation)
+        return j
+
+    def __call__(self, tick: int, physics) -> None:
+        data, obs = self._data, self.observation
+        self.true_pos[tick] = data.xpos[self._cabin]
+        cabin = data.xmat[self._cabin].reshape(3, 3)
+        self.true_rot[tick] = cabin
+        if tick % self.every == 0:
+            j = self._measured(tick, self.pose_lag, self.pose_noise, obs["cabin_pose_ts_position"],
+                               obs["cabin_pose_ts_rotation"])
+            obs["cabin_pose_ts_time"][0] = j * self.dt
+            obs["cabin_pose_ts_count"][0] += 1
+        j = self._measured(tick, self.stewart_lag, self.stewart_noise, obs["cabin_pose_position"],
+                           obs["cabin_pose_rotation"])
+        obs["cabin_pose_time"][0] = j * self.dt
+        ab, legs, setpoints = self._views
+        np.take(data.qpos, self._ab_qpos, out=ab)
+        np.take(data.qpos, self._leg_qpos, out=legs)
+        np.take(data.act, self._leg_act, out=setpoints)
+        np.matmul(cabin.T, data.xmat[self._ab_b].reshape(3, 3), out=obs["ab_rotation"])
+
+
+
+#: The Kalman filters' error state (true less estimated), world frame: position, velocity,
+#: accelerometer bias, attitude (the small rotation from the estimate to the truth) and gyro
+#: bias, 3 each. The biases are estimated in the world frame, which the slow tilts of the
+#: cabin (14 deg over minutes) make a good approximation; they are carried to the IMU's frame
+#: when applied. The specific force is about g up (the feed support's accelerations are
+#: millimetres per second squared), so an attitude error theta turns into an acceleration
+#: error theta x (0, 0, g): the model couples each horizontal position with its tilt, and
+#: the filter has one steady state (the model is time-invariant).
+P, V, BA, TH, BG = (slice(3 * k, 3 * k + 3) for k in range(5))
+
+
+def error_model(dt: float, gravity: float):
+    """(Phi (15, 15), G (15, 6)) of the error state per tick: x' = Phi x + G w, w the
+    accelerometers' and the gyros' white noise per tick (3 each)."""
+    phi = np.eye(15)
+    up = np.array([0.0, 0.0, gravity])
+    tilt = -skew(up)  # theta x up = -[up]x theta
+    phi[P, V] = dt * np.eye(3)
+    phi[P, BA] = -0.5 * dt * dt * np.eye(3)
+    phi[P, TH] = 0.5 * dt * dt * tilt
+    phi[V, BA] = -dt * np.eye(3)
+    phi[V, TH] = dt * tilt
+    phi[TH, BG] = -dt * np.eye(3)
+    g = np.zeros((15, 6))
+    g[P, :3] = 0.5 * dt * dt * np.eye(3)
+    g[V, :3] = dt * np.eye(3)
+    g[TH, 3:] = dt * np.eye(3)
+    return phi, g
+
+
+#: The filters' variances are at least this (m^2, rad^2, ...), so that an ideal sensor (a zero
+#: noise) still gives a well-posed Riccati equation.
+VARIANCE_FLOOR = 1e-18
+
+
+def steady_state_gain(phi: np.ndarray, g: np.ndarray, white: np.ndarray, walk: np.ndarray, every: int,
+                      measurement_var: np.ndarray) -> np.ndarray:
+    """The steady-state Kalman gain (15, 6) of the error model (``error_model``) measured in
+    position and attitude every ``every`` ticks.
+
+    ``white`` (6,): 1 sigma per tick of the accelerometers' and gyros' white noise; ``walk``
+    (6,): of their biases' random walk per tick; ``measurement_var`` (6,): the fix's variance
+    of position and attitude per axis. The fix-to-fix model is Phi^m with the process noise
+    summed over the m ticks; the a-priori covariance P solves the discrete algebraic Riccati
+    equation (scipy.linalg.solve_discrete_are), and K = P H^T (H P H^T + R)^-1.
+    """
+    q = g @ np.diag(np.square(white)) @ g.T + VARIANCE_FLOOR * np.eye(15)
+    q[BA, BA] += np.diag(np.square(walk[:3]))
+    q[BG, BG] += np.diag(np.square(walk[3:]))
+    phi_m, q_m = np.eye(15), np.zeros((15, 15))
+    for _ in range(every):
+        q_m = phi @ q_m @ phi.T + q
+        phi_m = phi @ phi_m
+    h = np.zeros((6, 15))
+    h[:3, P] = np.eye(3)
+    h[3:, TH] = np.eye(3)
+    r = np.diag(np.maximum(measurement_var, VARIANCE_FLOOR))
+    p = scipy.linalg.solve_discrete_are(phi_m.T, h.T, q_m, r)
+    return p @ h.T @ np.linalg.inv(h @ p @ h.T + r)
+
+
+def gauss_markov(rng: np.random.Generator, shape: tuple, sigma: float, correlation_s: float, dt: float) -> np.ndarray:
+    """A first-order Gauss-Markov process along axis 0 (stationary, ``sigma`` 1 sigma, time
+    constant ``correlation_s``) sampled every ``dt`` s: e_k+1 = phi e_k + sqrt(1 - phi^2)
+    sigma n_k (scipy.signal.lfilter), started in its stationary distribution."""
+    n = rng.standard_normal(shape)
+    if sigma == 0.0:
+        return np.zeros(shape)
+    phi = math.exp(-dt / correlation_s)
+    n[1:] *= math.sqrt(1.0 - phi * phi)
+    return sigma * scipy.signal.lfilter([1.0], [1.0, -phi], n, axis=0)
+
+
+def point_pose_noise(points: np.ndarray, sigma: float) -> float:
+    """1 sigma per axis of the attitude that the least-squares fit of ``points`` (k, 3) (body
+    frame) gives when each coordinate has ``sigma`` of white noise: sqrt of the largest
+    eigenvalue of sigma^2 (sum |q|^2 I - q q^T)^-1, q about the centroid (the tilt axes for
+    points in a plane)."""
+    q = points - points.mean(axis=0)
+    inertia = np.einsum("ki,ki->", q, q) * np.eye(3) - q.T @ q
+    return float(sigma * math.sqrt(np.linalg.eigvalsh(np.linalg.inv(inertia)).max()))
+
+
+class FusedPose:
+    """A Kalman filter of one body's pose, IMU-propagated and corrected by delayed point fixes.
+
+    Args:
+      points: (k, 3) the fix's points in the body frame, m.
+      imu_offset: (3,) the IMU's position in the body frame (its frame is the body's), m.
+      noise: the filter's noise model: accel_white, accel_walk, gyro_white, gyro_walk (per
+        tick), every (ticks between fixes), fix_white and fix_drift (1 sigma per point and
+        coordinate, m; the drift is common to the points).
+      dt: the control tick, s; gravity: (3,) m/s^2; history: ticks of state kept for late fixes.
+    """
+
+    def __init__(self, points, imu_offset, noise: dict, dt: float, gravity: np.ndarray, history: int):
+        self.points = np.asarray(points, float)
+        self.centroid = self.points.mean(axis=0)
+        self.imu_offset = np.asarray(imu_offset, float)
+        self.dt, self.gravity = dt, np.asarray(gravity, float)
+        self.history = history
+        phi, g = error_model(dt, float(np.linalg.norm(self.gravity)))
+        k = len(self.points)
+        position_var = noise["fix_white"] ** 2 / k + noise["fix_drift"] ** 2
+        attitude_var = point_pose_noise(self.points, noise["fix_white"]) ** 2
+        self.gain = steady_state_gain(
+            phi, g, np.repeat([noise["accel_white"], noise["gyro_white"]], 3),
+            np.repeat([noise["accel_walk"], noise["gyro_walk"]], 3), noise["every"],
+            np.repeat([position_var, attitude_var], 3))
+        # Phi^k for k = 0 .. history - 1, to carry a correction at a past tick to the present.
+        powers = [np.eye(15)]
+        for _ in range(history - 1):
+            powers.append(phi @ powers[-1])
+        self._powers = np.stack(powers)
+
+    def reset(self, position, rotation, velocity=None) -> None:
+        """Start at a known pose (the operator's survey of the parked machine), at rest."""
+        self.rotation = np.array(rotation, float)
+        self.position = np.array(position, float) + self.rotation @ self.imu_offset  # the IMU's point
+        self.velocity = np.zeros(3) if velocity is None else np.array(velocity, float)
+        self.accel_bias = np.zeros(3)  # IMU frame
+        self.gyro_bias = np.zeros(3)
+        h = self.history
+        self.past_position = np.repeat(self.position[None], h, axis=0)
+        self.past_velocity = np.repeat(self.velocity[None], h, axis=0)
+        self.past_rotation = np.repeat(self.rotation[None], h, axis=0)
+        self.tick = 0
+
+    def propagate(self, specific_force: np.ndarray, rate: np.ndarray) -> None:
+        """One tick of strapdown navigation from the IMU's readings (its frame) of the tick
+        that ends: attitude by the rate (first order; re-orthonormalized at each fix),
+        acceleration = R (f - b_a) + g."""
+        dt = self.dt
+        r = self.rotation
+        acceleration = r @ (specific_force - self.accel_bias) + self.gravity
+        self.position += (self.velocity + 0.5 * dt * acceleration) * dt
+        self.velocity += acceleration * dt
+        self.rotation = r + r @ skew((rate - self.gyro_bias) * dt)
+        self.tick += 1
+        k = self.tick % self.history
+        self.past_position[k] = self.position
+        self.past_velocity[k] = self.velocity
+        self.past_rotation[k] = self.rotation
+
+    def correct(self, measured_points: np.ndarray, at_tick: int) -> None:
+        """A fix of the points (k, 3) world, m, taken at tick ``at_tick`` (at most
+        ``history - 1`` ticks ago): the innovation against the estimate of that tick, the
+        steady-state correction, carried to every later tick kept and to the present
+        (x_k = Phi^(k - at_tick) dx; exact for the linear error model)."""
+        age = self.tick - at_tick
+        if not 0 <= age < self.history:
+            raise ValueError(f"a fix {age} ticks old: the filter keeps {self.history}")
+        measured_rotation, _ = Rotation.align_vectors(measured_points - measured_points.mean(axis=0),
+                                                      self.points - self.centroid)
+        rot_fix = measured_rotation.as_matrix()
+        imu_fix = measured_points.mean(axis=0) + rot_fix @ (self.imu_offset - self.centroid)
+        k = at_tick % self.history
+        innovation = np.concatenate([imu_fix - self.past_position[k],
+                                     vee(rot_fix @ self.past_rotation[k].T - np.eye(3))])
+        carried = self._powers[:age + 1] @ (self.gain @ innovation)  # (age + 1, 15)
+        ticks = (at_tick + np.arange(age + 1)) % self.history
+        self.past_position[ticks] += carried[:, P]
+        self.past_velocity[ticks] += carried[:, V]
+        self.past_rotation[ticks] = (np.eye(3) + skew(carried[:, TH])) @ self.past_rotation[ticks]
+        now = carried[-1]
+        self.position += now[P]
+        self.velocity += now[V]
+        self.rotation = _orthonormal((np.eye(3) + skew(now[TH])) @ self.rotation)
+        self.past_rotation[self.tick % self.history] = self.rotation
+        # The biases' corrections (world frame) in the IMU's frame: the error is the true
+        # bias less the estimate, so the estimate grows by it.
+        self.accel_bias += self.rotation.T @ now[BA]
+        self.gyro_bias += self.rotation.T @ now[BG]
+
+    def body_pose(self):
+        """(origin (3,), rotation (3, 3), velocity (3,)) of the body frame, world."""
+        return self.position - self.rotation @ self.imu_offset, self.rotation, self.velocity
+
+
+def _orthonormal(r: np.ndarray) -> np.ndarray:
+    """The rotation nearest to ``r`` (polar decomposition by SVD)."""
+    u, _, vt = np.linalg.svd(r)
+    return u @ vt
+
+
+class FusedSensors(Sensors):
+    """FAST's measurement system (module doc; ``SensorOptions(system="fused")``).
+
+    Observation keys (SI; world frame unless stated):
+      cabin_estimate_position (3,), cabin_estimate_rotation (3, 3), cabin_estimate_velocity
+        (3,), cabin_estimate_time (1,): the cabin frame's fused pose (origin at the anchor
+        plane's centre) for the present tick, from the cabin's SINS and GPS/RTK.
+      platform_estimate_position, _rotation, _velocity, _time: the feed platform's, from its
+        SINS and the total stations.
+      cabin_imu_accel, cabin_imu_gyro, platform_imu_accel, platform_imu_gyro (3,): the IMUs'
+        readings of the tick (specific force m/s^2 and rate rad/s, the IMU's frame = the
+        body's), for a user's own fusion.
+      cabin_rtk_points (3, 3) and platform_ts_points (3, 3): the last fix delivered (rows:
+        antennas rtk1..3 / prisms prism1..3, world, m), with _time (when it was taken) and
+        _count (a new one when it changes).
+      ab_angles, ab_rotation, leg_positions, leg_setpoints: the encoders, as IdealSensors.
+    """
+
+    BODIES = ("cabin", "platform")
+
+    def __init__(self, physics, options: SensorOptions = SensorOptions(), control_dt: float = CONTROL_DT):
+        super().__init__()
+        o = self.options = options
+        self.dt = control_dt
+        model = physics.model.ptr
+        self.gravity = model.opt.gravity.copy()
+        self.fix_every = {"cabin": _ticks(1.0 / o.rtk_rate_hz, control_dt, 1),
+                          "platform": _ticks(1.0 / o.ts_rate_hz, control_dt, 1)}
+        self.fix_lag = {"cabin": _ticks(o.rtk_latency_s, control_dt, 0),
+                        "platform": _ticks(o.ts_latency_s, control_dt, 0)}
+        self.body_ids = {"cabin": physics.cabin_body, "platform": int(model.body("feed_platform").id)}
+        self.point_sites = {"cabin": [model.site(f"rtk{i}").id for i in (1, 2, 3)],
+                            "platform": [model.site(f"prism{i}").id for i in (1, 2, 3)]}
+        self.imu_site = {b: model.site(f"{b}_imu").id for b in self.BODIES}
+        self.noise = {"cabin": (o.rtk_noise_m, o.rtk_common_m, o.rtk_point_m, o.rtk_drift_time_s),
+                      "platform": (o.ts_noise_m, o.ts_common_m, o.ts_point_m, o.ts_drift_time_s)}
+        history = max(self.fix_lag.values()) + 2
+        imu = dict(accel_white=o.imu_accel_noise / math.sqrt(control_dt), accel_walk=o.imu_accel_bias_walk *
+                   math.sqrt(control_dt), gyro_white=o.imu_gyro_noise / math.sqrt(control_dt),
+                   gyro_walk=o.imu_gyro_bias_walk * math.sqrt(control_dt))
+        self.filters = {}
+        for b in self.BODIES:
+            white, common, point, _ = self.noise[b]
+            fix = dict(imu, every=self.fix_every[b], fix_white=math.hypot(white, point), fix_drift=common)
+            points = model.site_pos[self.point_sites[b]]
+            self.filters[b] = FusedPose(points, model.site_pos[self.imu_site[b]], fix, control_dt, self.gravity,
+                                        history)
+        self._vel = {b: physics.sensor_block(f"{b}_imu_vel") for b in self.BODIES}
+        self._gyro = {b: physics.sensor_block(f"{b}_imu_gyro") for b in self.BODIES}
+        rate = 1.0 / control_dt
+        imu_noise = (f"white {o.imu_accel_noise:g} m/s^2/sqrt(Hz) and {o.imu_gyro_noise:g} rad/sqrt(s)")
+        imu_bias = (f"turn-on {o.imu_accel_bias:g} m/s^2 and {o.imu_gyro_bias:g} rad/s 1-sigma, random walk "
+                    f"{o.imu_accel_bias_walk:g} m/s^2/sqrt(s) and {o.imu_gyro_bias_walk:g} rad/s/sqrt(s)")
+
+        def fix_noise(b):
+            white, common, point, tau = self.noise[b]
+            return (f"white {1e3 * white:g} mm; Gauss-Markov ({tau:g} s) {1e3 * common:g} mm common and "
+                    f"{1e3 * point:g} mm per point, 1-sigma per coordinate")
+
+        self.specs = [
+            SensorSpec("cabin_estimate", "cabin pose fused from its SINS and GPS/RTK (Kalman filter)", "m|rad|m/s",
+                       rate, 0.0, "the filter's error (about 15 mm and 0.1 deg RMS)"),
+            SensorSpec("platform_estimate", "feed platform pose fused from its SINS and the total stations (Kalman "
+                       "filter)", "m|rad|m/s", rate, 0.0, "the filter's error (about 3 mm and 0.1 deg RMS)"),
+            SensorSpec("cabin_imu", "cabin SINS: specific force and angular rate, IMU frame", "m/s^2|rad/s", rate,
+                       0.0, imu_noise, imu_bias),
+            SensorSpec("platform_imu", "feed platform SINS: specific force and angular rate, IMU frame",
+                       "m/s^2|rad/s", rate, 0.0, imu_noise, imu_bias),
+            SensorSpec("cabin_rtk", "GPS/RTK positions of the cabin's three roof antennas", "m", o.rtk_rate_hz,
+                       o.rtk_latency_s, fix_noise("cabin")),
+            SensorSpec("platform_ts", "total-station positions of the feed platform's three prisms", "m",
+                       o.ts_rate_hz, o.ts_latency_s, fix_noise("platform")),
+            SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate),
+            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate),
+            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate),
+        ]
+
+    def reset(self, physics, times: np.ndarray, seed: int) -> dict:
+        o = self.options
+        n = times.size
+        self._data = data = physics.data.ptr
+        rng = np.random.default_rng([seed, 0xFA58])
+        shape = (n, 2, 3)
+        # IMU errors per tick: white noise, and a bias = turn-on + random walk.
+        dt = self.dt
+        self.accel_error = (rng.normal(0.0, o.imu_accel_noise / math.sqrt(dt), shape) + rng.normal(0.0, o.imu_accel_bias, (1, 2, 3))
+                            + np.cumsum(rng.normal(0.0, o.imu_accel_bias_walk * math.sqrt(dt), shape), axis=0))
+        self.gyro_error = (rng.normal(0.0, o.imu_gyro_noise / math.sqrt(dt), shape) + rng.normal(0.0, o.imu_gyro_bias, (1, 2, 3))
+                           + np.cumsum(rng.normal(0.0, o.imu_gyro_bias_walk * math.sqrt(dt), shape), axis=0))
+        # Fix errors per fix (rows: fixes; points; coordinates): white, common slow, per-point slow.
+        self.fix_error = {}
+        for b in self.BODIES:
+            white, common, point, tau = self.noise[b]
+            every = self.fix_every[b]
+            m = n // every + 1
+            fix_dt = every * dt
+            self.fix_error[b] = (rng.normal(0.0, white, (m, 3, 3)) + gauss_markov(rng, (m, 1, 3), common, tau, fix_dt)
+                                 + gauss_markov(rng, (m, 3, 3), point, tau, fix_dt))
+        self._last_velocity = np.zeros((2, 3))
+        self.pending = {b: deque() for b in self.BODIES}  # (arrival tick, points (3, 3), taken at tick)
+        self.estimate_log = np.zeros((n, 2, 12))  # per tick: position (3) and rotation (9) of each body
+        self._ab_qpos, self._leg_qpos, self._leg_act = physics.ab_qpos, physics.leg_qpos, physics.leg_act
+        self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
+        obs = {}
+        for b in self.BODIES:
+            body = self.body_ids[b]
+            self.filters[b].reset(data.xpos[body], data.xmat[body].reshape(3, 3))
+            obs.update({f"{b}_estimate_position": np.zeros(3), f"{b}_estimate_rotation": np.eye(3),
+                        f"{b}_estimate_velocity": np.zeros(3), f"{b}_estimate_time": np.zeros(1),
+                        f"{b}_imu_accel": np.zeros(3), f"{b}_imu_gyro": np.zeros(3)})
+        for key in ("cabin_rtk", "platform_ts"):
+            obs.update({f"{key}_points": np.zeros((3, 3)), f"{key}_time": np.zeros(1),
+                        f"{key}_count": np.zeros(1, dtype=int)})
+        obs.update(ab_angles=np.zeros(2), ab_rotation=np.eye(3), leg_positions=np.zeros(6), leg_setpoints=np.zeros(6))
+        self.observation = obs
+        self._fix_key = {"cabin": "cabin_rtk", "platform": "platform_ts"}
+        self(0, physics)
+        return obs
+
+    def __call__(self, tick: int, physics) -> None:
+        data, obs = self._data, self.observation
+        sd = data.sensordata
+        for k, b in enumerate(self.BODIES):
+            accel = obs[f"{b}_imu_accel"]
+            gyro = obs[f"{b}_imu_gyro"]
+            # The specific force of the tick from the velocity increment, IMU frame.
+            rotation = data.site_xmat[self.imu_site[b]].reshape(3, 3)
+            velocity = rotation @ sd[self._vel[b]]
+            if tick > 0:
+                np.matmul(rotation.T, (velocity - self._last_velocity[k]) / self.dt - self.gravity, out=accel)
+            else:
+                np.matmul(rotation.T, -self.gravity, out=accel)
+            self._last_velocity[k] = velocity
+            accel += self.accel_error[tick, k]
+            np.add(sd[self._gyro[b]], self.gyro_error[tick, k], out=gyro)
+            f = self.filters[b]
+            if tick > 0:
+                f.propagate(accel, gyro)
+            every = self.fix_every[b]
+            if tick % every == 0:  # a fix taken now, delivered after its latency
+                points = data.site_xpos[self.point_sites[b]] + self.fix_error[b][tick // every]
+                self.pending[b].append((tick + self.fix_lag[b], points, tick))
+            queue = self.pending[b]
+            while queue and queue[0][0] <= tick:
+                _, points, taken = queue.popleft()
+                f.correct(points, taken)
+                key = self._fix_key[b]
+                obs[f"{key}_points"][:] = points
+                obs[f"{key}_time"][0] = taken * self.dt
+                obs[f"{key}_count"][0] += 1
+            position, rotation, velocity = self.filters[b].body_pose()
+            obs[f"{b}_estimate_position"][:] = position
+            obs[f"{b}_estimate_rotation"][:] = rotation
+            obs[f"{b}_estimate_velocity"][:] = velocity
+            obs[f"{b}_estimate_time"][0] = tick * self.dt
+            self.estimate_log[tick, k, :3] = position
+            self.estimate_log[tick, k, 3:] = rotation.ravel()
+        np.take(data.qpos, self._ab_qpos, out=obs["ab_angles"])
+        np.take(data.qpos, self._leg_qpos, out=obs["leg_positions"])
+        np.take(data.act, self._leg_act, out=obs["leg_setpoints"])
+        np.matmul(data.xmat[self._cabin].reshape(3, 3).T, data.xmat[self._ab_b].reshape(3, 3), out=obs["ab_rotation"])
+
+
+def _ticks(seconds: float, dt: float, least: int) -> int:
+    return max(least, int(round(seconds / dt)))
+
+
+def make_sensors(physics, options: SensorOptions, control_dt: float = CONTROL_DT) -> Sensors:
+    """The task's sensors of ``options.system``."""
+    return (FusedSensors if options.system == "fused" else IdealSensors)(physics, options, control_dt)
+
+
+def floats_per_tick(options: SensorOptions, control_dt: float = CONTROL_DT) -> float:
+    """Doubles per control tick that the sensors of ``options`` preallocate. Ideal: the true
+    cabin pose (3 + 9) and the noise of their two measurements (2 x (3 + 9)). Fused: the IMUs'
+    errors (2 x (3 + 3)), the estimates' log (2 x 12), and the fixes' errors (9 a fix, and one
+    fix more per body: a run has n // every + 1)."""
+    if options.system == "ideal":
+        return 36.0
+    fixes = sum(1.0 / _ticks(1.0 / rate, control_dt, 1) for rate in (options.rtk_rate_hz, options.ts_rate_hz))
+    return 12.0 + 24.0 + 9.0 * fixes + 1.0
