@@ -153,3 +153,32 @@ def test_sensor_options_reach_the_run_from_the_scenario_parameters():
     assert spec["platform_ts"].latency_s == 0.15 and spec["platform_ts"].rate_hz == 8.0
     ideal = build_scenario(FastTrackingParams(duration=0.5, sensors=SensorOptions(system="ideal")))
     assert {s.name for s in ideal.sensors.specs} >= {"cabin_pose_ts", "cabin_pose"}
+
+
+def test_the_small_rotation_fit_is_scipy_s_exact_fit_to_first_order():
+    """A fix's attitude innovation: the first-order least squares (small_rotation_fit) against
+    scipy's exact fit (Rotation.align_vectors, Kabsch) of three prisms turned by 0.5 mrad and
+    noisy by 1 mm; they agree within 1 % of the angle (the filter takes a few per cent of an
+    innovation per fix)."""
+    rng = np.random.default_rng(3)
+    points = np.array([[1.2, 0.0, 0.06], [-0.6, 1.03923048, 0.06], [-0.6, -1.03923048, 0.06]])
+    q = points - points.mean(axis=0)
+    inverse_inertia = np.linalg.inv(np.einsum("ki,ki->", q, q) * np.eye(3) - q.T @ q)
+    for _ in range(20):
+        turn = Rotation.from_rotvec(rng.normal(0.0, 5e-4, 3))
+        measured = turn.apply(q) + rng.normal(0.0, 1e-3, q.shape)
+        measured -= measured.mean(axis=0)
+        exact, _ = Rotation.align_vectors(measured, q)
+        theta = measurement.small_rotation_fit(measured, q, inverse_inertia)
+        angle = np.linalg.norm(exact.as_rotvec())
+        assert np.abs(theta - exact.as_rotvec()).max() < 0.01 * angle
+
+
+def test_orthonormalizing_a_corrected_attitude():
+    """One Newton step of the polar decomposition takes (I + [theta]x) R, off by theta^2,
+    to a rotation to round-off."""
+    rotation = Rotation.from_rotvec([0.1, -0.2, 0.3]).as_matrix()
+    corrected = (np.eye(3) + measurement.skew(np.array([3e-4, -2e-4, 1e-4]))) @ rotation
+    fixed = measurement._orthonormal(corrected)
+    np.testing.assert_allclose(fixed.T @ fixed, np.eye(3), atol=1e-13)
+    assert np.abs(fixed - corrected).max() < 1e-7

@@ -40,7 +40,7 @@ import scipy.signal
 from scipy.spatial.transform import Rotation
 
 from planners.rotations import skew, vee
-from sims.fast.physics import CONTROL_DT
+from sims.fast.physics import _LEVI_CIVITA, CONTROL_DT, moment_sum
 from sims.params import Params, param
 from sims.task import Sensors, SensorSpec
 
@@ -295,106 +295,124 @@ def point_pose_noise(points: np.ndarray, sigma: float) -> float:
     return float(sigma * math.sqrt(np.linalg.eigvalsh(np.linalg.inv(inertia)).max()))
 
 
-class FusedPose:
-    """A Kalman filter of one body's pose, IMU-propagated and corrected by delayed point fixes.
+class FusedPoses:
+    """Kalman filters of several bodies' poses (one each, batched), IMU-propagated and
+    corrected by delayed point fixes.
 
     Args:
-      points: (k, 3) the fix's points in the body frame, m.
-      imu_offset: (3,) the IMU's position in the body frame (its frame is the body's), m.
-      noise: the filter's noise model: accel_white, accel_walk, gyro_white, gyro_walk (per
-        tick), every (ticks between fixes), fix_white and fix_drift (1 sigma per point and
-        coordinate, m; the drift is common to the points).
+      points: per body, (k, 3) its fix's points in its frame, m.
+      imu_offsets: per body, (3,) the IMU's position in its frame (the IMU's frame is the
+        body's), m.
+      noises: per body, its filter's noise model: accel_white, accel_walk, gyro_white,
+        gyro_walk (per tick), every (ticks between fixes), fix_white and fix_drift (1 sigma
+        per point and coordinate, m; the drift is common to the points).
       dt: the control tick, s; gravity: (3,) m/s^2; history: ticks of state kept for late fixes.
     """
 
-    def __init__(self, points, imu_offset, noise: dict, dt: float, gravity: np.ndarray, history: int):
-        self.points = np.asarray(points, float)
-        self.centroid = self.points.mean(axis=0)
-        self.imu_offset = np.asarray(imu_offset, float)
+    def __init__(self, points, imu_offsets, noises, dt: float, gravity: np.ndarray, history: int):
+        self.points = [np.asarray(p, float) for p in points]
+        self.centroids = [p.mean(axis=0) for p in self.points]
+        self.imu_offsets = np.array(imu_offsets, float)
         self.dt, self.gravity = dt, np.asarray(gravity, float)
         self.history = history
         phi, g = error_model(dt, float(np.linalg.norm(self.gravity)))
-        k = len(self.points)
-        position_var = noise["fix_white"] ** 2 / k + noise["fix_drift"] ** 2
-        attitude_var = point_pose_noise(self.points, noise["fix_white"]) ** 2
-        self.gain = steady_state_gain(
-            phi, g, np.repeat([noise["accel_white"], noise["gyro_white"]], 3),
-            np.repeat([noise["accel_walk"], noise["gyro_walk"]], 3), noise["every"],
-            np.repeat([position_var, attitude_var], 3))
+        self.gains, self._inverse_inertia = [], []
+        for pts, noise in zip(self.points, noises):
+            position_var = noise["fix_white"] ** 2 / len(pts) + noise["fix_drift"] ** 2
+            attitude_var = point_pose_noise(pts, noise["fix_white"]) ** 2
+            self.gains.append(steady_state_gain(
+                phi, g, np.repeat([noise["accel_white"], noise["gyro_white"]], 3),
+                np.repeat([noise["accel_walk"], noise["gyro_walk"]], 3), noise["every"],
+                np.repeat([position_var, attitude_var], 3)))
+            q = pts - pts.mean(axis=0)
+            self._inverse_inertia.append(np.linalg.inv(np.einsum("ki,ki->", q, q) * np.eye(3) - q.T @ q))
         # Phi^k for k = 0 .. history - 1, to carry a correction at a past tick to the present.
         powers = [np.eye(15)]
         for _ in range(history - 1):
             powers.append(phi @ powers[-1])
         self._powers = np.stack(powers)
 
-    def reset(self, position, rotation, velocity=None) -> None:
-        """Start at a known pose (the operator's survey of the parked machine), at rest."""
-        self.rotation = np.array(rotation, float)
-        self.position = np.array(position, float) + self.rotation @ self.imu_offset  # the IMU's point
-        self.velocity = np.zeros(3) if velocity is None else np.array(velocity, float)
-        self.accel_bias = np.zeros(3)  # IMU frame
-        self.gyro_bias = np.zeros(3)
-        h = self.history
-        self.past_position = np.repeat(self.position[None], h, axis=0)
-        self.past_velocity = np.repeat(self.velocity[None], h, axis=0)
-        self.past_rotation = np.repeat(self.rotation[None], h, axis=0)
+    def reset(self, positions, rotations) -> None:
+        """Start every body at a known pose (the operator's survey of the parked machine),
+        at rest: ``positions`` (B, 3), ``rotations`` (B, 3, 3) of the bodies' frames."""
+        self.rotation = np.array(rotations, float)
+        self.position = np.array(positions, float) + np.einsum("bij,bj->bi", self.rotation, self.imu_offsets)
+        self.velocity = np.zeros_like(self.position)
+        self.accel_bias = np.zeros_like(self.position)  # IMU frame
+        self.gyro_bias = np.zeros_like(self.position)
+        # Per body, the estimates at the ticks of the fixes still on their way: (tick,
+        # position, velocity, rotation), oldest first.
+        self._samples = [deque() for _ in self.points]
         self.tick = 0
 
     def propagate(self, specific_force: np.ndarray, rate: np.ndarray) -> None:
-        """One tick of strapdown navigation from the IMU's readings (its frame) of the tick
-        that ends: attitude by the rate (first order; re-orthonormalized at each fix),
-        acceleration = R (f - b_a) + g."""
+        """One tick of strapdown navigation of every body from its IMU's readings (B, 3), its
+        frame, of the tick that ends: attitude by the rate (first order; re-orthonormalized at
+        each fix), acceleration = R (f - b_a) + g."""
         dt = self.dt
         r = self.rotation
-        acceleration = r @ (specific_force - self.accel_bias) + self.gravity
-        self.position += (self.velocity + 0.5 * dt * acceleration) * dt
+        acceleration = np.einsum("bij,bj->bi", r, specific_force - self.accel_bias) + self.gravity
+        self.position += (self.velocity + (0.5 * dt) * acceleration) * dt
         self.velocity += acceleration * dt
-        self.rotation = r + r @ skew((rate - self.gyro_bias) * dt)
+        # R + R [w dt]x, with R [w]x = -R_ik eps_kjl w_l in one call.
+        self.rotation = r - np.einsum("bik,kjl,bl->bij", r, _LEVI_CIVITA, (rate - self.gyro_bias) * dt)
         self.tick += 1
-        k = self.tick % self.history
-        self.past_position[k] = self.position
-        self.past_velocity[k] = self.velocity
-        self.past_rotation[k] = self.rotation
 
-    def correct(self, measured_points: np.ndarray, at_tick: int) -> None:
-        """A fix of the points (k, 3) world, m, taken at tick ``at_tick`` (at most
-        ``history - 1`` ticks ago): the innovation against the estimate of that tick, the
-        steady-state correction, carried to every later tick kept and to the present
-        (x_k = Phi^(k - at_tick) dx; exact for the linear error model)."""
+    def sample(self, body: int) -> None:
+        """Keep ``body``'s estimate of the present tick: a fix taken now will be compared with it."""
+        self._samples[body].append((self.tick, self.position[body].copy(), self.rotation[body].copy()))
+
+    def correct(self, body: int, measured_points: np.ndarray, at_tick: int) -> None:
+        """A fix of body ``body``'s points (k, 3) world, m, taken at tick ``at_tick`` (at most
+        ``history - 1`` ticks ago, where ``sample`` kept the estimate): the innovation against
+        that estimate, the steady-state correction, carried to the estimates kept for later
+        fixes and to the present (x_k = Phi^(k - at_tick) dx; exact for the linear error model)."""
         age = self.tick - at_tick
         if not 0 <= age < self.history:
             raise ValueError(f"a fix {age} ticks old: the filter keeps {self.history}")
-        measured_rotation, _ = Rotation.align_vectors(measured_points - measured_points.mean(axis=0),
-                                                      self.points - self.centroid)
-        rot_fix = measured_rotation.as_matrix()
-        imu_fix = measured_points.mean(axis=0) + rot_fix @ (self.imu_offset - self.centroid)
-        k = at_tick % self.history
-        innovation = np.concatenate([imu_fix - self.past_position[k],
-                                     vee(rot_fix @ self.past_rotation[k].T - np.eye(3))])
-        carried = self._powers[:age + 1] @ (self.gain @ innovation)  # (age + 1, 15)
-        ticks = (at_tick + np.arange(age + 1)) % self.history
-        self.past_position[ticks] += carried[:, P]
-        self.past_velocity[ticks] += carried[:, V]
-        self.past_rotation[ticks] = (np.eye(3) + skew(carried[:, TH])) @ self.past_rotation[ticks]
-        now = carried[-1]
-        self.position += now[P]
-        self.velocity += now[V]
-        self.rotation = _orthonormal((np.eye(3) + skew(now[TH])) @ self.rotation)
-        self.past_rotation[self.tick % self.history] = self.rotation
+        samples = self._samples[body]
+        while samples[0][0] < at_tick:  # a fix that never came (none do: they arrive in order)
+            samples.popleft()
+        _, position, estimated = samples.popleft()
+        centroid = self.centroids[body]
+        centre = measured_points.mean(axis=0)
+        theta = small_rotation_fit(measured_points - centre, (self.points[body] - centroid) @ estimated.T,
+                                   estimated @ self._inverse_inertia[body] @ estimated.T)
+        imu_fix = centre + (np.eye(3) + skew(theta)) @ (estimated @ (self.imu_offsets[body] - centroid))
+        dx = self.gains[body] @ np.concatenate([imu_fix - position, theta])
+        for k, (tick, later_position, later_rotation) in enumerate(samples):
+            later = self._powers[tick - at_tick] @ dx
+            later_position += later[P]
+            samples[k] = (tick, later_position, (np.eye(3) + skew(later[TH])) @ later_rotation)
+        now = self._powers[age] @ dx
+        self.position[body] += now[P]
+        self.velocity[body] += now[V]
+        self.rotation[body] = _orthonormal((np.eye(3) + skew(now[TH])) @ self.rotation[body])
         # The biases' corrections (world frame) in the IMU's frame: the error is the true
         # bias less the estimate, so the estimate grows by it.
-        self.accel_bias += self.rotation.T @ now[BA]
-        self.gyro_bias += self.rotation.T @ now[BG]
+        self.accel_bias[body] += self.rotation[body].T @ now[BA]
+        self.gyro_bias[body] += self.rotation[body].T @ now[BG]
 
-    def body_pose(self):
-        """(origin (3,), rotation (3, 3), velocity (3,)) of the body frame, world."""
-        return self.position - self.rotation @ self.imu_offset, self.rotation, self.velocity
+    def body_poses(self):
+        """(origins (B, 3), rotations (B, 3, 3), velocities (B, 3)) of the bodies' frames, world."""
+        return (self.position - np.einsum("bij,bj->bi", self.rotation, self.imu_offsets), self.rotation,
+                self.velocity)
+
+
+def small_rotation_fit(measured: np.ndarray, predicted: np.ndarray, inverse_inertia: np.ndarray) -> np.ndarray:
+    """The small rotation theta (3,) that best turns the centred points ``predicted`` (k, 3)
+    onto the centred ``measured`` (k, 3): min sum |m - (I + [theta]x) q|^2, whose normal
+    equations give theta = (sum |q|^2 I - q q^T)^-1 sum q x (m - q) (``inverse_inertia``: that
+    inverse, in the same frame). First order in theta: a fix's innovation is a fraction of a
+    milliradian, where it equals the exact fit (Kabsch; scipy's Rotation.align_vectors,
+    tested) to its square, and costs a tenth of it."""
+    return inverse_inertia @ moment_sum(predicted, measured - predicted)
 
 
 def _orthonormal(r: np.ndarray) -> np.ndarray:
-    """The rotation nearest to ``r`` (polar decomposition by SVD)."""
-    u, _, vt = np.linalg.svd(r)
-    return u @ vt
+    """``r`` (3, 3), within 1e-6 of a rotation, made orthonormal to round-off: one Newton
+    step of the polar decomposition, R (3 I - R^T R) / 2 (its error squares)."""
+    return r @ (1.5 * np.eye(3) - 0.5 * (r.T @ r))
 
 
 class FusedSensors(Sensors):
@@ -437,15 +455,17 @@ class FusedSensors(Sensors):
         imu = dict(accel_white=o.imu_accel_noise / math.sqrt(control_dt), accel_walk=o.imu_accel_bias_walk *
                    math.sqrt(control_dt), gyro_white=o.imu_gyro_noise / math.sqrt(control_dt),
                    gyro_walk=o.imu_gyro_bias_walk * math.sqrt(control_dt))
-        self.filters = {}
+        noises = []
         for b in self.BODIES:
             white, common, point, _ = self.noise[b]
-            fix = dict(imu, every=self.fix_every[b], fix_white=math.hypot(white, point), fix_drift=common)
-            points = model.site_pos[self.point_sites[b]]
-            self.filters[b] = FusedPose(points, model.site_pos[self.imu_site[b]], fix, control_dt, self.gravity,
-                                        history)
-        self._vel = {b: physics.sensor_block(f"{b}_imu_vel") for b in self.BODIES}
-        self._gyro = {b: physics.sensor_block(f"{b}_imu_gyro") for b in self.BODIES}
+            noises.append(dict(imu, every=self.fix_every[b], fix_white=math.hypot(white, point), fix_drift=common))
+        self.filters = FusedPoses([model.site_pos[self.point_sites[b]] for b in self.BODIES],
+                                  [model.site_pos[self.imu_site[b]] for b in self.BODIES], noises, control_dt,
+                                  self.gravity, history)
+        self._imu_sites = np.array([self.imu_site[b] for b in self.BODIES])
+        columns = np.arange(model.nsensordata)  # (2, 3) sensordata columns of each body's reading
+        self._vel_columns = np.array([columns[physics.sensor_block(f"{b}_imu_vel")] for b in self.BODIES])
+        self._gyro_columns = np.array([columns[physics.sensor_block(f"{b}_imu_gyro")] for b in self.BODIES])
         rate = 1.0 / control_dt
         imu_noise = (f"white {o.imu_accel_noise:g} m/s^2/sqrt(Hz) and {o.imu_gyro_noise:g} rad/sqrt(s)")
         imu_bias = (f"turn-on {o.imu_accel_bias:g} m/s^2 and {o.imu_gyro_bias:g} rad/s 1-sigma, random walk "
@@ -501,12 +521,16 @@ class FusedSensors(Sensors):
         self._ab_qpos, self._leg_qpos, self._leg_act = physics.ab_qpos, physics.leg_qpos, physics.leg_act
         self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
         obs = {}
-        for b in self.BODIES:
-            body = self.body_ids[b]
-            self.filters[b].reset(data.xpos[body], data.xmat[body].reshape(3, 3))
-            obs.update({f"{b}_estimate_position": np.zeros(3), f"{b}_estimate_rotation": np.eye(3),
-                        f"{b}_estimate_velocity": np.zeros(3), f"{b}_estimate_time": np.zeros(1),
-                        f"{b}_imu_accel": np.zeros(3), f"{b}_imu_gyro": np.zeros(3)})
+        # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
+        self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
+        self._position, self._rotation, self._velocity = np.zeros((2, 3)), np.zeros((2, 3, 3)), np.zeros((2, 3))
+        self._time = np.zeros(1)
+        bodies = [self.body_ids[b] for b in self.BODIES]
+        self.filters.reset(data.xpos[bodies], data.xmat[bodies].reshape(-1, 3, 3))
+        for k, b in enumerate(self.BODIES):
+            obs.update({f"{b}_estimate_position": self._position[k], f"{b}_estimate_rotation": self._rotation[k],
+                        f"{b}_estimate_velocity": self._velocity[k], f"{b}_estimate_time": self._time,
+                        f"{b}_imu_accel": self._accel[k], f"{b}_imu_gyro": self._gyro[k]})
         for key in ("cabin_rtk", "platform_ts"):
             obs.update({f"{key}_points": np.zeros((3, 3)), f"{key}_time": np.zeros(1),
                         f"{key}_count": np.zeros(1, dtype=int)})
@@ -519,41 +543,38 @@ class FusedSensors(Sensors):
     def __call__(self, tick: int, physics) -> None:
         data, obs = self._data, self.observation
         sd = data.sensordata
+        # The IMUs: the tick's specific force from the velocity increment, and the rate, in
+        # their frames, with their errors.
+        rotation = data.site_xmat[self._imu_sites].reshape(2, 3, 3)
+        velocity = np.einsum("kij,kj->ki", rotation, sd[self._vel_columns])
+        if tick > 0:
+            force = (velocity - self._last_velocity) / self.dt - self.gravity
+        else:
+            force = np.broadcast_to(-self.gravity, (2, 3))
+        np.add(np.einsum("kji,kj->ki", rotation, force), self.accel_error[tick], out=self._accel)
+        np.add(sd[self._gyro_columns], self.gyro_error[tick], out=self._gyro)
+        self._last_velocity = velocity
+        f = self.filters
+        if tick > 0:
+            f.propagate(self._accel, self._gyro)
         for k, b in enumerate(self.BODIES):
-            accel = obs[f"{b}_imu_accel"]
-            gyro = obs[f"{b}_imu_gyro"]
-            # The specific force of the tick from the velocity increment, IMU frame.
-            rotation = data.site_xmat[self.imu_site[b]].reshape(3, 3)
-            velocity = rotation @ sd[self._vel[b]]
-            if tick > 0:
-                np.matmul(rotation.T, (velocity - self._last_velocity[k]) / self.dt - self.gravity, out=accel)
-            else:
-                np.matmul(rotation.T, -self.gravity, out=accel)
-            self._last_velocity[k] = velocity
-            accel += self.accel_error[tick, k]
-            np.add(sd[self._gyro[b]], self.gyro_error[tick, k], out=gyro)
-            f = self.filters[b]
-            if tick > 0:
-                f.propagate(accel, gyro)
             every = self.fix_every[b]
             if tick % every == 0:  # a fix taken now, delivered after its latency
+                f.sample(k)
                 points = data.site_xpos[self.point_sites[b]] + self.fix_error[b][tick // every]
                 self.pending[b].append((tick + self.fix_lag[b], points, tick))
             queue = self.pending[b]
             while queue and queue[0][0] <= tick:
                 _, points, taken = queue.popleft()
-                f.correct(points, taken)
+                f.correct(k, points, taken)
                 key = self._fix_key[b]
                 obs[f"{key}_points"][:] = points
                 obs[f"{key}_time"][0] = taken * self.dt
                 obs[f"{key}_count"][0] += 1
-            position, rotation, velocity = self.filters[b].body_pose()
-            obs[f"{b}_estimate_position"][:] = position
-            obs[f"{b}_estimate_rotation"][:] = rotation
-            obs[f"{b}_estimate_velocity"][:] = velocity
-            obs[f"{b}_estimate_time"][0] = tick * self.dt
-            self.estimate_log[tick, k, :3] = position
-            self.estimate_log[tick, k, 3:] = rotation.ravel()
+        self._position[:], self._rotation[:], self._velocity[:] = f.body_poses()
+        self._time[0] = tick * self.dt
+        self.estimate_log[tick, :, :3] = self._position
+        self.estimate_log[tick, :, 3:] = self._rotation.reshape(2, 9)
         np.take(data.qpos, self._ab_qpos, out=obs["ab_angles"])
         np.take(data.qpos, self._leg_qpos, out=obs["leg_positions"])
         np.take(data.act, self._leg_act, out=obs["leg_setpoints"])

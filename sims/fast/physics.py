@@ -264,7 +264,7 @@ _LEVI_CIVITA[0, 1, 2] = _LEVI_CIVITA[1, 2, 0] = _LEVI_CIVITA[2, 0, 1] = 1.0
 _LEVI_CIVITA[0, 2, 1] = _LEVI_CIVITA[2, 1, 0] = _LEVI_CIVITA[1, 0, 2] = -1.0
 
 
-def _moment(arms: np.ndarray, forces: np.ndarray) -> np.ndarray:
+def moment_sum(arms: np.ndarray, forces: np.ndarray) -> np.ndarray:
     """sum_n arms_n x forces_n, (3,), for (n, 3) arrays."""
     return np.einsum("ijk,nj,nk->i", _LEVI_CIVITA, arms, forces)
 
@@ -741,7 +741,7 @@ class CableLoads:
             self.force[tick] = cable_drag.sum(axis=0) + force
             anchor_force += cable_drag
         self._xfrc[:3] = anchor_force.sum(axis=0) + force
-        self._xfrc[3:] = _moment(arms, anchor_force) + torque
+        self._xfrc[3:] = moment_sum(arms, anchor_force) + torque
 
     def _cabin_drag(self, u: float):
         """(force (3,), torque (3,) about the cabin body's centre of mass) of the wind speed
@@ -753,7 +753,7 @@ class CableLoads:
             math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
         drag = 0.5 * AIR_DENSITY * CABIN_DRAG_COEFFICIENT * area * abs(u) * u * self.direction
         centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE - data.xipos[self._cabin]
-        return drag, _moment(centre[None], drag[None])
+        return drag, moment_sum(centre[None], drag[None])
 
     def __call__(self, tick: int, physics) -> None:
         if self._directions is not None:
@@ -777,7 +777,9 @@ class ChainCableLoads(CableLoads):
         self._n = n
         self._nodes = physics.node_bodies
         self._segments = physics.segment_tendons
-        self._node_xfrc = physics.data.ptr.xfrc_applied[self._nodes.ravel()]
+        self._node_ids = self._nodes.ravel()
+        self._first = self._segments[:, 0]
+        self._passive = self._segments[:, 1:].ravel()
         model, data = physics.model.ptr, physics.data.ptr
         rest = data.ctrl[physics.cable_ids] / n
         # A segment's axial mode, 2 sqrt(EA / mu) / l rad/s, must stay slow for the timestep
@@ -800,42 +802,65 @@ class ChainCableLoads(CableLoads):
         model.dof_damping[dofs] = (2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[..., None]
         super().reset(physics, times, rng)
 
+    #: Control ticks between refreshes of what changes slowly: the springs' stiffness EA / l
+    #: (l = L0 / n moves by under 1.3e-4 of itself in 0.1 s at the winches' 0.4 m/s), the
+    #: directions of the segments and the cabin's tilt that shape the drag (under 1.2e-4 rad
+    #: in 0.1 s), and the end weights' moment. The rest lengths (the rope paying through)
+    #: and the wind's speed act every tick. tests/test_fast_physics.py compares with 1.
+    GEOMETRY_TICKS = 10
+
     def apply(self, physics, tick: int | None = None) -> None:
         model, data = self._model, self._data
         ids = self._cables
-        self._rest = rest = data.ctrl[ids] / self._n  # (6,) every segment's unstretched length
-        k = self.ea / np.maximum(rest, 1e-3)
-        model.actuator_gainprm[ids, 0] = k / self._n
+        self._rest = rest = data.ctrl[ids] * (1.0 / self._n)  # (6,) every segment's unstretched length
+        refresh = tick is None or tick % self.GEOMETRY_TICKS == 0 or self._directions is not None
+        if refresh:
+            self._refresh(rest)
+        # The winch's segment: force = (k / n) L0 - k L1 - beta k L1' (k frozen between
+        # refreshes, so L0 itself moves its rest length); the others: springs of rest l.
+        model.tendon_lengthspring[self._passive] = np.repeat(rest, self._n - 1)[:, None]
+        self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
+        if tick is not None:
+            self.tension_log[tick] = self.tension
+        u = 0.0 if tick is None else float(self.speed[tick])
+        scale = u * abs(u)  # drag goes with u |u|
+        if u != 0.0:
+            np.multiply(self._node_drag, scale, out=self._node_force)
+            data.xfrc_applied[self._node_ids, :3] = self._node_force
+            self.force[tick] = scale * self._total_drag
+        np.add(self._static_wrench, scale * self._drag_wrench, out=self._xfrc)
+
+    def _refresh(self, rest: np.ndarray) -> None:
+        """The slowly changing parts (GEOMETRY_TICKS): the springs' stiffness and damping, the
+        end weights' force and moment on the cabin, and the drag per unit of u |u| on every
+        node, on the cabin and in all."""
+        model, data = self._model, self._data
+        ids, n = self._cables, self._n
+        self._k = k = self.ea / np.maximum(rest, 1e-3)
+        model.actuator_gainprm[ids, 0] = k / n
         model.actuator_biasprm[ids, 0] = 0.0
         model.actuator_biasprm[ids, 1] = -k
         model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
-        passive = self._segments[:, 1:]
-        model.tendon_stiffness[passive] = k[:, None]
-        model.tendon_damping[passive] = CABLE_DAMPING_S * k[:, None]
-        model.tendon_lengthspring[passive] = rest[:, None, None]
-        self.tension = np.maximum(k * (data.ten_length[self._segments[:, 0]] - rest), 0.0)
-        if tick is not None:
-            self.tension_log[tick] = self.tension
+        model.tendon_stiffness[self._passive] = np.repeat(k, n - 1)
+        model.tendon_damping[self._passive] = CABLE_DAMPING_S * np.repeat(k, n - 1)
         anchors = data.site_xpos[self._sites]
-        anchor_force = np.zeros((6, 3))
-        anchor_force[:, 2] = -end_fraction(self._n, load=True) * self.weight * self._rest * self._n
-        u = 0.0 if tick is None else float(self.speed[tick])
-        force, torque = np.zeros(3), np.zeros(3)
-        if u != 0.0:
-            wind = u * self.direction
-            nodes = data.xpos[self._nodes]  # (6, n - 1, 3)
-            points = np.concatenate([self._towers[:, None], nodes, anchors[:, None]], axis=1)
-            pieces = np.diff(points, axis=1)  # (6, n, 3) segment vectors
-            drag = cable_drag_force(wind, pieces.reshape(-1, 3), np.repeat(self._rest, self._n)).reshape(6, self._n, 3)
-            node_drag = 0.5 * (drag[:, :-1] + drag[:, 1:])  # half of each neighbouring segment
-            self._node_xfrc[:, :3] = node_drag.reshape(-1, 3)
-            data.xfrc_applied[self._nodes.ravel()] = self._node_xfrc
-            anchor_force += 0.5 * drag[:, -1]
-            force, torque = self._cabin_drag(u)
-            self.force[tick] = drag.sum(axis=(0, 1)) - 0.5 * drag[:, 0].sum(axis=0) + force
-        com = data.xipos[self._cabin]
-        self._xfrc[:3] = anchor_force.sum(axis=0) + force
-        self._xfrc[3:] = _moment(anchors - com, anchor_force) + torque
+        arms = anchors - data.xipos[self._cabin]
+        weight = np.zeros((6, 3))
+        weight[:, 2] = -end_fraction(n, load=True) * self.weight * rest * n
+        self._static_wrench = np.concatenate([weight.sum(axis=0), moment_sum(arms, weight)])
+        if self.mean_speed == 0.0 and self._directions is None:
+            self._drag_wrench = np.zeros(6)
+            return
+        nodes = data.xpos[self._nodes]  # (6, n - 1, 3)
+        points = np.concatenate([self._towers[:, None], nodes, anchors[:, None]], axis=1)
+        pieces = np.diff(points, axis=1)  # (6, n, 3) segment vectors
+        drag = cable_drag_force(self.direction, pieces.reshape(-1, 3), np.repeat(rest, n)).reshape(6, n, 3)
+        self._node_drag = (0.5 * (drag[:, :-1] + drag[:, 1:])).reshape(-1, 3)  # half of each neighbour
+        self._node_force = np.empty_like(self._node_drag)
+        anchor = 0.5 * drag[:, -1]
+        cabin_force, cabin_torque = self._cabin_drag(1.0)
+        self._drag_wrench = np.concatenate([anchor.sum(axis=0) + cabin_force, moment_sum(arms, anchor) + cabin_torque])
+        self._total_drag = drag.sum(axis=(0, 1)) - 0.5 * drag[:, 0].sum(axis=0) + cabin_force
 
 
 # ----------------------------------------------------------------------------- a perturbed start
