@@ -81,9 +81,9 @@ class SensorOptions(Params):
     ts_common_m: float = param(1.5e-3, "their slowly varying error common to the three prisms (refraction, the "
                                "stations' orientation), 1 sigma per coordinate (set so that the fused platform "
                                "error is the published 2.99 mm)", "m", low=0.0, high=0.1, reason="an assumed bound")
-    ts_point_m: float = param(1.5e-3, "their slowly varying error of each prism alone, 1 sigma per coordinate (set "
-                              "so that the fused platform attitude error is the published 0.093 deg)", "m", low=0.0,
-                              high=0.1, reason="an assumed bound")
+    ts_point_m: float = param(1.5e-3, "their slowly varying error of each prism alone, 1 sigma per coordinate "
+                              "(assumed; the fused attitude stays at 0.005 deg, not the published 0.093: "
+                              "models/fast/README.md)", "m", low=0.0, high=0.1, reason="an assumed bound")
     ts_drift_time_s: float = param(5.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
                                    "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
     rtk_rate_hz: float = param(10.0, "GPS/RTK fixes of the cabin's three roof antennas (a common RTK output rate; "
@@ -97,8 +97,8 @@ class SensorOptions(Params):
                                 "atmosphere), 1 sigma per coordinate (set so that the fused cabin error is the "
                                 "published 14.56 mm)", "m", low=0.0, high=0.5, reason="an assumed bound")
     rtk_point_m: float = param(7.7e-3, "their slowly varying error of each antenna alone (multipath), 1 sigma per "
-                               "coordinate (set so that the fused cabin attitude error is the published 0.095 deg)",
-                               "m", low=0.0, high=0.5, reason="an assumed bound")
+                               "coordinate (assumed; the fused attitude stays at 0.012 deg, not the published 0.095: "
+                               "models/fast/README.md)", "m", low=0.0, high=0.5, reason="an assumed bound")
     rtk_drift_time_s: float = param(5.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
                                     "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
 
@@ -118,6 +118,23 @@ class SensorOptions(Params):
     stewart_noise_rad: float = param(10e-6, "its white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
                                      high=0.1, reason="an assumed bound")
 
+
+
+def encoder_specs(rate_hz: float) -> list[SensorSpec]:
+    """The encoders both measurement systems read every tick, exactly."""
+    return [SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate_hz),
+            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate_hz),
+            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate_hz)]
+
+
+def read_encoders(physics, data, obs: dict) -> None:
+    """Write the encoders' readings (``encoder_specs``) into ``obs``: the A-B angles and the B
+    frame's rotation in the cabin frame that they give, the legs' lengths and set-points."""
+    np.take(data.qpos, physics.ab_qpos, out=obs["ab_angles"])
+    np.take(data.qpos, physics.leg_qpos, out=obs["leg_positions"])
+    np.take(data.act, physics.leg_act, out=obs["leg_setpoints"])
+    np.matmul(data.xmat[physics.cabin_body].reshape(3, 3).T, data.xmat[physics.ab_b_body].reshape(3, 3),
+              out=obs["ab_rotation"])
 
 
 class IdealSensors(Sensors):
@@ -155,16 +172,14 @@ class IdealSensors(Sensors):
                        f"white, {1e3 * o.pose_noise_m:g} mm and {1e6 * o.pose_noise_rad:g} urad 1-sigma per axis"),
             SensorSpec("cabin_pose", "cabin pose for the stabilizer (IMU-aided)", "m|rad", rate, o.stewart_latency_s,
                        f"white, {1e3 * o.stewart_noise_m:g} mm and {1e6 * o.stewart_noise_rad:g} urad 1-sigma per axis"),
-            SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate),
-            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate),
-            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate),
+            *encoder_specs(rate),
         ]
 
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
         o = self.options
         n = times.size
         self._data = physics.data.ptr
-        self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
+        self._cabin = physics.cabin_body
         rng = np.random.default_rng([seed, 0xFA57])
         self.true_pos = np.empty((n, 3))
         self.true_rot = np.empty((n, 3, 3))
@@ -173,7 +188,7 @@ class IdealSensors(Sensors):
                            np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
         self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
                               np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
-        self._ab_qpos, self._leg_qpos, self._leg_act = physics.ab_qpos, physics.leg_qpos, physics.leg_act
+        self._physics = physics
         self.observation = obs = {
             "cabin_pose_ts_position": np.zeros(3), "cabin_pose_ts_rotation": np.eye(3),
             "cabin_pose_ts_time": np.zeros(1), "cabin_pose_ts_count": np.zeros(1, dtype=int),
@@ -181,7 +196,6 @@ class IdealSensors(Sensors):
             "ab_angles": np.zeros(2), "ab_rotation": np.eye(3), "leg_positions": np.zeros(6),
             "leg_setpoints": np.zeros(6),
         }
-        self._views = (obs["ab_angles"], obs["leg_positions"], obs["leg_setpoints"])
         self(0, physics)
         return obs
 
@@ -204,11 +218,7 @@ class IdealSensors(Sensors):
         j = self._measured(tick, self.stewart_lag, self.stewart_noise, obs["cabin_pose_position"],
                            obs["cabin_pose_rotation"])
         obs["cabin_pose_time"][0] = j * self.dt
-        ab, legs, setpoints = self._views
-        np.take(data.qpos, self._ab_qpos, out=ab)
-        np.take(data.qpos, self._leg_qpos, out=legs)
-        np.take(data.act, self._leg_act, out=setpoints)
-        np.matmul(cabin.T, data.xmat[self._ab_b].reshape(3, 3), out=obs["ab_rotation"])
+        read_encoders(self._physics, data, obs)
 
 
 
@@ -489,9 +499,7 @@ class FusedSensors(Sensors):
                        o.rtk_latency_s, fix_noise("cabin")),
             SensorSpec("platform_ts", "total-station positions of the feed platform's three prisms", "m",
                        o.ts_rate_hz, o.ts_latency_s, fix_noise("platform")),
-            SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate),
-            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate),
-            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate),
+            *encoder_specs(rate),
         ]
 
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
@@ -518,8 +526,7 @@ class FusedSensors(Sensors):
         self._last_velocity = np.zeros((2, 3))
         self.pending = {b: deque() for b in self.BODIES}  # (arrival tick, points (3, 3), taken at tick)
         self.estimate_log = np.zeros((n, 2, 12))  # per tick: position (3) and rotation (9) of each body
-        self._ab_qpos, self._leg_qpos, self._leg_act = physics.ab_qpos, physics.leg_qpos, physics.leg_act
-        self._cabin, self._ab_b = physics.cabin_body, physics.ab_b_body
+        self._physics = physics
         obs = {}
         # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
         self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
@@ -575,10 +582,7 @@ class FusedSensors(Sensors):
         self._time[0] = tick * self.dt
         self.estimate_log[tick, :, :3] = self._position
         self.estimate_log[tick, :, 3:] = self._rotation.reshape(2, 9)
-        np.take(data.qpos, self._ab_qpos, out=obs["ab_angles"])
-        np.take(data.qpos, self._leg_qpos, out=obs["leg_positions"])
-        np.take(data.act, self._leg_act, out=obs["leg_setpoints"])
-        np.matmul(data.xmat[self._cabin].reshape(3, 3).T, data.xmat[self._ab_b].reshape(3, 3), out=obs["ab_rotation"])
+        read_encoders(self._physics, data, obs)
 
 
 def _ticks(seconds: float, dt: float, least: int) -> int:

@@ -945,7 +945,10 @@ class ControllerOptions(Params):
     with the 150 ms latency, proportional and derivative action destabilize those modes (kp
     0.2 with the stabilizer on at the zenith, kd 0.1 at zenith angle 40 deg: found in
     simulation), and the slow integral (0.02/s, 50 s) removes the drift the stabilizer would
-    otherwise carry.
+    otherwise carry. With the fused measurement system the stabilizer is an integral loop
+    on the platform's fused estimate (platform_bandwidth_hz, 2 Hz: the cabin's 0.17-0.6 Hz
+    motion is well inside it, and the 25 ms of tick and servo lag leave 70 deg of phase
+    margin); its estimate's 3 mm error passes to the feed below that bandwidth.
     """
 
     stewart: bool = param(True, "the Stewart stabilizer corrects the feed (false: its legs hold nominal)")
@@ -1088,12 +1091,17 @@ class FastController:
         command[self.multifeed_id] = state.multifeed[0]
 
     def _cable_feedback(self, obs) -> None:
-        o, s = self.options, self.state
+        s = self.state
         j = int(round(obs["cabin_pose_ts_time"][0] / self.dt))
         pos, rot = obs["cabin_pose_ts_position"], obs["cabin_pose_ts_rotation"]
         # Rotation error: the small rotation that turns the measured attitude to the planned one.
-        error = np.concatenate([s.cabin_origin[j] - pos, vee(s.cabin_rotation[j] @ rot.T)])
-        dt = self.pose_dt
+        self._pid(np.concatenate([s.cabin_origin[j] - pos, vee(s.cabin_rotation[j] @ rot.T)]), self.pose_dt)
+
+    def _pid(self, error: np.ndarray, dt: float) -> None:
+        """The cable loop's pose correction from the cabin's pose error (6,) (planned less
+        measured: m and rad) of a fix ``dt`` s after the last: kp e + kd de/dt (first-order
+        filtered) + ki int e."""
+        o = self.options
         if self.last_error is not None:
             alpha = dt / (o.derivative_filter_s + dt)
             self.derivative += alpha * ((error - self.last_error) / dt - self.derivative)
@@ -1122,16 +1130,10 @@ class FastController:
     def _fused_cable_feedback(self, obs, tick: int) -> None:
         """Integral (and optional proportional-derivative) action on the cabin's fused
         estimate, at each GPS/RTK fix's arrival: the estimate of the present tick."""
-        o, s = self.options, self.state
+        s = self.state
         pos, rot = obs["cabin_estimate_position"], obs["cabin_estimate_rotation"]
-        error = np.concatenate([s.cabin_origin[tick] - pos, vee(s.cabin_rotation[tick] @ rot.T)])
-        dt = self.cabin_fix_dt
-        if self.last_error is not None:
-            alpha = dt / (o.derivative_filter_s + dt)
-            self.derivative += alpha * ((error - self.last_error) / dt - self.derivative)
-        self.last_error = error
-        self.integral += error * dt
-        self.correction = o.kp * error + o.kd * self.derivative + o.ki * self.integral
+        self._pid(np.concatenate([s.cabin_origin[tick] - pos, vee(s.cabin_rotation[tick] @ rot.T)]),
+                  self.cabin_fix_dt)
 
     def _fused_stewart_legs(self, obs, nxt: int) -> np.ndarray:
         """Leg length changes (6,): the planned ones plus an integral of the platform's error
@@ -1145,37 +1147,28 @@ class FastController:
                                            (self.platform_jacobian @ error), -stroke, stroke)
         return self.legs_plan[nxt] + self.platform_correction
 
-    def _fused_call(self, tick: int, obs) -> None:
-        s, command = self.state, self.command
-        nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
-        count = int(obs["cabin_rtk_count"][0])
-        if count != self.seen:
-            self.seen = count
-            self._fused_cable_feedback(obs, tick)
-            a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[tick],
-                                 s.cabin_rotation[tick])
-            self.length_correction = -a.T @ self.correction
-        command[self.cable_ids] = self.l0_ff[nxt] + self.length_correction
-        self.ab_integral += self._ab_gain * (self.ab_reference[tick] - obs["ab_angles"])
-        command[self.ab_ids] = self.ab_setpoint[nxt] + self.ab_integral
-        command[self.multifeed_id] = s.multifeed[nxt]
+    def _fused_legs(self, obs, nxt: int) -> None:
+        """The legs' set-point rates with the fused measurement system: the stabilizer's
+        lengths (``_fused_stewart_legs``), or off, nominal with integral action on the
+        encoders as the idealized path's."""
         if self.options.stewart:
             setpoint = self._fused_stewart_legs(obs, nxt)
-        else:  # the legs hold nominal, with integral action on their encoders as below
+        else:
             self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (-obs["leg_positions"]),
                                         -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
             setpoint = self.leg_integral
-        command[self.leg_ids] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
+        self.command[self.leg_ids] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
 
     def __call__(self, tick: int, obs) -> None:
-        if self.fused:
-            return self._fused_call(tick, obs)
         s, command = self.state, self.command
         nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
-        count = int(obs["cabin_pose_ts_count"][0])
+        count = int(obs["cabin_rtk_count" if self.fused else "cabin_pose_ts_count"][0])
         if count != self.seen:
             self.seen = count
-            self._cable_feedback(obs)
+            if self.fused:
+                self._fused_cable_feedback(obs, tick)
+            else:
+                self._cable_feedback(obs)
             # Cable lengths for the pose correction dx: dL = -A^T dx (planners.legs), at the
             # planned pose (it moves by millimetres between two updates).
             a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[tick],
@@ -1186,6 +1179,8 @@ class FastController:
         self.ab_integral += self._ab_gain * (self.ab_reference[tick] - obs["ab_angles"])
         command[self.ab_ids] = self.ab_setpoint[nxt] + self.ab_integral
         command[self.multifeed_id] = s.multifeed[nxt]
+        if self.fused:
+            return self._fused_legs(obs, nxt)
         legs = self._stewart_legs(obs, nxt) if self.options.stewart else self._leg_target
         # Leg servos: integral action on the encoders toward the last commanded lengths,
         # bounded by 5 % of the stroke (anti-windup); off, the legs hold nominal the same way.
