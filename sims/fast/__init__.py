@@ -42,7 +42,7 @@ from sims.controllers import demanded_force
 from sims.fast.physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
                                FastController, FastPhysics, FastPlant, _compiled,
                                max_cable_segments, parked_command, perturbed_start, winch_feedforward)
-from sims.fast.measurement import FusedSensors, SensorOptions, floats_per_tick, make_sensors
+from sims.fast.measurement import FusedSensors, SensorOptions, estimate_errors, floats_per_tick, make_sensors
 from sims.runner import RunLog, Setup
 from sims.params import ParamError, ScenarioParams, param
 from sims.task import nominal_copy, plan_checked
@@ -305,8 +305,9 @@ class FastEvaluation:
     plan's unstretched lengths are computed (default the plant's: the nominal plant)."""
 
     def __init__(self, physics: FastPhysics, problem: fp.FastProblem, loads: CableLoads, description: dict,
-                 planned_tower_tops: np.ndarray | None = None):
+                 planned_tower_tops: np.ndarray | None = None, sensors=None):
         self.physics, self.problem, self.loads = physics, problem, loads
+        self.sensors = sensors  # the fused system's estimates are judged against the truth
         self.planned_tower_tops = planned_tower_tops
         self.goal = problem.goal
         self.description = description
@@ -414,6 +415,8 @@ class FastEvaluation:
             "ab_error_max_arcsec": ab_error.round(2).tolist(),
             "stewart_leg_max_mm": 1e3 * float(np.abs(s["stewart_leg"]).max()),
         })
+        if isinstance(self.sensors, FusedSensors):
+            metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, log.qpos)
         if self.loads.mean_speed > 0:
             wind = self.loads.speed[:n]
             metrics.update({"wind_speed_std_m_s": float(np.std(wind)),
@@ -531,10 +534,11 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
         loads = plant.loads(segments, **wind)  # the true cables' EA and weight
     else:
         loads = (ChainCableLoads if segments else CableLoads)(**wind)
-    evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops)
+    sensors = make_sensors(physics, params.sensors if sensor_options is None else sensor_options, CONTROL_DT)
+    evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops,
+                                sensors=sensors)
     return Setup(physics=physics, trajectory=trajectory, controller=controller,
-                 sensors=make_sensors(physics, params.sensors if sensor_options is None else sensor_options,
-                                      CONTROL_DT), problem=session, planner=planner,
+                 sensors=sensors, problem=session, planner=planner,
                  control_dt=CONTROL_DT, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
                  report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed, params=params,
                  output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1,

@@ -848,7 +848,7 @@ class ChainCableLoads(CableLoads):
         weight = np.zeros((6, 3))
         weight[:, 2] = -end_fraction(n, load=True) * self.weight * rest * n
         self._static_wrench = np.concatenate([weight.sum(axis=0), moment_sum(arms, weight)])
-        if self.mean_speed == 0.0 and self._directions is None:
+        if not np.any(self.speed):  # still air (the speeds are known for the whole run)
             self._drag_wrench = np.zeros(6)
             return
         nodes = data.xpos[self._nodes]  # (6, n - 1, 3)
