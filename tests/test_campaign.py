@@ -237,6 +237,51 @@ duration = 0.5
     assert status[0] != "error" and status[2] != "error"
 
 
+class _PoolThatBreaksOnSubmit:
+    """An in-process stand-in for ProcessPoolExecutor whose first pool refuses its third
+    submit, as a real pool does when a worker died between two submits."""
+
+    pools = 0
+
+    def __init__(self, max_workers, mp_context, initializer, initargs):
+        import concurrent.futures as cf
+        self._cf, self._submits = cf, 0
+        self._breaks = _PoolThatBreaksOnSubmit.pools == 0
+        _PoolThatBreaksOnSubmit.pools += 1
+        initializer(*initargs)
+
+    def submit(self, fn, *args):
+        self._submits += 1
+        if self._breaks and self._submits == 3:
+            raise self._cf.process.BrokenProcessPool("a child process terminated abruptly")
+        future = self._cf.Future()
+        future.set_result(fn(*args))
+        return future
+
+    def shutdown(self, wait=True, cancel_futures=False):
+        pass
+
+
+def test_a_pool_that_breaks_between_submits_loses_no_run(tmp_path, monkeypatch):
+    from sims.campaign import engines
+    monkeypatch.setattr(engines.cf, "ProcessPoolExecutor", _PoolThatBreaksOnSubmit)
+    _PoolThatBreaksOnSubmit.pools = 0
+    spec = _write(tmp_path / "spec.toml", """
+scenario = "hexapod-sync-move"
+[grid]
+"moves[0].target[0]" = [1.0, 1.1, 1.2, 1.3]
+""")
+    tables = {}
+    for name, pools_before in (("broken", 0), ("whole", 1)):  # the second never breaks
+        _PoolThatBreaksOnSubmit.pools = pools_before
+        cli.main(["sweep", str(spec), "--out", str(tmp_path / name), "--workers", "1", "--quiet"])
+        tables[name] = _comparable(pq.read_table(tmp_path / name / "results.parquet").sort_by("run"))
+        assert _PoolThatBreaksOnSubmit.pools == pools_before + (2 if name == "broken" else 1)
+    assert tables["broken"].column("run").to_pylist() == [0, 1, 2, 3]
+    assert tables["broken"].column("status").to_pylist() == ["passed"] * 4
+    assert tables["broken"].equals(tables["whole"])
+
+
 # ------------------------------------------------------------------------------ bad specs
 
 BAD_SPECS = {

@@ -71,11 +71,23 @@ class LocalEngine:
         while True:
             pool = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
                                           initializer=_init_worker, initargs=(context,))
-            broken = []
+            broken, unsent = [], []
+            futures = {}
+
+            def submit(batch):
+                # A pool can break between two submits (a worker died meanwhile); a chunk it
+                # refuses never ran, so it goes back to the queue without counting as a death.
+                for i, c in enumerate(batch):
+                    try:
+                        futures[pool.submit(_run_in_worker, c)] = c
+                    except cf.process.BrokenProcessPool:
+                        unsent.extend(batch[i:])
+                        return
+
             try:
                 # Chunks that were in flight when a pool broke run one at a time, so the one
                 # that breaks it again is known; the others go on as usual.
-                futures = {pool.submit(_run_in_worker, c): c for c in next_chunks(1 if retry else 2 * self.workers)}
+                submit(next_chunks(1 if retry else 2 * self.workers))
                 while futures:
                     done, _ = cf.wait(futures, return_when=cf.FIRST_COMPLETED)
                     for future in done:
@@ -88,15 +100,15 @@ class LocalEngine:
                         except Exception as e:  # noqa: BLE001  (pickling, a worker's import error)
                             result = _lost(context, chunk, worker._exception_text(e))
                         yield chunk, result
-                    if not broken:
-                        for c in next_chunks((1 if retry else 2 * self.workers) - len(futures)):
-                            futures[pool.submit(_run_in_worker, c)] = c
+                    if not broken and not unsent:
+                        submit(next_chunks((1 if retry else 2 * self.workers) - len(futures)))
             except BaseException:
                 _terminate(pool)
                 raise
             pool.shutdown(wait=True)
-            if not broken:
+            if not broken and not unsent:
                 return
+            retry.extendleft(reversed(unsent))
             for chunk in sorted(broken, key=lambda c: c[0].index, reverse=True):
                 if chunk[0].index in broke_once:
                     yield chunk, _lost(context, chunk, "its worker process died twice running it (out of memory, "
