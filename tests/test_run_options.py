@@ -47,11 +47,12 @@ def _no_nan(text: str):
 #: (arguments after "run", words the one line must hold: the key, the value and the limit).
 BAD_RUNS = [
     # a duration under one control tick (the scenario's own tick)
-    (("fast-tracking", "--duration", "1e-6"), ("duration = 1e-06 s", "[0.01, ...] s", "one control tick (10 ms)")),
+    (("fast-tracking", "--duration", "1e-6"), ("duration = 1e-06 s", "[0.02, ...] s", "one control tick (20 ms)")),
     (("loader-supply", "--duration", "0.0049"), ("duration = 0.0049 s", "one control tick (5 ms)")),
     (("hexapod-async-move", "--duration", "0.001"), ("duration = 0.001 s", "(5 ms)")),
     (("antenna-sea-state", "--duration", "0.004"), ("duration = 0.004 s", "[0.005, ...] s")),
-    (("fast-ra-scan", "--duration", "0.0099"), ("duration = 0.0099 s", "(10 ms)")),
+    (("fast-ra-scan", "--duration", "0.0199"), ("duration = 0.0199 s", "(20 ms)")),
+    (("fast-ra-scan", "--duration", "0.0099", "--set", "control_rate_hz=100"), ("duration = 0.0099 s", "(10 ms)")),
     # a log that would not fit in memory: the estimate and the limit
     (("fast-tracking", "--duration", "1e12"), ("duration 1e+12 s", "PiB of log", "LIMIT")),
     (("antenna-paper-motion", "--duration", "1e12"), ("duration 1e+12 s", "PiB of log", "LIMIT")),
@@ -134,7 +135,10 @@ def test_the_cable_segment_limit_is_the_models():
 
 @pytest.mark.parametrize("args", [
     ("loader-supply", "--duration", "0.005"),  # exactly one tick
-    ("fast-tracking", "--duration", "0.01"),
+    ("fast-tracking", "--duration", "0.02"),  # exactly one tick at the default 50 Hz
+    ("fast-tracking", "--duration", "0.01", "--set", "control_rate_hz=100"),
+    ("fast-tracking", "--set", "control_rate_hz=500"),
+    ("fast-tracking", "--set", "control_rate_hz=10"),
     ("antenna-sea-state", "--hs", "20", "--tp", "30"),
     ("antenna-sea-state", "--hs", "6.6", "--tp", "8"),  # just under 1/15
     ("antenna-sea-state", "--hs", "0.1", "--tp", "1"),

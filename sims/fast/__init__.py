@@ -39,7 +39,7 @@ from planners.errors import LimitError
 from sims import run_limits
 from sims.checks import Check
 from sims.controllers import demanded_force
-from sims.fast.physics import (CONTROL_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
+from sims.fast.physics import (CONTROL_DT, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, CableLoads, ChainCableLoads, ControllerOptions,
                                FastController, FastPhysics, FastPlant, _compiled,
                                max_cable_segments, parked_command, perturbed_start, winch_feedforward)
 from sims.fast.measurement import FusedSensors, SensorOptions, estimate_errors, floats_per_tick, make_sensors
@@ -273,10 +273,15 @@ FEED_MAX_LIMIT_MM = 30.0
 #: The cable robot's own accuracy: no public figure found; assumed 50 mm RMS, a fifth of the
 #: Stewart's +/-0.25 m stroke, so that the stabilizer corrects the cabin well inside its range.
 CABIN_RMS_LIMIT_MM = 50.0
-#: Runs longer than this write every OUTPUT_STRIDE-th tick to timeseries.npz (10 Hz; a 20-min
-#: run at 100 Hz would be 190 MB); the checks use every tick.
+#: Runs longer than this write timeseries.npz at OUTPUT_RATE_HZ (a 20-min run at 100 Hz would
+#: be 190 MB); the checks use every tick.
 LONG_RUN_S = 120.0
-OUTPUT_STRIDE = 10
+OUTPUT_RATE_HZ = 10.0
+
+
+def output_stride(control_dt: float) -> int:
+    """Ticks between two rows of a long run's timeseries.npz (OUTPUT_RATE_HZ)."""
+    return max(1, int(round(1.0 / (OUTPUT_RATE_HZ * control_dt))))
 #: Segments during which the feed must hold its accuracy (names of planners.fast_plan).
 OBSERVING_PREFIXES = ("observation", "leg", "transition")
 
@@ -405,7 +410,7 @@ class FastEvaluation:
             "feed_error_rms_all_mm": _rms(feed_mm),
             "feed_error_max_all_mm": float(feed_mm.max()),
             "cabin_error_max_mm": float(cabin_mm[window].max()),
-            "observing_s": float(observing.sum() * CONTROL_DT),
+            "observing_s": float(observing.sum() * (log.t[1] - log.t[0])) if log.t.size > 1 else 0.0,
             "segments": segments,
             "cable_tension_range_kN": [float(tension.min()) / 1e3, float(tension.max()) / 1e3],
             "planned_tension_range_kN": [float(s["cable_tension_planned"].min()) / 1e3,
@@ -465,12 +470,13 @@ class FastEvaluation:
 PER_TICK_FLOATS = 71 + 10
 
 
-def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: SensorOptions = SensorOptions()) -> float:
+def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: SensorOptions = SensorOptions(),
+                       control_dt: float = CONTROL_DT) -> float:
     """Bytes a FAST run preallocates per control tick: the runner's log of the compiled model
     (13 planned channels; the discretized cables add their nodes' joints), PER_TICK_FLOATS and
     the sensors' (``sims.fast.measurement.floats_per_tick``)."""
     return run_limits.floats(run_limits.runlog_floats_per_tick(_compiled(cable_segments), len(fp.PLAN_LABELS))
-                             + PER_TICK_FLOATS + floats_per_tick(sensors))
+                             + PER_TICK_FLOATS + floats_per_tick(sensors, control_dt))
 
 
 def problem(plan: fp.FastPlan) -> fp.FastProblem:
@@ -501,7 +507,8 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     perturbed = plant is not None and not plant.is_nominal
     if perturbed:
         plant.check_segments(segments)
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(segments, params.sensors))
+    control_dt = params.control_dt
+    run_limits.check_duration(duration, control_dt, log_bytes_per_tick(segments, params.sensors, control_dt))
     measured = None
     if params.wind_file is not None:
         measured = MeasuredWind(params.wind_file)
@@ -534,14 +541,14 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
         loads = plant.loads(segments, **wind)  # the true cables' EA and weight
     else:
         loads = (ChainCableLoads if segments else CableLoads)(**wind)
-    sensors = make_sensors(physics, params.sensors if sensor_options is None else sensor_options, CONTROL_DT)
+    sensors = make_sensors(physics, params.sensors if sensor_options is None else sensor_options, control_dt)
     evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops,
                                 sensors=sensors)
     return Setup(physics=physics, trajectory=trajectory, controller=controller,
                  sensors=sensors, problem=session, planner=planner,
-                 control_dt=CONTROL_DT, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
+                 control_dt=control_dt, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
                  report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed, params=params,
-                 output_stride=OUTPUT_STRIDE if duration > LONG_RUN_S else 1,
+                 output_stride=output_stride(control_dt) if duration > LONG_RUN_S else 1,
                  nominal_physics=nominal_copy(nominal) if perturbed else None,  # None: a copy of physics
                  plant=plant if plant is not None else FastPlant())
 
@@ -595,7 +602,7 @@ class FastParams(ScenarioParams):
     wind_spectrum: str = param("kaimal", "turbulence spectrum", choices=tuple(SPECTRA))
     wind_file: str | None = param(
         None, "measured wind instead of the model: CSV rows t (s), speed (m/s)[, direction (deg)], covering the "
-        "run; resampled to the 10 ms control ticks (a relative path is the scenario file's directory's)", path=True)
+        "run; resampled to the control ticks (a relative path is the scenario file's directory's)", path=True)
     stewart: bool = param(True, "the Stewart stabilizer in the cabin on (off: the feed rides the A-B rotator)")
     sensors: SensorOptions = param(SensorOptions(), "the measurement system (sims.fast.measurement.SensorOptions: "
                                    "fused, FAST's, or ideal; its rates, latencies, noises and biases)")
@@ -605,8 +612,15 @@ class FastParams(ScenarioParams):
                                 high=max_cable_segments(),
                                 reason="more segments vibrate beyond the 2 ms timestep's limit omega dt <= "
                                        f"{SEGMENT_OMEGA_DT_LIMIT:g}")
-    duration: float | None = param(None, "simulated time; none: the whole session", "s", low=CONTROL_DT,
-                                   reason="at least one control tick (10 ms)")
+    duration: float | None = param(None, "simulated time; none: the whole session", "s", low=0.0, low_open=True,
+                                   reason="at least one control tick (checked against control_rate_hz: 20 ms at "
+                                          "the default 50 Hz)")
+    control_rate_hz: float = param(1.0 / CONTROL_DT, "the control loop's rate: the sensors are read and the "
+                                   "controller called once per tick (FAST's own rates are not public: assumed, "
+                                   "sims/fast/physics.py CONTROL_DT; 100 Hz gives the earlier figures)", "Hz",
+                                   low=10.0, high=1.0 / PHYSICS_DT,
+                                   reason="the 2 ms physics step divided by a whole number (500, 250, 166.7, "
+                                          "125, 100, 83.3, 71.4, 62.5, 55.6, 50, ... 10 Hz)")
 
     def check(self) -> None:
         if self.cable_segments == 1:
@@ -617,8 +631,23 @@ class FastParams(ScenarioParams):
                 MeasuredWind(self.wind_file)
             except WindFileError as e:
                 raise ParamError(f"wind_file: {e}") from None
+        steps = 1.0 / (self.control_rate_hz * PHYSICS_DT)
+        if abs(steps - round(steps)) > 1e-6:
+            raise ParamError(f"control_rate_hz = {self.control_rate_hz:g} Hz is not the 2 ms physics step divided "
+                             f"by a whole number (it would be {steps:.3g} steps a tick): 500 / k Hz, e.g. 50 or 100")
+        self.sensors.check_rates(self.control_rate_hz)
+        if self.duration is not None and self.duration < self.control_dt * (1.0 - 1e-9):
+            raise ParamError(f"duration = {self.duration:g} s is outside [{self.control_dt:g}, ...] s: at least one "
+                             f"control tick ({self.control_dt * 1e3:g} ms) at control_rate_hz = "
+                             f"{self.control_rate_hz:g} Hz")
         if self.duration is not None:
-            run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.cable_segments, self.sensors))
+            run_limits.check_duration(self.duration, self.control_dt,
+                                      log_bytes_per_tick(self.cable_segments, self.sensors, self.control_dt))
+
+    @property
+    def control_dt(self) -> float:
+        """The control period, s: a whole number of physics steps."""
+        return round(1.0 / (self.control_rate_hz * PHYSICS_DT)) * PHYSICS_DT
         start = getattr(self, "start_utc", None)
         if start is not None:
             try:

@@ -12,7 +12,7 @@ user's controller gets the same observation as ours):
   (a strapdown unit integrates its accelerometers internally; fast.xml says why not a sampled
   ``accelerometer``) and the rate of its ``gyro`` (models/fast/fast.xml: ``cabin_imu_*``,
   ``platform_imu_*``), with white noise, a turn-on bias and a bias random walk of a
-  navigation-grade fibre-optic SINS (``SensorOptions``; the telescope's own is not public);
+  tactical-grade fibre-optic SINS (``SensorOptions``; the telescope's own is not public);
 * GPS/RTK antennas on the cabin roof (sites ``rtk1..3``) and total-station prisms on the feed
   platform (sites ``prism1..3``), each fix the three points' world positions with white noise
   and a slowly varying (first-order Gauss-Markov) error per coordinate: multipath for RTK,
@@ -24,9 +24,10 @@ user's controller gets the same observation as ours):
   correction is carried to the present through the error model's transition (exact for the
   linear filter), so a 200 ms old fix corrects without lag.
 
-The defaults are set so that the estimates' position errors against the truth match the
-published fused ones (tests/test_fast_measurement.py measures them on a 60 s run); their
-attitude errors are ten times smaller than published (models/fast/README.md), an open gap.
+The defaults are set so that the estimates' errors against the truth match the published
+fused ones, positions and attitudes (tests/test_fast_measurement.py measures them on 60 s
+runs). The attitudes need an IMU whose accelerometers wander enough that gravity does not pin
+the tilt, and fix errors that stay correlated for 15 s (models/fast/README.md).
 """
 
 from __future__ import annotations
@@ -40,8 +41,8 @@ import scipy.linalg
 import scipy.signal
 
 from planners.rotations import skew, vee
-from sims.fast.physics import _LEVI_CIVITA, CONTROL_DT, moment_sum
-from sims.params import Params, param
+from sims.fast.physics import _LEVI_CIVITA, CONTROL_DT, PHYSICS_DT, moment_sum
+from sims.params import ParamError, Params, param
 from sims.task import Sensors, SensorSpec
 
 @dataclass(frozen=True)
@@ -50,61 +51,66 @@ class SensorOptions(Params):
     the same readings). Typed and ranged as the scenarios' parameters (sims.params).
 
     ``system = "fused"`` (default): the measurement system of the module doc, whose defaults
-    give the published fused position errors (not yet the attitude ones). ``system = "ideal"``: the earlier, idealized pair of
+    give the published fused errors (positions and attitudes). ``system = "ideal"``: the earlier, idealized pair of
     cabin-pose measurements (``IdealSensors``: ``pose_*`` and ``stewart_*``), kept to compare.
     """
 
     system: str = param("fused", "the measurement system: fused (IMUs, total stations and GPS/RTK through Kalman "
                         "filters, FAST's published errors) or ideal (the idealized cabin-pose measurements pose_* "
                         "and stewart_*)", choices=("fused", "ideal"))
-    imu_gyro_noise: float = param(1.45e-6, "the SINS gyros' angle random walk, per axis (0.005 deg/sqrt(h), a "
-                                  "navigation-grade fibre-optic gyro; FAST's own is not public: assumed)",
+    imu_gyro_noise: float = param(4.4e-5, "the SINS gyros' angle random walk, per axis (0.15 deg/sqrt(h), a "
+                                  "tactical-grade fibre-optic gyro; FAST's own is not public: assumed, with the "
+                                  "fix errors below, so that the fused attitudes are the published ones)",
                                   "rad/sqrt(s)", low=0.0, high=1e-3, reason="up to a consumer MEMS gyro's")
-    imu_gyro_bias: float = param(9.7e-8, "their turn-on bias, 1 sigma per axis (0.02 deg/h; assumed as above)",
+    imu_gyro_bias: float = param(4.85e-6, "their turn-on bias, 1 sigma per axis (1 deg/h; assumed as above)",
                                  "rad/s", low=0.0, high=1e-3, reason="up to a consumer MEMS gyro's")
-    imu_gyro_bias_walk: float = param(1e-9, "their bias random walk (assumed)", "rad/s/sqrt(s)", low=0.0, high=1e-5,
+    imu_gyro_bias_walk: float = param(1e-6, "their bias random walk (assumed)", "rad/s/sqrt(s)", low=0.0, high=1e-5,
                                       reason="an assumed bound")
-    imu_accel_noise: float = param(4.9e-4, "the SINS accelerometers' white noise density, per axis (50 ug/sqrt(Hz), "
-                                   "navigation grade; assumed)", "m/s^2/sqrt(Hz)", low=0.0, high=0.1,
+    imu_accel_noise: float = param(1e-3, "the SINS accelerometers' white noise density, per axis (100 ug/sqrt(Hz), "
+                                   "tactical grade; assumed)", "m/s^2/sqrt(Hz)", low=0.0, high=0.1,
                                    reason="up to a consumer MEMS accelerometer's")
-    imu_accel_bias: float = param(9.8e-4, "their turn-on bias, 1 sigma per axis (100 ug; assumed)", "m/s^2", low=0.0,
+    imu_accel_bias: float = param(1e-2, "their turn-on bias, 1 sigma per axis (1 mg; assumed)", "m/s^2", low=0.0,
                                   high=0.5, reason="up to a consumer MEMS accelerometer's")
-    imu_accel_bias_walk: float = param(1e-5, "their bias random walk (assumed)", "m/s^2/sqrt(s)", low=0.0, high=1e-2,
+    imu_accel_bias_walk: float = param(1e-3, "their bias random walk (assumed: large enough that gravity does not pin "
+                                       "the tilt, as FAST's 'the inertial part alone diverges')", "m/s^2/sqrt(s)",
+                                       low=0.0, high=1e-2,
                                        reason="an assumed bound")
     ts_rate_hz: float = param(8.0, "the total stations' fixes of the feed platform's three prisms", "Hz", low=0.1,
-                              high=1.0 / CONTROL_DT, reason="a fix at least every 10 s, at most one per 10 ms tick "
-                              "(about 8 Hz at 500 m: REFERENCE.md)")
+                              high=1.0 / PHYSICS_DT, reason="a fix at least every 10 s, at most one per control "
+                              "tick (checked against control_rate_hz; about 8 Hz at 500 m: REFERENCE.md)")
     ts_latency_s: float = param(0.2, "their latency (150-240 ms measured: REFERENCE.md)", "s", low=0.0, high=1.0,
                                 reason="the filter keeps a second of its past for late fixes")
     ts_noise_m: float = param(1e-3, "their white noise per prism and coordinate, 1 sigma (about 2 mm uncertainty "
                               "at 150-300 m: SPIE 6280)", "m", low=0.0, high=0.1, reason="an assumed bound")
-    ts_common_m: float = param(1.5e-3, "their slowly varying error common to the three prisms (refraction, the "
+    ts_common_m: float = param(0.8e-3, "their slowly varying error common to the three prisms (refraction, the "
                                "stations' orientation), 1 sigma per coordinate (set so that the fused platform "
                                "error is the published 2.99 mm)", "m", low=0.0, high=0.1, reason="an assumed bound")
-    ts_point_m: float = param(1.5e-3, "their slowly varying error of each prism alone, 1 sigma per coordinate "
-                              "(assumed; the fused attitude stays at 0.005 deg, not the published 0.093: "
-                              "models/fast/README.md)", "m", low=0.0, high=0.1, reason="an assumed bound")
-    ts_drift_time_s: float = param(5.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
+    ts_point_m: float = param(2.2e-3, "their slowly varying error of each prism alone, 1 sigma per coordinate "
+                              "(set, with the SINS above, so that the fused platform attitude is the published "
+                              "0.093 deg)", "m", low=0.0, high=0.1, reason="an assumed bound")
+    ts_drift_time_s: float = param(15.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
                                    "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
     rtk_rate_hz: float = param(10.0, "GPS/RTK fixes of the cabin's three roof antennas (a common RTK output rate; "
-                               "assumed)", "Hz", low=0.1, high=1.0 / CONTROL_DT,
-                               reason="a fix at least every 10 s, at most one per 10 ms tick")
+                               "assumed)", "Hz", low=0.1, high=1.0 / PHYSICS_DT,
+                               reason="a fix at least every 10 s, at most one per control tick (checked against "
+                                      "control_rate_hz)")
     rtk_latency_s: float = param(0.05, "their latency (assumed)", "s", low=0.0, high=1.0,
                                  reason="the filter keeps a second of its past for late fixes")
     rtk_noise_m: float = param(5e-3, "their white noise per antenna and coordinate, 1 sigma (assumed)", "m",
                                low=0.0, high=0.5, reason="an assumed bound")
-    rtk_common_m: float = param(7e-3, "their slowly varying error common to the three antennas (base station, "
+    rtk_common_m: float = param(6.5e-3, "their slowly varying error common to the three antennas (base station, "
                                 "atmosphere), 1 sigma per coordinate (set so that the fused cabin error is the "
                                 "published 14.56 mm)", "m", low=0.0, high=0.5, reason="an assumed bound")
-    rtk_point_m: float = param(7.7e-3, "their slowly varying error of each antenna alone (multipath), 1 sigma per "
-                               "coordinate (assumed; the fused attitude stays at 0.012 deg, not the published 0.095: "
-                               "models/fast/README.md)", "m", low=0.0, high=0.5, reason="an assumed bound")
-    rtk_drift_time_s: float = param(5.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
+    rtk_point_m: float = param(8.5e-3, "their slowly varying error of each antenna alone (multipath), 1 sigma per "
+                               "coordinate (set, with the SINS above, so that the fused cabin attitude is the "
+                               "published 0.095 deg)", "m", low=0.0, high=0.5, reason="an assumed bound")
+    rtk_drift_time_s: float = param(15.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
                                     "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
 
     pose_rate_hz: float = param(10.0, "ideal system: rate of the cable loop's cabin pose fixes (total stations; the issue's "
-                                "10 Hz)", "Hz", low=0.1, high=1.0 / CONTROL_DT,
-                                reason="a fix at least every 10 s (assumed), at most one per 10 ms control tick")
+                                "10 Hz)", "Hz", low=0.1, high=1.0 / PHYSICS_DT,
+                                reason="a fix at least every 10 s (assumed), at most one per control tick (checked "
+                                       "against control_rate_hz)")
     pose_latency_s: float = param(0.15, "their latency (the issue's 150 ms)", "s", low=0.0, high=10.0,
                                   reason="total stations lag 150-240 ms (REFERENCE.md); 10 s is an assumed bound")
     pose_noise_m: float = param(1e-3, "their white position noise per axis, 1 sigma (assumed: a total station's "
@@ -118,6 +124,15 @@ class SensorOptions(Params):
     stewart_noise_rad: float = param(10e-6, "its white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
                                      high=0.1, reason="an assumed bound")
 
+
+    def check_rates(self, control_rate_hz: float) -> None:
+        """A ParamError naming the first fix rate of this system above the control rate (a
+        fix needs a tick of its own)."""
+        names = ("rtk_rate_hz", "ts_rate_hz") if self.system == "fused" else ("pose_rate_hz",)
+        for name in names:
+            if getattr(self, name) > control_rate_hz * (1.0 + 1e-9):
+                raise ParamError(f"sensors.{name} = {getattr(self, name):g} Hz is above the control rate "
+                                 f"control_rate_hz = {control_rate_hz:g} Hz: at most one fix per tick")
 
 
 def encoder_specs(rate_hz: float) -> list[SensorSpec]:
@@ -498,10 +513,11 @@ class FusedSensors(Sensors):
                        0.0, imu_noise, imu_bias),
             SensorSpec("platform_imu", "feed platform SINS: specific force and angular rate, IMU frame",
                        "m/s^2|rad/s", rate, 0.0, imu_noise, imu_bias),
-            SensorSpec("cabin_rtk", "GPS/RTK positions of the cabin's three roof antennas", "m", o.rtk_rate_hz,
-                       o.rtk_latency_s, fix_noise("cabin")),
+            # The rates and latencies as simulated: whole numbers of ticks.
+            SensorSpec("cabin_rtk", "GPS/RTK positions of the cabin's three roof antennas", "m",
+                       rate / self.fix_every["cabin"], self.fix_lag["cabin"] * control_dt, fix_noise("cabin")),
             SensorSpec("platform_ts", "total-station positions of the feed platform's three prisms", "m",
-                       o.ts_rate_hz, o.ts_latency_s, fix_noise("platform")),
+                       rate / self.fix_every["platform"], self.fix_lag["platform"] * control_dt, fix_noise("platform")),
             *encoder_specs(rate),
         ]
 

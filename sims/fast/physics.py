@@ -1,7 +1,8 @@
 """FAST in MuJoCo: physics accessors, the cables' elastic-catenary law, wind, and the controller.
 
 The model is models/fast (README.md there has every number's source). Three pieces run once
-per control tick (100 Hz), MuJoCo takes the physics steps between them:
+per control tick (50 Hz by default: the scenarios' control_rate_hz), MuJoCo takes the
+physics steps between them:
 
 * ``CableLoads`` (the runner's disturbance; it is part of the plant, so a user's controller
   gets it too): each cable's tension from the elastic catenary (parabolic sag) at the current
@@ -15,7 +16,7 @@ per control tick (100 Hz), MuJoCo takes the physics steps between them:
   default), the A-B rotator servo (gravity feed-forward and integral action), the multi-beam
   rotation, and the Stewart stabilizer. With FAST's fused measurement system
   (sims.fast.measurement, the default) the cable loop reads the cabin's fused estimate at
-  each GPS/RTK fix, and the stabilizer is an integral loop at 100 Hz on the platform's fused
+  each GPS/RTK fix, and the stabilizer is an integral loop every tick on the platform's fused
   estimate (its planned pose less the estimate, through the legs' Jacobian, added to the
   legs' planned lengths). With the idealized sensors (``system = "ideal"``) it reads the
   10 Hz total-station fix with 150 ms latency, and the stabilizer leads an alpha-beta
@@ -55,7 +56,12 @@ from sims.params import ParamError, Params, PlantParams, param
 from sims.plant import set_inertial
 from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
 
-CONTROL_DT = 0.01  # s: the runner's tick, the Stewart stabilizer's 100 Hz
+#: s: the default control period (50 Hz; FastParams.control_rate_hz). FAST's own rates are not
+#: public; 50 Hz samples the 0.17-0.6 Hz cabin modes and the stabilizer's 2 Hz loop 25-80
+#: times per period, and is six times the total stations' 8 Hz. 100 Hz (the earlier default)
+#: is an option, and reproduces the earlier figures.
+CONTROL_DT = 0.02
+PHYSICS_DT = 0.002  # s: models/fast/fast.xml's timestep (tested); a control period is a multiple
 
 #: Cables (REFERENCE.md): 46 mm steel wire rope, ~10 kg/m, E A = 1.5e8 N (E ~ 150 GPa on the
 #: rope's metallic area; generic, not a FAST figure).
@@ -644,7 +650,7 @@ class CableLoads:
     the tension T at the current chord (``catenary_tension``, from the last tick's value),
     the tangent stiffness k and the chord factor g, written into the actuator's affine law so
     that over the tick force = -(T + k (L' - L) - g k (L0' - L0)) - beta k L'_dot, i.e. the
-    catenary law linearized at the tick's start (the tension changes little in 10 ms); half
+    catenary law linearized at the tick's start (the tension changes little in 20 ms); half
     of each cable's weight at its anchor; with wind: drag on the cabin (its silhouette across
     the wind at its tilt) and on each cable (the wind's component normal to the chord; half of
     the cable's drag at its anchor). All as one force and torque on the cabin body
@@ -799,21 +805,24 @@ class ChainCableLoads(CableLoads):
             body = model.body(f"anchor_mass{i + 1}").id
             model.body_mass[body] = ends[2 * i] + ends[2 * i + 1]
         dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)
+        tick = float(times[1] - times[0]) if times.size > 1 else self.GEOMETRY_S
+        self.geometry_ticks = max(1, int(round(self.GEOMETRY_S / tick)))
         model.dof_damping[dofs] = (2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[..., None]
         super().reset(physics, times, rng)
 
-    #: Control ticks between refreshes of what changes slowly: the springs' stiffness EA / l
-    #: (l = L0 / n moves by under 1.3e-4 of itself in 0.1 s at the winches' 0.4 m/s), the
+    #: Seconds between refreshes of what changes slowly: the springs' stiffness EA / l (l =
+    #: L0 / n moves by under 1.3e-4 of itself in 0.1 s at the winches' 0.4 m/s), the
     #: directions of the segments and the cabin's tilt that shape the drag (under 1.2e-4 rad
-    #: in 0.1 s), and the end weights' moment. The rest lengths (the rope paying through)
-    #: and the wind's speed act every tick. tests/test_fast_physics.py compares with 1.
-    GEOMETRY_TICKS = 10
+    #: in 0.1 s), and the end weights' moment; a whole number of ticks, at least one. The
+    #: rest lengths (the rope paying through) and the wind's speed act every tick.
+    #: tests/test_fast_physics.py compares with refreshing every tick.
+    GEOMETRY_S = 0.1
 
     def apply(self, physics, tick: int | None = None) -> None:
         model, data = self._model, self._data
         ids = self._cables
         self._rest = rest = data.ctrl[ids] * (1.0 / self._n)  # (6,) every segment's unstretched length
-        refresh = tick is None or tick % self.GEOMETRY_TICKS == 0 or self._directions is not None
+        refresh = tick is None or tick % self.geometry_ticks == 0 or self._directions is not None
         if refresh:
             self._refresh(rest)
         # The winch's segment: force = (k / n) L0 - k L1 - beta k L1' (k frozen between
@@ -831,7 +840,7 @@ class ChainCableLoads(CableLoads):
         np.add(self._static_wrench, scale * self._drag_wrench, out=self._xfrc)
 
     def _refresh(self, rest: np.ndarray) -> None:
-        """The slowly changing parts (GEOMETRY_TICKS): the springs' stiffness and damping, the
+        """The slowly changing parts (GEOMETRY_S): the springs' stiffness and damping, the
         end weights' force and moment on the cabin, and the drag per unit of u |u| on every
         node, on the cabin and in all."""
         model, data = self._model, self._data
@@ -875,6 +884,7 @@ class ChainCableLoads(CableLoads):
 SETTLE_CABIN_HZ = 0.30
 SETTLE_SPEED = 1e-6
 SETTLE_MAX_S = 60.0
+SETTLE_DT = 0.01  # s: the loads' tick while settling
 
 
 def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: float = SETTLE_MAX_S) -> np.ndarray:
@@ -885,9 +895,9 @@ def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: fl
     its limit)."""
     scratch = nominal_copy(physics)()
     model, data = scratch.model.ptr, scratch.data.ptr
-    n = int(round(max_duration / CONTROL_DT))
-    steps = int(round(CONTROL_DT / model.opt.timestep))
-    loads.reset(scratch, np.arange(n + 1) * CONTROL_DT, np.random.default_rng(0))  # sets the nodes' masses
+    n = int(round(max_duration / SETTLE_DT))
+    steps = int(round(SETTLE_DT / model.opt.timestep))
+    loads.reset(scratch, np.arange(n + 1) * SETTLE_DT, np.random.default_rng(0))  # sets the nodes' masses
     mujoco.mj_forward(model, data)
     dense = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, dense)
@@ -953,8 +963,9 @@ class ControllerOptions(Params):
 
     stewart: bool = param(True, "the Stewart stabilizer corrects the feed (false: its legs hold nominal)")
     stewart_bandwidth_hz: float = param(3.0, "bandwidth of the stabilizer's pose estimator", "Hz", low=0.0,
-                                        low_open=True, high=0.5 / CONTROL_DT, high_open=True,
-                                        reason="below half the 100 Hz control rate")
+                                        low_open=True, high=0.5 / PHYSICS_DT, high_open=True,
+                                        reason="below half the control rate (checked against the run's at the "
+                                               "start)")
     kp: float = param(0.0, "cable-loop proportional gain on the cabin pose error", "", low=0.0,
                       reason="a gain, not a sign change")
     kd: float = param(0.0, "cable-loop derivative gain", "s", low=0.0, reason="a gain, not a sign change")
@@ -966,8 +977,9 @@ class ControllerOptions(Params):
                                  "leaves)", "s", low=0.0, low_open=True, reason="an integral time")
     platform_bandwidth_hz: float = param(2.0, "with the fused measurement system: bandwidth of the stabilizer's "
                                          "integral loop on the platform's fused pose estimate", "Hz", low=0.0,
-                                         low_open=True, high=0.5 / CONTROL_DT, high_open=True,
-                                         reason="below half the 100 Hz control rate")
+                                         low_open=True, high=0.5 / PHYSICS_DT, high_open=True,
+                                         reason="below half the control rate (checked against the run's at "
+                                                "the start)")
     leg_integral_s: float = param(0.2, "the Stewart legs' integral time on their encoder error (removes the servo "
                                   "droop under the platform's weight, 0.2-0.7 mm at kp = 2e7 N/m)", "s", low=0.0,
                                   low_open=True, reason="an integral time")
@@ -1038,6 +1050,10 @@ class FastController:
         o = self.options
         g = fast.FAST
         control_dt = context.control_dt
+        for name in ("stewart_bandwidth_hz", "platform_bandwidth_hz"):
+            if getattr(o, name) >= 0.5 / control_dt:
+                raise ParamError(f"ControllerOptions.{name} = {getattr(o, name):g} Hz is not below half the "
+                                 f"control rate, {0.5 / control_dt:g} Hz")
         nominal = context.nominal_physics()
         self.state = state = fast_plan.reference_state(context.reference)
         specs = {s.name: s for s in context.sensors}
