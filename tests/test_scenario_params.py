@@ -270,6 +270,8 @@ def test_the_readme_tables_are_the_declarations():
     for cls in _classes():
         assert params.markdown_table(cls) in readme, f"README's table of {cls.__name__} differs: regenerate it " \
                                                      "with sims.params.markdown_table"
+    # and the nested tables (a scenario's ``sensors``, list items): the whole generated section
+    assert params.readme_tables().rstrip("\n") in readme, "README's parameter tables differ: python -m sims.params"
 
 
 # ------------------------------------------------------------------ scenario files

@@ -957,8 +957,9 @@ class ControllerOptions(Params):
     simulation), and the slow integral (0.02/s, 50 s) removes the drift the stabilizer would
     otherwise carry. With the fused measurement system the stabilizer is an integral loop
     on the platform's fused estimate (platform_bandwidth_hz, 2 Hz: the cabin's 0.17-0.6 Hz
-    motion is well inside it, and the 25 ms of tick and servo lag leave 70 deg of phase
-    margin); its estimate's 3 mm error passes to the feed below that bandwidth.
+    motion is well inside it, and the 35 ms of tick and servo lag at 50 Hz, 20 ms + kv/kp =
+    15 ms, leave 65 deg of phase margin); its estimate's 3 mm error passes to the feed below
+    that bandwidth.
     """
 
     stewart: bool = param(True, "the Stewart stabilizer corrects the feed (false: its legs hold nominal)")
