@@ -406,16 +406,16 @@ class FusedPoses:
         centre = measured_points.mean(axis=0)
         theta = small_rotation_fit(measured_points - centre, (self.points[body] - centroid) @ estimated.T,
                                    estimated @ self._inverse_inertia[body] @ estimated.T)
-        imu_fix = centre + (np.eye(3) + skew(theta)) @ (estimated @ (self.imu_offsets[body] - centroid))
+        imu_fix = centre + (_EYE3 + skew(theta)) @ (estimated @ (self.imu_offsets[body] - centroid))
         dx = self.gains[body] @ np.concatenate([imu_fix - position, theta])
         for k, (tick, later_position, later_rotation) in enumerate(samples):
             later = self._powers[tick - at_tick] @ dx
             later_position += later[P]
-            samples[k] = (tick, later_position, (np.eye(3) + skew(later[TH])) @ later_rotation)
+            samples[k] = (tick, later_position, (_EYE3 + skew(later[TH])) @ later_rotation)
         now = self._powers[age] @ dx
         self.position[body] += now[P]
         self.velocity[body] += now[V]
-        self.rotation[body] = _orthonormal((np.eye(3) + skew(now[TH])) @ self.rotation[body])
+        self.rotation[body] = _orthonormal((_EYE3 + skew(now[TH])) @ self.rotation[body])
         # The biases' corrections (world frame) in the IMU's frame: the error is the true
         # bias less the estimate, so the estimate grows by it.
         self.accel_bias[body] += self.rotation[body].T @ now[BA]
@@ -425,6 +425,11 @@ class FusedPoses:
         """(origins (B, 3), rotations (B, 3, 3), velocities (B, 3)) of the bodies' frames, world."""
         return (self.position - np.einsum("bij,bj->bi", self.rotation, self.imu_offsets), self.rotation,
                 self.velocity)
+
+
+#: Constants of the per-fix arithmetic (an allocation each, otherwise).
+_EYE3 = np.eye(3)
+_EYE3_15 = 1.5 * np.eye(3)
 
 
 def small_rotation_fit(measured: np.ndarray, predicted: np.ndarray, inverse_inertia: np.ndarray) -> np.ndarray:
@@ -440,7 +445,7 @@ def small_rotation_fit(measured: np.ndarray, predicted: np.ndarray, inverse_iner
 def _orthonormal(r: np.ndarray) -> np.ndarray:
     """``r`` (3, 3), within 1e-6 of a rotation, made orthonormal to round-off: one Newton
     step of the polar decomposition, R (3 I - R^T R) / 2 (its error squares)."""
-    return r @ (1.5 * np.eye(3) - 0.5 * (r.T @ r))
+    return r @ (_EYE3_15 - 0.5 * (r.T @ r))
 
 
 class FusedSensors(Sensors):

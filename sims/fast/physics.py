@@ -1160,8 +1160,9 @@ class FastController:
         r_base = obs["cabin_estimate_rotation"] @ obs["ab_rotation"]
         error = np.concatenate([r_base.T @ (self.p_platform[nxt] - pos), r_base.T @ vee(self.r_platform[nxt] @ rot.T)])
         stroke = fast.STEWART.stroke
-        self.platform_correction = np.clip(self.platform_correction + self._platform_gain *
-                                           (self.platform_jacobian @ error), -stroke, stroke)
+        # np.minimum / np.maximum: np.clip's values at a fifth of its call cost
+        self.platform_correction = np.minimum(np.maximum(self.platform_correction + self._platform_gain *
+                                                         (self.platform_jacobian @ error), -stroke), stroke)
         return self.legs_plan[nxt] + self.platform_correction
 
     def _fused_legs(self, obs, nxt: int) -> None:
