@@ -243,6 +243,13 @@ def test_bad_controller_and_sensor_options_are_named(options, option, value, wor
         CableLoads(-2.0)
 
 
+def test_the_physics_step_constant_is_the_model_s():
+    """FastParams checks control rates against PHYSICS_DT before any model loads: it must be
+    models/fast/fast.xml's timestep, for the chains as for the lumped cables."""
+    for segments in (0, 2):
+        assert FastPhysics.load(segments).model.opt.timestep == fast_physics.PHYSICS_DT
+
+
 @pytest.mark.parametrize("overrides, words", [
     ({"control_rate_hz": 60.0}, r"control_rate_hz = 60 Hz is not the 2 ms physics step divided by a whole number"),
     ({"control_rate_hz": 5.0}, r"control_rate_hz = 5 Hz is outside \[10, 500\] Hz"),

@@ -164,8 +164,8 @@ class IdealSensors(Sensors):
       cabin_pose_ts_position (3,) m, cabin_pose_ts_rotation (3, 3), cabin_pose_ts_time (1,) s,
         cabin_pose_ts_count (1,): the total stations' fix (every 1 / pose_rate_hz, a new one
         when the count changes), for the cable loop.
-      cabin_pose_position (3,), cabin_pose_rotation (3, 3), cabin_pose_time (1,): the 100 Hz
-        measurement (IMU-aided), for the stabilizer.
+      cabin_pose_position (3,), cabin_pose_rotation (3, 3), cabin_pose_time (1,): the
+        every-tick measurement (IMU-aided), for the stabilizer.
       ab_angles (2,) rad and ab_rotation (3, 3): the A-B rotator's encoders and the B frame's
         orientation in the cabin frame that they give (exact).
       leg_positions (6,) m and leg_setpoints (6,) m: the Stewart legs' encoders (exact) and
@@ -177,15 +177,17 @@ class IdealSensors(Sensors):
         super().__init__()
         o = self.options = options
         self.dt = control_dt
-        self.every = max(1, int(round(1.0 / (o.pose_rate_hz * control_dt))))
-        self.pose_lag = int(round(o.pose_latency_s / control_dt))
-        self.stewart_lag = int(round(o.stewart_latency_s / control_dt))
+        self.every = _ticks(1.0 / o.pose_rate_hz, control_dt, 1)
+        self.pose_lag = _ticks(o.pose_latency_s, control_dt, 0)
+        self.stewart_lag = _ticks(o.stewart_latency_s, control_dt, 0)
         rate = 1.0 / control_dt
+        # The rates and latencies as simulated: whole numbers of ticks (as FusedSensors').
         self.specs = [
             SensorSpec("cabin_pose_ts", "cabin pose by the total stations (position and attitude)", "m|rad",
-                       o.pose_rate_hz, o.pose_latency_s,
+                       rate / self.every, self.pose_lag * control_dt,
                        f"white, {1e3 * o.pose_noise_m:g} mm and {1e6 * o.pose_noise_rad:g} urad 1-sigma per axis"),
-            SensorSpec("cabin_pose", "cabin pose for the stabilizer (IMU-aided)", "m|rad", rate, o.stewart_latency_s,
+            SensorSpec("cabin_pose", "cabin pose for the stabilizer (IMU-aided)", "m|rad", rate,
+                       self.stewart_lag * control_dt,
                        f"white, {1e3 * o.stewart_noise_m:g} mm and {1e6 * o.stewart_noise_rad:g} urad 1-sigma per axis"),
             *encoder_specs(rate),
         ]
