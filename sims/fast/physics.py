@@ -884,7 +884,7 @@ class ChainCableLoads(CableLoads):
 SETTLE_CABIN_HZ = 0.30
 SETTLE_SPEED = 1e-6
 SETTLE_MAX_S = 60.0
-SETTLE_DT = 0.01  # s: the loads' tick while settling
+SETTLE_DT = 0.01  # s: the loads' tick while settling (the earlier control tick; the settled state does not depend on it)
 
 
 def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: float = SETTLE_MAX_S) -> np.ndarray:
