@@ -210,7 +210,7 @@ def _divergence(data, qpos, qvel, times, i: int, window: int):
     if not finite.all():
         first = lo + int(np.argmin(finite))
         return float(times[first]), f"non-finite state at t = {times[first]:.4f} s"
-    warnings = warning_counts(data)
+    warnings = warning_counts(data) if data.warning.number.any() else None  # (one call, not one per warning)
     if warnings:
         detail = ", ".join(f"{name} x{count}" for name, count in warnings.items())
         return float(times[i]), f"MuJoCo warning {detail} by t = {times[i]:.4f} s"

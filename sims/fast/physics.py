@@ -693,6 +693,7 @@ class CableLoads:
             self.speed, self._directions = self.measured.resample(times)
             if self._directions is not None:
                 self.direction = self._directions[0]
+        self.still_air = not np.any(self.speed)  # the speeds are known for the whole run
         self.force = np.zeros((times.size, 3))
         self.tension_log = np.zeros((times.size, 6))
         model, data = physics.model.ptr, physics.data.ptr
@@ -786,6 +787,7 @@ class ChainCableLoads(CableLoads):
         self._node_ids = self._nodes.ravel()
         self._first = self._segments[:, 0]
         self._passive = self._segments[:, 1:].ravel()
+        self._passive_cable = np.repeat(np.arange(self._segments.shape[0]), n - 1)  # each passive segment's cable
         model, data = physics.model.ptr, physics.data.ptr
         rest = data.ctrl[physics.cable_ids] / n
         # A segment's axial mode, 2 sqrt(EA / mu) / l rad/s, must stay slow for the timestep
@@ -827,7 +829,7 @@ class ChainCableLoads(CableLoads):
             self._refresh(rest)
         # The winch's segment: force = (k / n) L0 - k L1 - beta k L1' (k frozen between
         # refreshes, so L0 itself moves its rest length); the others: springs of rest l.
-        model.tendon_lengthspring[self._passive] = np.repeat(rest, self._n - 1)[:, None]
+        model.tendon_lengthspring[self._passive] = rest[self._passive_cable, None]
         self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
         if tick is not None:
             self.tension_log[tick] = self.tension
@@ -850,14 +852,14 @@ class ChainCableLoads(CableLoads):
         model.actuator_biasprm[ids, 0] = 0.0
         model.actuator_biasprm[ids, 1] = -k
         model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
-        model.tendon_stiffness[self._passive] = np.repeat(k, n - 1)
-        model.tendon_damping[self._passive] = CABLE_DAMPING_S * np.repeat(k, n - 1)
+        model.tendon_stiffness[self._passive] = k[self._passive_cable]
+        model.tendon_damping[self._passive] = CABLE_DAMPING_S * k[self._passive_cable]
         anchors = data.site_xpos[self._sites]
         arms = anchors - data.xipos[self._cabin]
         weight = np.zeros((6, 3))
         weight[:, 2] = -end_fraction(n, load=True) * self.weight * rest * n
         self._static_wrench = np.concatenate([weight.sum(axis=0), moment_sum(arms, weight)])
-        if not np.any(self.speed):  # still air (the speeds are known for the whole run)
+        if self.still_air:
             self._drag_wrench = np.zeros(6)
             return
         nodes = data.xpos[self._nodes]  # (6, n - 1, 3)
