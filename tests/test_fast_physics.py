@@ -250,6 +250,20 @@ def test_the_physics_step_constant_is_the_model_s():
         assert FastPhysics.load(segments).model.opt.timestep == fast_physics.PHYSICS_DT
 
 
+def test_collision_detection_is_off_only_because_no_geom_collides():
+    """fast.xml disables collision detection for speed; that is sound only while none of its
+    geoms (the chains' nodes included) can collide. With the flag cleared, MuJoCo finds no
+    contact either at the start of a run."""
+    for segments in (0, 2):
+        physics = FastPhysics.load(segments)
+        model = physics.model.ptr
+        assert model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONTACT
+        assert not np.any(model.geom_contype) and not np.any(model.geom_conaffinity)
+        model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        mujoco.mj_forward(model, physics.data.ptr)
+        assert physics.data.ptr.ncon == 0
+
+
 @pytest.mark.parametrize("overrides, words", [
     ({"control_rate_hz": 60.0}, r"control_rate_hz = 60 Hz is not the 2 ms physics step divided by a whole number"),
     ({"control_rate_hz": 5.0}, r"control_rate_hz = 5 Hz is outside \[10, 500\] Hz"),
