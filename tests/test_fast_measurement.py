@@ -137,10 +137,11 @@ BEFORE = {"feed_error_rms": 0.5704301260969762, "feed_error_max": 1.591034054028
 
 def test_the_ideal_option_gives_the_figures_of_before():
     """system = "ideal" on the lumped cables at the earlier 100 Hz control rate reproduces the
-    earlier run: bit for bit on the CPU that recorded BEFORE, and to round-off on another.
-    numpy picks its SIMD kernels by CPU (an AVX-512 EPYC on 2026-12-02 against the recording
-    machine), and their last bits, carried through 30 s of simulation, moved these values by
-    at most 4e-11 of themselves; a change of behaviour moves them by 1e-3 or more."""
+    earlier run: bit for bit on the machine that recorded BEFORE, to round-off on another.
+    On 2026-12-02's machine (an AVX-512 AMD EPYC) the recording commit's code itself gives
+    values within 4e-11 of them: the libraries' last bits differ by CPU (not numpy's SIMD
+    kernels alone: they were switched off, tried), and 30 s of simulation carry them that far.
+    A change of behaviour moves these values by 1e-3 or more."""
     result, _ = tracking(30.0, sensors=SensorOptions(system="ideal"), cable_segments=0, control_rate_hz=100.0)
     values = {c.name: c.value for c in result.checks if c.name in BEFORE}
     assert values.keys() == BEFORE.keys()
