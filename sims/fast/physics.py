@@ -799,18 +799,28 @@ class ChainCableLoads(CableLoads):
                              f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
                              f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most "
                              f"{most} segments")
-        mass = np.broadcast_to((node_mass_factor(n) * self.mass_per_length * rest)[:, None], self._nodes.shape)
-        model.body_mass[self._nodes] = mass
-        # The ends' share of the mass at the anchors (two cables each), gravity-compensated.
-        ends = end_fraction(n, load=False) * self.mass_per_length * rest * n
-        for i in range(3):
-            body = model.body(f"anchor_mass{i + 1}").id
-            model.body_mass[body] = ends[2 * i] + ends[2 * i + 1]
-        dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)
+        self._anchor_masses = np.array([model.body(f"anchor_mass{i + 1}").id for i in range(3)])
+        self._node_dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)  # (6, n - 1, 3)
+        self.settling_damping = np.zeros(self._node_dofs.shape)  # N s/m on the nodes (static_equilibrium's)
         tick = float(times[1] - times[0]) if times.size > 1 else self.GEOMETRY_S
         self.geometry_ticks = max(1, int(round(self.GEOMETRY_S / tick)))
-        model.dof_damping[dofs] = (2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[..., None]
         super().reset(physics, times, rng)
+
+    def _set_masses(self, rest: np.ndarray) -> None:
+        """The rope between tower and cabin is the winch's unstretched length L0 = n l (rest:
+        (6,) l): the nodes' masses (and so their weights, through their fixed gravcomp) and
+        their damping, and the ends' share at the anchors (two cables each, gravity-compensated),
+        follow it as the winches pay out (a few per cent of L0 over a switch; held at the
+        start's, the sag they carry was 40 mm of cabin offset off, tried). MuJoCo's dynamics
+        read body_mass every step (body_subtreemass stays the compiled one: it only moves the
+        reference point of the trees' spatial quantities, which the dynamics do not depend on)."""
+        model, n = self._model, self._n
+        mass = node_mass_factor(n) * self.mass_per_length * rest  # (6,)
+        model.body_mass[self._nodes] = mass[:, None]
+        model.dof_damping[self._node_dofs] = ((2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[:, None, None]
+                                              + self.settling_damping)
+        ends = end_fraction(n, load=False) * self.mass_per_length * rest * n
+        model.body_mass[self._anchor_masses] = ends[0::2] + ends[1::2]
 
     #: Seconds between refreshes of what changes slowly: the springs' stiffness EA / l (l =
     #: L0 / n moves by under 1.3e-4 of itself in 0.1 s at the winches' 0.4 m/s), the
@@ -848,6 +858,7 @@ class ChainCableLoads(CableLoads):
         model, data = self._model, self._data
         ids, n = self._cables, self._n
         self._k = k = self.ea / np.maximum(rest, 1e-3)
+        self._set_masses(rest)
         model.actuator_gainprm[ids, 0] = k / n
         model.actuator_biasprm[ids, 0] = 0.0
         model.actuator_biasprm[ids, 1] = -k
@@ -906,9 +917,10 @@ def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: fl
     diagonal = np.diag(dense).copy()
     cabin = model.jnt_dofadr[model.joint("cabin").id] + np.arange(6)
     model.dof_damping[cabin] += 2 * (2 * math.pi * SETTLE_CABIN_HZ) * diagonal[cabin]
-    if physics.cable_segments:
-        nodes = (model.body_dofadr[scratch.node_bodies][..., None] + np.arange(3)).ravel()
-        model.dof_damping[nodes] += 2 * (2 * math.pi * STRING_MODE_HZ) * diagonal[nodes]
+    if physics.cable_segments:  # through the loads, which rewrite the nodes' damping with their masses
+        nodes = model.body_dofadr[scratch.node_bodies][..., None] + np.arange(3)
+        loads.settling_damping = 2 * (2 * math.pi * STRING_MODE_HZ) * diagonal[nodes]
+        model.dof_damping[nodes] += loads.settling_damping
     for tick in range(n):
         loads(tick, scratch)
         mujoco.mj_step(model, data, nstep=steps)
