@@ -77,7 +77,9 @@ def test_antenna_sample_and_hold_lags_the_paper_motion_and_holds_the_sea(tmp_pat
 def test_fast_feedforward_alone_is_worse_than_the_stabilized_feed(tmp_path):
     summary, checks = run(tmp_path, "fast-tracking", "controller", "fast/feedforward_controller.py:FeedforwardOnly",
                           "--duration", "200")
-    assert checks["feed_error_rms"]["value"] > 2.0  # mm: 5.08 measured
+    # With the measured cable dynamics the cable robot alone misses FAST's 10 mm (11.4 mm
+    # measured; the stabilized feed 3.67 mm), as examples/fast/README.md states.
+    assert failed(checks) == {"feed_error_rms"}
     assert checks["stewart_stroke"]["value"] < 1.0  # mm: the legs hold nominal
 
 
