@@ -811,7 +811,7 @@ class ChainCableLoads(CableLoads):
         (6,) l): the nodes' masses (and so their weights, through their fixed gravcomp) and
         their damping, and the ends' share at the anchors (two cables each, gravity-compensated),
         follow it as the winches pay out (a few per cent of L0 over a switch; held at the
-        start's, the sag they carry was 40 mm of cabin offset off, tried). MuJoCo's dynamics
+        start's, they left the cabin 40 mm from where the catenary law puts it, tested). MuJoCo's dynamics
         read body_mass every step (body_subtreemass stays the compiled one: it only moves the
         reference point of the trees' spatial quantities, which the dynamics do not depend on)."""
         model, n = self._model, self._n
