@@ -22,8 +22,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.rotations import cross
-
 
 def leg_vectors(anchors: np.ndarray, points: np.ndarray, position: np.ndarray,
                 rotation: np.ndarray) -> np.ndarray:
@@ -65,7 +63,7 @@ def structure_matrix(anchors, points, position, rotation) -> np.ndarray:
     arms = np.einsum("...jk,nk->...nj", np.asarray(rotation, dtype=float),
                      np.asarray(points, dtype=float))
     force = -units
-    moment = -cross(arms, units)
+    moment = -np.cross(arms, units)
     return np.swapaxes(np.concatenate([force, moment], axis=-1), -1, -2)
 
 

@@ -774,7 +774,8 @@ class ChainCableLoads(CableLoads):
     The chain carries sag, cable weight and cable inertia itself; per tick this shares the
     winch command L0 (``ctrl``) among the segments: rest length l = L0 / n, stiffness EA / l
     and damping beta EA / l for the springs, and the winch segment's law force =
-    (EA / l) (L0 / n - L1) - beta (EA / l) L1'; puts the half segment that ends at the cabin
+    (EA / l) (L0 / n - L1) - beta (EA / l) L1'; gives the nodes and ends the mass of the rope
+    paid out (``_set_masses``); puts the half segment that ends at the cabin
     anchor (its weight) on the cabin; and applies the wind: on the cabin, and on every node half
     of each neighbouring segment's normal drag (half the last segment on the cabin).
     """
@@ -825,7 +826,8 @@ class ChainCableLoads(CableLoads):
     #: Seconds between refreshes of what changes slowly: the springs' stiffness EA / l (l =
     #: L0 / n moves by under 1.3e-4 of itself in 0.1 s at the winches' 0.4 m/s), the
     #: directions of the segments and the cabin's tilt that shape the drag (under 1.2e-4 rad
-    #: in 0.1 s), and the end weights' moment; a whole number of ticks, at least one. The
+    #: in 0.1 s), the end weights' moment, and the rope's mass and weight on the nodes and
+    #: ends (``_set_masses``); a whole number of ticks, at least one. The
     #: rest lengths (the rope paying through) and the wind's speed act every tick.
     #: tests/test_fast_physics.py compares with refreshing every tick.
     GEOMETRY_S = 0.1
@@ -917,10 +919,9 @@ def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: fl
     diagonal = np.diag(dense).copy()
     cabin = model.jnt_dofadr[model.joint("cabin").id] + np.arange(6)
     model.dof_damping[cabin] += 2 * (2 * math.pi * SETTLE_CABIN_HZ) * diagonal[cabin]
-    if physics.cable_segments:  # through the loads, which rewrite the nodes' damping with their masses
+    if physics.cable_segments:  # the loads write the nodes' damping with their masses, from the first tick on
         nodes = model.body_dofadr[scratch.node_bodies][..., None] + np.arange(3)
         loads.settling_damping = 2 * (2 * math.pi * STRING_MODE_HZ) * diagonal[nodes]
-        model.dof_damping[nodes] += loads.settling_damping
     for tick in range(n):
         loads(tick, scratch)
         mujoco.mj_step(model, data, nstep=steps)
