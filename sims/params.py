@@ -380,18 +380,44 @@ def field_types(cls) -> dict:
 # ---------------------------------------------------------------------- text forms
 
 
-def parse_value(kind: _Type, text: str):
+def _one_toml_value(text: str, shown: str):
+    """``text`` as one TOML value; a TOMLDecodeError if it is none. A value that ends its line
+    and goes on with more ("5", a line break, "seed = 3": TOML reads a second key) is refused,
+    naming it, and so is one nested deeper than the parser's recursion allows."""
+    try:
+        document = tomllib.loads(f"v = {text}")
+    except RecursionError:
+        raise ParamError(f"{shown}: a value nested too deep to read (lists or tables within "
+                         "one another, thousands of levels)") from None
+    if len(document) > 1:
+        extra = next(k for k in document if k != "v")
+        raise ParamError(f"{shown} = {text!r} holds a line break and then {extra!r}: give one value per "
+                         "option (a second key needs its own --set)")
+    return document["v"]
+
+
+def parse_value(kind: _Type, text: str, shown: str = "value"):
     """A command-line value: TOML's syntax for numbers, booleans, lists and tables
     (``--set moves=[{target=[1,0,0,0,0,0]}]``); on/off, yes/no for switches; "none" for an
-    optional value; anything else as a name."""
+    optional value; anything else as a name. ``shown``: how the option was written, for the
+    errors ("--duration", "--set duration"). An empty value is refused (write "none" to unset
+    an optional one), and so is a line break that is not inside one TOML value."""
     stripped = text.strip()
-    if kind.optional and stripped.lower() in ("none", "null", ""):
+    if stripped == "":
+        unset = " (none unsets it)" if kind.optional else ""
+        raise ParamError(f"{shown} is empty: give a {kind.name()}{unset}")
+    if "\n" in stripped or "\r" in stripped:
+        try:
+            _one_toml_value(stripped, shown)
+        except tomllib.TOMLDecodeError:
+            raise ParamError(f"{shown} = {text!r} holds a line break: give one value per option") from None
+    if kind.optional and stripped.lower() in ("none", "null"):
         return None
     if kind.kind == "bool" and stripped.lower() in ("on", "off", "yes", "no", "true", "false", "1", "0"):
         return stripped.lower() in ("on", "yes", "true", "1")
     if kind.kind == "str":
         try:
-            value = tomllib.loads(f"v = {stripped}")["v"]
+            value = _one_toml_value(stripped, shown)
             return value if isinstance(value, str) else stripped
         except tomllib.TOMLDecodeError:
             return stripped
@@ -401,7 +427,7 @@ def parse_value(kind: _Type, text: str):
         except ValueError:
             pass
     try:
-        return tomllib.loads(f"v = {stripped}")["v"]
+        return _one_toml_value(stripped, shown)
     except tomllib.TOMLDecodeError:
         # Python's spellings of numbers TOML lacks (1e3 is TOML; .5, 5., inf are not).
         try:
@@ -428,7 +454,7 @@ def set_overrides(cls: type[Params], assignments: list[str], prefix: str = "") -
             continue
         if key not in hints:
             raise ParamError(f"--set: unknown parameter {prefix + key!r}; {cls.__name__} has: {', '.join(cls.names())}")
-        out[key] = parse_value(hints[key], value)
+        out[key] = parse_value(hints[key], value, f"--set {prefix}{key}")
     return out
 
 

@@ -56,7 +56,16 @@ def resolve(argument: str, get_scenario, known_names) -> Source:
             raise ParamError(f"{path}: not a planbench summary.json with resolved \"parameters\" (written by "
                              "planbench run since scenario files exist)")
         # Every value as it ran (null: an optional value unset); plug-ins as they were given.
-        run = {"scenario": data.get("scenario"), "parameters": data["parameters"], **(data.get("plugins") or {})}
+        plugins = data.get("plugins") or {}
+        if not isinstance(plugins, dict) or any(role not in ("planner", "controller") or not isinstance(spec, str)
+                                                for role, spec in plugins.items()):
+            raise ParamError(f"{path}: \"plugins\" must be a table of planner and controller, each "
+                             f"\"MODULE:FACTORY\", got {_shown(plugins)}")
+        seed = data["parameters"].get("seed")
+        if "seed" in data and (data["seed"] != seed or type(data["seed"]) is not type(seed)):
+            raise ParamError(f"{path}: \"seed\" = {_shown(data['seed'])} disagrees with the run's "
+                             f"parameters.seed = {_shown(seed)}; the file was changed after the run")
+        run = {"scenario": data.get("scenario"), "parameters": data["parameters"], **plugins}
         if data.get("plant") is not None:
             run["plant"] = data["plant"]
         return _from_data(path, run, get_scenario, data.get("versions"))
@@ -70,6 +79,15 @@ def _read(path: Path, parse, parse_error, kind: str):
         raise ParamError(f"{path}: cannot be read ({e})") from None
     except parse_error as e:
         raise ParamError(f"{path}: not {kind}: {e}") from None
+    except RecursionError:
+        raise ParamError(f"{path}: {kind} nested too deep to read (arrays or tables within one "
+                         "another, thousands of levels)") from None
+
+
+def _shown(value) -> str:
+    """A value of a file in an error: its repr, cut to 60 characters."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _from_data(path: Path, data: dict, get_scenario, versions) -> Source:
@@ -117,6 +135,6 @@ def overrides_from_flags(cls, flags: dict, assignments: list[str]) -> dict:
     """The command line's values: ``--KEY VALUE`` flags (text) and ``--set KEY=VALUE``,
     parsed by each field's type (sims.params.parse_value)."""
     types = field_types(cls)
-    out = {key: parse_value(types[key], text) for key, text in flags.items()}
+    out = {key: parse_value(types[key], text, "--" + key.replace("_", "-")) for key, text in flags.items()}
     out.update(set_overrides(cls, assignments))
     return out

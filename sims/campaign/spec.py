@@ -394,6 +394,9 @@ def load(path, get_scenario=None, known_names=None) -> CampaignSpec:
         raise ParamError(f"{path}: cannot be read ({e})") from None
     except tomllib.TOMLDecodeError as e:
         raise ParamError(f"{path}: not TOML: {e}") from None
+    except RecursionError:
+        raise ParamError(f"{path}: TOML nested too deep to read (arrays or tables within one another, "
+                         "thousands of levels)") from None
     try:
         return _parse(path, data, get_scenario, known_names, scenario_files)
     except ParamError as e:
@@ -467,6 +470,7 @@ def _parse(path: Path, data: dict, get_scenario, known_names, scenario_files) ->
         raise
     grid = _axes(data.get("grid", {}), "grid", scenario, base_params, base_plant)
     random = _axes(data.get("random", {}), "random", scenario, base_params, base_plant)
+    _check_overlap(grid, random)
     if random and samples < 2 and "samples" not in data:
         raise ParamError("[random] axes need samples = N draws (N >= 1, given explicitly)")
     if not random and samples > 1:
@@ -503,6 +507,23 @@ def _axes(table, section: str, scenario, base_params, base_plant) -> list[Axis]:
         if columns.count(c) > 1:
             raise ParamError(f"axis {c!r} is given twice")
     return out
+
+
+def _check_overlap(grid: list[Axis], random: list[Axis]) -> None:
+    """No value set by two axes: the same key in [grid] and [random], or one axis inside
+    another's (``key_points`` and ``key_points[1][0]``), would let one silently override the
+    other."""
+    axes = [("grid", a) for a in grid] + [("random", a) for a in random]
+    for i, (section_a, a) in enumerate(axes):
+        for section_b, b in axes[i + 1:]:
+            if a.plant != b.plant:
+                continue
+            short, long = (a, b) if len(a.path) <= len(b.path) else (b, a)
+            if long.path[:len(short.path)] == short.path:
+                where = "[grid] and [random]" if section_a != section_b else f"[{section_a}]"
+                what = (f"axis {a.column!r} is in both {where}" if section_a != section_b and a.path == b.path
+                        else f"axes {a.column!r} and {b.column!r} of {where} set the same value")
+                raise ParamError(f"{what}; a value may have one axis only")
 
 
 def _axis(section: str, key: str, value, plant: bool, cls) -> Axis:
