@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import models
 from planners.errors import PlanningError
-from planners.loader import CubicBSplinePlanner, si_to_table1
+from planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, si_to_table1
 from planners.loader.bspline import CubicBSplineTrajectory
 from planners.trajectory import TrajectorySample
 from sims import api, scenarios
@@ -206,3 +206,116 @@ def test_random_key_points(drawn):
     assert c["joint_range"].value >= ticks["joint_range"].value - 1e-12
     assert c["joint_rate"].value >= ticks["joint_rate"].value - 1e-12
     assert c["plan_min_clearance"].evaluated
+
+
+# ----------------------------------------------------------------------------- the range's tolerance
+
+
+def slide_sets(slide_mm):
+    """Key point sets at P2 but for the slide (theta1, mm)."""
+    rows = np.tile(TABLE1[0], (len(slide_mm), 1))
+    rows[:, 0] = slide_mm
+    return rows
+
+
+def planner_accepts(params) -> bool:
+    try:
+        CubicBSplinePlanner().plan(problem(params))
+    except PlanningError:
+        return False
+    return True
+
+
+@pytest.mark.parametrize("slide_mm, overshoot_m, accepted", [
+    # Found by hypothesis: the slide's spline dips 7.8e-92 m below its limit 0; the planner
+    # refused it (its round-off tolerance scaled with the values: 1e-104) while joint_range's
+    # ratio rounded to exactly 1.0 and passed.
+    ([0.0, 0.0, 7.02e-88], 7.8e-92, True),
+    ([2e-88, 1e-88, 5e-89, 0.0, 2e-88], 1.5e-92, True),
+    # At the tolerance's scale: 8e-10 m is within JOINT_LIMIT_TOLERANCE, 1.1e-9 m is not.
+    ([0.0, 0.0, 7.2e-6], 8e-10, True),
+    ([0.0, 0.0, 9.9e-6], 1.1e-9, False),
+    ([0.0, 0.0, 0.01], 1.1e-6, False),
+])
+def test_the_planner_refuses_exactly_the_overshoots_joint_range_fails(slide_mm, overshoot_m, accepted):
+    """One tolerance, ``JOINT_LIMIT_TOLERANCE`` (1 nm on the slide), for the planner's refusal
+    and the check: an overshoot within it is accepted and joint_range passes (at most 1), one
+    beyond it is refused and joint_range fails (above 1)."""
+    [params] = params_of([slide_sets(slide_mm)])
+    dip = -unlimited_spline(problem(params)).extrema()[0][:, 0].min()
+    assert dip == pytest.approx(overshoot_m, rel=0.02)
+    assert planner_accepts(params) == accepted
+    [checks] = judge_plans([params])
+    c = by_name(checks)["joint_range"]
+    assert c.passed == accepted and (c.value <= 1.0) == accepted
+    assert ("LimitError" in c.note) == (not accepted)
+
+
+def test_the_tolerance_is_stated_and_tied_to_the_machine():
+    """1 nm / 1 nrad: far below any encoder's count (~7.5e-7 rad for 23 bits a turn), far
+    above the spline's round-off at the loader's magnitudes."""
+    assert JOINT_LIMIT_TOLERANCE == 1e-9
+    trajectory = CubicBSplinePlanner().plan(problem(LoaderParams()))
+    np.testing.assert_array_equal(trajectory.margin, np.full(6, JOINT_LIMIT_TOLERANCE))
+    round_off = trajectory.limit_tolerance - trajectory.margin
+    assert np.all(round_off < 1e-13) and JOINT_LIMIT_TOLERANCE < 2 * np.pi / 2**23
+
+
+def test_a_key_point_beyond_the_tolerance_is_refused_and_fails_joint_range():
+    """The key points obey the same tolerance: a slide key 0.5 nm below its limit 0 is accepted
+    and passes, one 2 nm below is refused and fails."""
+    spec = models.loader_spec()
+    for slide_m, accepted in ((-5e-10, True), (-2e-9, False)):
+        task = problem(LoaderParams())
+        points = task.key_points.copy()
+        points[:, 0] = 0.0
+        points[1, 0] = slide_m
+        task = type(task)(task.key_times, points, task.labels, task.lower, task.upper,
+                          task.rate_limit, task.force_limit)
+        try:
+            trajectory = CubicBSplinePlanner().plan(task)
+            ok = True
+        except PlanningError as e:
+            assert "beyond its lower limit" in str(e) and "tolerance 1e-09" in str(e)
+            ok = False
+        assert ok == accepted
+        c = by_name(judge_trajectory(task, unlimited_spline(task)))["joint_range"]
+        assert (c.value <= 1.0) == accepted
+        if ok:
+            assert trajectory.sample(task.key_times).position[1, 0] == pytest.approx(slide_m, rel=1e-12)
+    assert spec.lower[0] == 0.0
+
+
+LIMITS = list(zip(LOW, HIGH))
+
+
+@st.composite
+def near_limit_sets(draw):
+    """2 to 5 key points whose values sit on the joint limits, just inside them, near zero
+    (the slide's limit is 0: down to 1e-88 mm) or anywhere, so that the spline overshoots the
+    limits by amounts on every scale from 1e-92 m to centimetres."""
+    def value(j):
+        lo, hi = float(LIMITS[j][0]), float(LIMITS[j][1])
+        edge = draw(st.sampled_from([lo, hi]))
+        inward = 1.0 if edge == lo else -1.0
+        return draw(st.one_of(
+            st.just(edge),
+            st.builds(lambda e, x: e + inward * x, st.just(edge),
+                      st.floats(1e-90, 1e-3, allow_subnormal=False)),
+            st.floats(lo, hi, allow_nan=False)))
+    n = draw(st.integers(2, 5))
+    return [[value(j) for j in range(6)] for _ in range(n)], draw(st.sampled_from([0.3, 0.5, 1.0]))
+
+
+@settings(max_examples=60, deadline=None)
+@given(near_limit_sets())
+@example(drawn=(slide_sets([0.0, 0.0, 7.02e-88]).tolist(), 0.5))
+def test_near_the_limits_the_planner_refuses_iff_joint_range_fails(drawn):
+    points, interval = drawn
+    points = np.clip(points, LOW, HIGH)  # LoaderParams' ranges (Table 1's units)
+    [params] = params_of([points], key_interval=interval)
+    [checks] = judge_plans([params])
+    c = by_name(checks)["joint_range"]
+    accepted = planner_accepts(params)
+    assert c.passed == accepted, (c.value, c.note)
+    assert (c.value > 1.0) == (not accepted)

@@ -33,6 +33,16 @@ TABLE1 = np.array(
 TABLE1_TIMES = np.arange(6) * 0.5  # s
 TABLE1_LABELS = ("P2", "M1", "M2", "M3", "M4", "P3")
 
+#: How far a joint may be beyond its range and still count as within it, m for the slide and
+#: rad for the hinges: 1 nm and 1 nrad, the same for the planner's refusal and for the
+#: ``joint_range`` check (``sims.loader.plan_checks``). The loader's encoders are modelled
+#: exact (no figures are published, models/loader/README.md); the finest absolute encoders
+#: resolve ~7.5e-7 rad (23 bits a turn) and linear scales ~1e-8 m, so a value this close to a
+#: limit is the limit for any machine that measures it. It is also far above the spline's
+#: round-off at the loader's magnitudes (64 eps x 3.2 rad = 4.5e-14 rad), so the check's ratio
+#: |theta - centre| / half range is above 1 for every value the planner refuses.
+JOINT_LIMIT_TOLERANCE = 1e-9
+
 
 def table1_to_si(rows: np.ndarray) -> np.ndarray:
     """Table 1 units (mm, deg) to joint SI units (m, rad)."""
@@ -86,19 +96,22 @@ def _problem(times, points, spec: SerialChainSpec) -> LoaderProblem:
 
 class CubicBSplinePlanner:
     """The paper's planner: the cubic B-spline through the problem's key points (section 3,
-    ``planners.bspline``), checked against the joint ranges."""
+    ``planners.loader.bspline``), checked against the joint ranges: it refuses (a LimitError)
+    key points, or a spline between them, beyond a limit by more than
+    ``JOINT_LIMIT_TOLERANCE`` (between key points plus the spline's round-off,
+    ``limit_tolerance``)."""
 
     def plan(self, problem: LoaderProblem) -> CubicBSplineTrajectory:
         return CubicBSplineTrajectory(problem.key_times, problem.key_points, labels=list(problem.labels),
-                                      lower=problem.lower, upper=problem.upper)
+                                      lower=problem.lower, upper=problem.upper, margin=JOINT_LIMIT_TOLERANCE)
 
 
 def supply_plan(spec: SerialChainSpec | None = None) -> CubicBSplineTrajectory:
     """The supply stage of the paper: P2 -> M1 ... M4 -> P3 through the cubic B-spline."""
     spec = spec or loader_spec()
     return CubicBSplineTrajectory(
-        TABLE1_TIMES, table1_to_si(TABLE1), labels=spec.names, lower=spec.lower, upper=spec.upper
-    )
+        TABLE1_TIMES, table1_to_si(TABLE1), labels=spec.names, lower=spec.lower, upper=spec.upper,
+        margin=JOINT_LIMIT_TOLERANCE)
 
 
 def direct_plan(spec: SerialChainSpec | None = None) -> CubicBSplineTrajectory:
@@ -110,8 +123,8 @@ def direct_plan(spec: SerialChainSpec | None = None) -> CubicBSplineTrajectory:
     spec = spec or loader_spec()
     q = table1_to_si(TABLE1)
     return CubicBSplineTrajectory(
-        TABLE1_TIMES[[0, -1]], q[[0, -1]], labels=spec.names, lower=spec.lower, upper=spec.upper
-    )
+        TABLE1_TIMES[[0, -1]], q[[0, -1]], labels=spec.names, lower=spec.lower, upper=spec.upper,
+        margin=JOINT_LIMIT_TOLERANCE)
 
 
 def _scipy_quat(wxyz: np.ndarray) -> Rotation:

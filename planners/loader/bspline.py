@@ -48,6 +48,13 @@ its range. A real overshoot, larger than this, is still refused, and the sampled
 stays within the limits up to the same tolerance (both tested in
 ``tests/test_api_bad_input.py``).
 
+A planner for a machine may also allow an absolute ``margin`` per joint (default 0): key
+points may then lie up to ``margin`` beyond a limit, and the spline between them up to
+``margin`` plus its round-off (``limit_tolerance``). The loader's planner allows its encoders'
+``planners.loader.JOINT_LIMIT_TOLERANCE``, so that what it refuses is a departure from the
+range the machine could measure, not one of 1e-92 m (round-off of values near 1e-88 is
+1e-104, which no limit check at the range's scale can see).
+
 Inputs are checked before anything is solved: key times, key points and limits must be finite
 and within +/-``planners.trajectory.MAX_MAGNITUDE``, the limits ordered, and the key step long
 enough that the spline's accelerations stay within that magnitude too (a step of 1e-200 s
@@ -129,8 +136,11 @@ class CubicBSplineTrajectory:
       key_points: (n+1, m) joint values at those times, SI units (m or rad).
       labels: m joint names, used in error messages and outputs.
       lower, upper: optional (m,) joint limits, finite, lower <= upper. Key points outside
-        them are rejected, and so is a spline that overshoots them between key points by more
-        than its round-off (``limit_tolerance``; module docstring).
+        them (by more than ``margin``) are rejected, and so is a spline that overshoots them
+        between key points by more than ``limit_tolerance`` (``margin`` plus its round-off;
+        module docstring).
+      margin: absolute tolerance beyond a limit, a number or (m,), >= 0, in the joints'
+        units (default 0: key points exactly, the spline to its round-off).
 
     Before ``times[0]`` and after ``times[-1]`` the trajectory holds its end points at rest.
     """
@@ -142,6 +152,7 @@ class CubicBSplineTrajectory:
         labels: Sequence[str] | None = None,
         lower: Sequence[float] | None = None,
         upper: Sequence[float] | None = None,
+        margin: float | Sequence[float] = 0.0,
     ):
         try:
             times = np.asarray(times, dtype=float)
@@ -195,6 +206,14 @@ class CubicBSplineTrajectory:
                 arr, lambda i, name=name: f"{name} limit of joint {labels[i[0]]}"
             )
         self._lower, self._upper = limits["lower"], limits["upper"]
+        try:
+            margin = np.broadcast_to(np.asarray(margin, dtype=float), (m,)).copy()
+        except (TypeError, ValueError):
+            raise PlanningError(f"margin {margin!r} must be a number >= 0 or {m} of them") from None
+        bad = np.flatnonzero(~(margin >= 0) | ~np.isfinite(margin))
+        if bad.size:
+            raise PlanningError(f"margin of joint {labels[bad[0]]} = {margin[bad[0]]!r} must be finite and >= 0")
+        self._margin = margin
         if self._lower is not None and self._upper is not None:
             crossed = np.flatnonzero(self._lower > self._upper)
             if crossed.size:
@@ -217,7 +236,7 @@ class CubicBSplineTrajectory:
         self._coef_u = np.einsum("rc,scm->srm", BASIS, windows)
         self._check_key_step()
         finfo = np.finfo(float)
-        self._tolerance = LIMIT_TOLERANCE_ULPS * (
+        self._tolerance = self._margin + LIMIT_TOLERANCE_ULPS * (
             finfo.eps * np.max(np.abs(self.control_points), axis=0) + finfo.smallest_subnormal)
         self._check_overshoot()
 
@@ -240,9 +259,14 @@ class CubicBSplineTrajectory:
 
     @property
     def limit_tolerance(self) -> np.ndarray:
-        """(m,) round-off allowed beyond a limit between key points: 64 (eps max |P| + eta)
+        """(m,) allowed beyond a limit between key points: ``margin`` + 64 (eps max |P| + eta)
         per joint (module docstring, "Joint limits and round-off"); in the joints' units."""
         return self._tolerance.copy()
+
+    @property
+    def margin(self) -> np.ndarray:
+        """(m,) allowed beyond a limit at the key points (the constructor's ``margin``)."""
+        return self._margin.copy()
 
     def sample(self, t: np.ndarray | float) -> TrajectorySample:
         """Positions, velocities and accelerations at times ``t`` (s), vectorized (eq. 10).
@@ -293,32 +317,36 @@ class CubicBSplineTrajectory:
             )
 
     def _check_limits(self, values, labels, times, what):
-        for name, lim, breaks in (
-            ("lower", self._lower, lambda v, l: v < l),
-            ("upper", self._upper, lambda v, l: v > l),
-        ):
+        # sign (v - l) > margin: with margin 0 exactly v > l (a difference of two doubles is 0
+        # only when they are equal).
+        for name, lim, sign in (("lower", self._lower, -1.0), ("upper", self._upper, 1.0)):
             if lim is None:
                 continue
-            bad = np.argwhere(breaks(values, lim[None, :]))
+            excess = sign * (values - lim[None, :])
+            bad = np.argwhere(excess > self._margin[None, :])
             if bad.size:
                 k, j = bad[0]
                 value, limit = _distinct(values[k, j], lim[j])
+                allowed = f" by {excess[k, j]:.3g} (tolerance {self._margin[j]:.3g})" if self._margin[j] else ""
                 raise LimitError(
                     f"{what} at t = {times[k]:.4g} s: joint {labels[j]} = {value} "
-                    f"is beyond its {name} limit {limit}"
+                    f"is beyond its {name} limit {limit}{allowed}"
                 )
 
-    def _check_overshoot(self):
-        """Reject a spline that leaves the joint limits between key points.
+    def extrema(self) -> tuple[np.ndarray, np.ndarray]:
+        """The values the limit check judges between key points, as it computes them.
 
         Each segment is a cubic in u; its extrema are the roots of the derivative quadratic
         qa u^2 + qb u + qc, found without cancellation: q = -(qb + sign(qb) sqrt(disc)) / 2,
         roots q / qa and qc / q. (The textbook (-qb + sqrt(disc)) / (2 qa) with a cutoff
         |qa| < 1e-14 for "linear" lost the root of a segment whose a3 was round-off of 4e-14:
         the spline 360, 128.5, 128.5, 360 dips to 70.6 and passed a lower limit of 75.)
+
+        Returns:
+          ((4 segments, m) values at each segment's start, end and derivative roots inside it
+           (the start where there is none), in the joints' units; (4 segments, m) their
+           times, s). Each column's numbers depend on that column's key points only.
         """
-        if self._lower is None and self._upper is None:
-            return
         a3, a2, a1 = self._coef_u[:, 0], self._coef_u[:, 1], self._coef_u[:, 2]
         candidates = [np.zeros_like(a3), np.ones_like(a3)]
         qa, qb, qc = 3.0 * a3, 2.0 * a2, a1
@@ -330,20 +358,31 @@ class CubicBSplineTrajectory:
             r2 = np.where(q != 0, qc / q, np.nan)  # q == 0: qb == qa qc == 0, roots at 0 only
         for r in (r1, r2):
             candidates.append(np.where(np.isfinite(r) & (r > 0) & (r < 1), r, 0.0))
+        values, times = [], []
         for u in candidates:
-            values = ((a3 * u + a2) * u + a1) * u + self._coef_u[:, 3]  # (segments, m)
-            times = self._t0 + (np.arange(values.shape[0])[:, None] + u) * self._h
-            for name, lim, sign in (("lower", self._lower, -1.0), ("upper", self._upper, 1.0)):
-                if lim is None:
-                    continue
-                excess = sign * (values - lim[None, :])
-                bad = np.argwhere(excess > self._tolerance[None, :])
-                if bad.size:
-                    k, j = bad[0]
-                    value, limit = _distinct(values[k, j], lim[j])
-                    raise LimitError(
-                        f"spline between key points at t = {times[k, j]:.4g} s: joint "
-                        f"{self._labels[j]} = {value} overshoots its {name} limit "
-                        f"{limit} by {excess[k, j]:.3g} (round-off tolerance "
-                        f"{self._tolerance[j]:.3g})"
-                    )
+            values.append(((a3 * u + a2) * u + a1) * u + self._coef_u[:, 3])  # (segments, m)
+            times.append(self._t0 + (np.arange(a3.shape[0])[:, None] + u) * self._h)
+        return np.concatenate(values), np.concatenate(times)
+
+    def _check_overshoot(self):
+        """Reject a spline that leaves the joint limits between key points (at ``extrema``)
+        by more than ``limit_tolerance``."""
+        if self._lower is None and self._upper is None:
+            return
+        values, times = self.extrema()
+        for name, lim, sign in (("lower", self._lower, -1.0), ("upper", self._upper, 1.0)):
+            if lim is None:
+                continue
+            excess = sign * (values - lim[None, :])
+            bad = np.argwhere(excess > self._tolerance[None, :])
+            if bad.size:
+                k, j = bad[0]
+                value, limit = _distinct(values[k, j], lim[j])
+                what = (f"tolerance {self._margin[j]:.3g} and the spline's round-off "
+                        f"{self._tolerance[j] - self._margin[j]:.2g}" if self._margin[j]
+                        else f"round-off tolerance {self._tolerance[j]:.3g}")
+                raise LimitError(
+                    f"spline between key points at t = {times[k, j]:.4g} s: joint "
+                    f"{self._labels[j]} = {value} overshoots its {name} limit "
+                    f"{limit} by {excess[k, j]:.3g} ({what})"
+                )

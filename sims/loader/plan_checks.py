@@ -17,9 +17,11 @@ plan_keypoint_error  deg    <= 0.1                largest |theta_j(t_k) - M_k,j|
                                                   is the encoders'
 joint_range          ratio  <= 1                  largest |theta_j - centre| / half range of any
                                                   joint, at the key points and between them (at
-                                                  the spline's extrema, eq. 10); > 1: the planner
-                                                  refuses the key points (a LimitError, named in
-                                                  the note), the value says by how much
+                                                  the spline's extrema, eq. 10), a value within
+                                                  JOINT_LIMIT_TOLERANCE of a limit counting as
+                                                  on it; > 1: the planner refuses the key points
+                                                  (a LimitError, named in the note), the value
+                                                  says by how much
 joint_rate           ratio  <= 1                  largest |dtheta_j/dt| / the drive's rate limit
                                                   (models.loader_spec().rate_limit), at the
                                                   velocity's extrema
@@ -31,10 +33,13 @@ plan_min_clearance   m      > 0                   smallest signed distance betwe
 ===================  =====  ====================  ================================================
 
 Limits are the run's (``sims.loader``) and the model's (``models.loader_spec``), never
-loosened. ``joint_range`` judges as the planner does: the key points exactly (they are the
-caller's numbers), the spline between them allowing the planner's own round-off
-(``CubicBSplineTrajectory.limit_tolerance``, 64 eps max |P|) beyond a limit as on it; so it passes
-exactly when the planner accepts the key points (tested on random key points). A run has no
+loosened. ``joint_range`` judges as the planner does, with its numbers and its one tolerance,
+``planners.loader.JOINT_LIMIT_TOLERANCE`` (1e-9 m on the slide, 1e-9 rad on the hinges):
+a key point beyond a limit by no more than it, or the spline between key points (at the
+planner's own ``CubicBSplineTrajectory.extrema``) by no more than it plus the spline's
+round-off (``limit_tolerance``), counts as on the limit (ratio at most 1); anything beyond is
+above 1, however little. So it passes exactly when the planner accepts the key points (tested
+on random key points and on key points on, near and just inside the limits, down to 1e-88). A run has no
 ``joint_rate`` check (its ``joint_torque`` is the drives' demanded torque, from physics): the
 rate limit is the drives' set-point rate, which a planned trajectory should respect, and the
 paper's spline does not respect it by construction.
@@ -106,7 +111,7 @@ import numpy as np
 
 import models
 from planners.errors import PlanningError
-from planners.loader import LoaderProblem
+from planners.loader import JOINT_LIMIT_TOLERANCE, LoaderProblem
 from planners.loader.bspline import CubicBSplineTrajectory
 from planners.trajectory import control_ticks
 from sims.checks import Check
@@ -447,24 +452,22 @@ def _judge_group(tasks: Sequence[LoaderProblem]) -> list[dict]:
     m = len(first.labels)
     g = len(tasks)
     points = np.concatenate([t.key_points for t in tasks], axis=1)            # (k, m g)
-    stacked = CubicBSplineTrajectory(first.key_times, points)
+    stacked = CubicBSplineTrajectory(first.key_times, points, margin=JOINT_LIMIT_TOLERANCE)
     lower, upper = np.tile(first.lower, g), np.tile(first.upper, g)
     rate = np.tile(first.rate_limit, g)
-    centre, half = (upper + lower) / 2.0, (upper - lower) / 2.0
     # Key points: the planned motion at the key times.
     at_keys = stacked.sample(first.key_times).position - points
     key_deg = np.degrees(np.abs(at_keys)).reshape(-1, g, m)
     key_slide_mm = 1e3 * np.abs(at_keys).reshape(-1, g, m)[:, :, 0].max(axis=0)
     # Range and rate at their extrema (exact per segment).
     h = (first.key_times[-1] - first.key_times[0]) / (first.key_times.size - 1)
-    positions, position_t, speeds, speed_t = _extremes(stacked.segment_polynomials(), h)
-    # As the planner judges them: the key points exactly (they are the caller's numbers), the
-    # spline between them allowing its round-off (``limit_tolerance``) beyond a limit.
-    tolerance = stacked.limit_tolerance
-    beyond = ((positions > upper) & (positions - upper <= tolerance)) | \
-             ((positions < lower) & (lower - positions <= tolerance))
-    range_ratio = np.concatenate([np.abs(points - centre) / half,
-                                  np.where(beyond, 1.0, np.abs(positions - centre) / half)])  # (c, m g)
+    _, _, speeds, speed_t = _extremes(stacked.segment_polynomials(), h)
+    # The range as the planner judges it, with its numbers: the key points and the values at
+    # the spline's extrema (``extrema``, the planner's own arithmetic, channel by channel).
+    positions, position_t = stacked.extrema()
+    range_ratio = np.concatenate([
+        range_ratio_of(points, lower, upper, stacked.margin),
+        range_ratio_of(positions, lower, upper, stacked.limit_tolerance)])      # (c, m g)
     positions = np.concatenate([points, positions])
     position_t = np.concatenate([np.broadcast_to(first.key_times[:, None], points.shape), position_t])
     rate_ratio = speeds / rate
@@ -507,6 +510,19 @@ def _judge_group(tasks: Sequence[LoaderProblem]) -> list[dict]:
             "ticks_evaluated": evaluated, "ticks": ticks.size,
         })
     return out
+
+
+def range_ratio_of(values: np.ndarray, lower: np.ndarray, upper: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    """``joint_range``'s ratio |theta - centre| / half range of each value (..., m), with the
+    planner's rule (``CubicBSplineTrajectory``): a value beyond a limit by no more than
+    ``allowed`` (m,) (the key points' ``margin``, the spline's ``limit_tolerance``) counts as
+    on it, at most 1; one beyond by more is above 1, however little (the planner refuses it).
+    So the check passes exactly when the planner accepts, whatever the rounding of the
+    ratio."""
+    excess = np.maximum(values - upper, -(values - lower))   # the planner's sign (v - l)
+    ratio = np.abs(values - (upper + lower) / 2.0) / ((upper - lower) / 2.0)
+    within = excess <= allowed
+    return np.where(within, np.minimum(ratio, 1.0), np.maximum(ratio, np.nextafter(1.0, 2.0)))
 
 
 def _refusal(task: LoaderProblem) -> str:
@@ -599,8 +615,7 @@ def judge_trajectory(task: LoaderProblem, trajectory) -> list[Check]:
     at_keys = np.asarray(trajectory.sample(task.key_times).position, dtype=float) - task.key_points
     key_deg = np.degrees(np.abs(at_keys[:, 1:]))
     k, jk = np.unravel_index(int(np.argmax(key_deg)), key_deg.shape)
-    centre, half = (task.upper + task.lower) / 2.0, (task.upper - task.lower) / 2.0
-    rr = np.abs(q - centre) / half
+    rr = range_ratio_of(q, task.lower, task.upper, np.full(q.shape[1], JOINT_LIMIT_TOLERANCE))
     kr, jr = np.unravel_index(int(np.argmax(rr)), rr.shape)
     rt = np.abs(np.asarray(sample.velocity, dtype=float)) / task.rate_limit
     kt, jt = np.unravel_index(int(np.argmax(rt)), rt.shape)
