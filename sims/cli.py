@@ -292,16 +292,13 @@ def cmd_sweep(args) -> int:
 
 
 def _demo_root(raw: str) -> Path:
-    """The demo's directory: created if missing, never replaced itself (only the scenarios'
-    directories inside it are)."""
-    from sims.outputs import OutputError
+    """The demo's directory: validated as a run's output is (sims.outputs.OutputRoot: never
+    the root, the current or the home directory, nor one holding files planbench did not
+    write), created if missing, never replaced itself (only the scenarios' directories
+    inside it are)."""
+    from sims import outputs, scenarios
 
-    if raw.strip() == "":
-        raise BadInput("demo --out '' is empty; give it a directory")
-    root = Path(raw)
-    if os.path.lexists(root) and not root.is_dir():
-        raise OutputError(f"demo --out {root} exists and is not a directory")
-    return root
+    return outputs.OutputRoot(raw, "demo --out", inner=tuple(scenarios.SCENARIOS)).path
 
 
 def cmd_demo(args) -> int:

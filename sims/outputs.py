@@ -295,6 +295,80 @@ class _Target:
             self._created.append(d)
 
 
+def _refuse_place(what: str, path: Path) -> None:
+    """The directories no output may replace or fill: the root, the current directory and
+    every directory that holds it, the home directory."""
+    real = Path(os.path.realpath(path))
+    cwd = Path(os.path.realpath(os.getcwd()))
+    if real == Path(real.anchor):
+        raise OutputError(f"{what} {path} is the file system's root; choose a new directory")
+    if real == cwd:
+        raise OutputError(f"{what} {path} is the current directory; choose a new directory")
+    if cwd.is_relative_to(real):
+        raise OutputError(f"{what} {path} holds the current directory; choose a new directory")
+    if real == Path(os.path.realpath(Path.home())):
+        raise OutputError(f"{what} {path} is the home directory; choose a new directory")
+
+
+def _written_by_planbench(entry: Path) -> bool:
+    """Whether an entry of a directory of outputs is planbench's: an output directory (its
+    manifest), a campaign directory (its state file), a lock, staging or probe entry, or a
+    video with planbench's tag."""
+    if entry.name.startswith((LOCK_PREFIX, STAGING_PREFIX, PROBE_PREFIX)):
+        return True
+    if entry.is_symlink():
+        return False
+    if entry.is_dir():
+        return read_manifest(entry) is not None or (entry / CAMPAIGN_STATE).is_file()
+    return entry.is_file() and entry.suffix.lower() in VIDEO_SUFFIXES and is_planbench_video(entry)
+
+
+#: A campaign directory's state file (sims.campaign.store.STATE).
+CAMPAIGN_STATE = "planbench-campaign.json"
+
+
+class OutputRoot:
+    """A directory of output directories (``demo --out``: one directory per scenario inside).
+
+    The same places are refused as for an OutputDir (the root, the current directory or one
+    that holds it, the home directory, the empty string, a file, a symbolic link, names too
+    long). An existing directory may hold only what planbench wrote: output and campaign
+    directories, planbench's lock and staging entries and its videos (``planbench run``'s
+    default ``results/NAME`` and a sweep's ``results/SPEC`` live there too). ``inner``: the
+    names of the output directories the caller validates itself, each an OutputDir.
+    Nothing is written here; the first OutputDir reserved inside creates the directory.
+    """
+
+    what = "output dir"
+
+    def __init__(self, raw, option: str, inner=()):
+        self.option = option
+        self.path = path = _absolute(raw, self.what, option)
+        _refuse_place(self.what, path)
+        longest = max([len(os.fsencode(n)) for n in inner] + [0])
+        _check_lengths(self.what, path, longest + 1 + len(STAGING_PREFIX) + 8 + 1 + _LONGEST_INNER)
+        if os.path.islink(path):
+            raise OutputError(f"{self.what} {path} is a symbolic link; give the directory itself")
+        if not os.path.lexists(path):
+            return
+        if not path.is_dir():
+            raise OutputError(f"{self.what} {path} exists and is not a directory")
+        try:
+            names = sorted(os.listdir(path))
+        except OSError as e:
+            raise OutputError(f"{self.what} {path} cannot be read ({e.strerror or e})") from None
+        foreign = [n for n in names if n not in inner and not _written_by_planbench(path / n)]
+        if foreign:
+            raise OutputError(f"{self.what} {path} holds files planbench did not write ({_shown(foreign)}); "
+                              f"choose another {option} or move them away")
+
+    def __str__(self) -> str:
+        return str(self.path)
+
+    def __truediv__(self, name: str) -> Path:
+        return self.path / name
+
+
 class OutputDir(_Target):
     """A directory that planbench writes whole (``--out`` of ``run`` and ``plan``, and each
     scenario's directory of ``demo``).
@@ -311,16 +385,7 @@ class OutputDir(_Target):
         super().__init__(raw, option)
         self.kind = kind
         path, what = self.path, self.what
-        real = Path(os.path.realpath(path))
-        cwd = Path(os.path.realpath(os.getcwd()))
-        if real == Path(real.anchor):
-            raise OutputError(f"{what} {path} is the file system's root; choose a new directory")
-        if real == cwd:
-            raise OutputError(f"{what} {path} is the current directory; choose a new directory")
-        if cwd.is_relative_to(real):
-            raise OutputError(f"{what} {path} holds the current directory; choose a new directory")
-        if real == Path(os.path.realpath(Path.home())):
-            raise OutputError(f"{what} {path} is the home directory; choose a new directory")
+        _refuse_place(what, path)
         _check_lengths(what, path, _LONGEST_INNER)
         if os.path.islink(path):
             raise OutputError(f"{what} {path} is a symbolic link; give the directory itself")

@@ -288,6 +288,9 @@ class RecordingPlanner:
         self.wall_s += time.perf_counter() - start
         if theta.shape != (4,):
             raise PluginError(f"the antenna planner's step returned shape {theta.shape}, not (4,) joint angles")
+        if not np.isfinite(theta).all():  # before any use: NaN angles only make numpy warn downstream
+            raise PluginError(f"the antenna planner's step at t = {t:g} s returned non-finite joint angles "
+                              f"{np.array2string(theta, precision=4)}")
         i = self.count
         if i == self.t.size:  # more updates than the IMU's rate gives: grow
             for name in ("t", "attitude", "theta", "iterations", "damped", "rate_limited"):

@@ -18,6 +18,7 @@ import itertools
 import multiprocessing
 import os
 
+from sims import outputs
 from sims.campaign import worker
 
 ENGINES = ("local", "ray")
@@ -30,8 +31,64 @@ def _lost(context, chunk, why: str) -> dict:
     return {"rows": rows, "checks": {}, "files": {}}
 
 
-def _init_worker(context):
+def _init_worker(context, parent: int | None = None):
+    contain_worker(parent)
     worker._context = context
+
+
+#: How often a worker without PR_SET_PDEATHSIG looks whether its driver still lives, s.
+PARENT_POLL_S = 1.0
+_PR_SET_PDEATHSIG = 1
+
+
+def contain_worker(parent: int | None) -> None:
+    """Make this process a quiet worker of the process ``parent``.
+
+    Ctrl-C at a terminal signals the whole process group: the driver alone answers it (it
+    ends its workers and prints one line), so a worker ignores SIGINT and SIGHUP, and SIGTERM
+    (the driver's way to end it) ends it silently. The driver spawns its workers with those
+    signals blocked (``sims.outputs.signals_deferred``), so none arrives before this. And a
+    worker ends with its driver, even one killed by SIGKILL: the kernel sends it SIGKILL when
+    the driver dies (Linux PR_SET_PDEATHSIG), elsewhere a thread that looks every
+    PARENT_POLL_S whether the parent's pid changed. Without that, orphaned workers (and the
+    resource tracker they keep alive) would hold the caller's stdout open.
+    """
+    import signal
+    import threading
+
+    from sims.outputs import INTERRUPT_SIGNALS
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # tqdm's default lock is a named multiprocessing semaphore; a worker ended by SIGTERM never
+    # unlinks it and the resource tracker reports it as leaked. A worker's bars need no lock
+    # shared with other processes.
+    from tqdm import tqdm
+
+    tqdm.set_lock(threading.RLock())
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, INTERRUPT_SIGNALS)
+    if parent is None:
+        return
+    armed = False
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        armed = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != parent:  # the driver died before the kernel was told
+        os._exit(1)
+    if armed:
+        return
+
+    def watch():
+        while os.getppid() == parent:
+            threading.Event().wait(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="planbench-parent-watch", daemon=True).start()
 
 
 def _run_in_worker(chunk):
@@ -70,19 +127,23 @@ class LocalEngine:
 
         while True:
             pool = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                          initializer=_init_worker, initargs=(context,))
+                                          initializer=_init_worker, initargs=(context, os.getpid()))
             broken, unsent = [], []
             futures = {}
 
             def submit(batch):
                 # A pool can break between two submits (a worker died meanwhile); a chunk it
                 # refuses never ran, so it goes back to the queue without counting as a death.
-                for i, c in enumerate(batch):
-                    try:
-                        futures[pool.submit(_run_in_worker, c)] = c
-                    except cf.process.BrokenProcessPool:
-                        unsent.extend(batch[i:])
-                        return
+                # Submitting spawns workers: with SIGINT, SIGTERM and SIGHUP held back, an
+                # interrupt never cuts a spawn (or its semaphores) in half, and each worker
+                # starts with them blocked until contain_worker has set them.
+                with outputs.signals_deferred():
+                    for i, c in enumerate(batch):
+                        try:
+                            futures[pool.submit(_run_in_worker, c)] = c
+                        except cf.process.BrokenProcessPool:
+                            unsent.extend(batch[i:])
+                            return
 
             try:
                 # Chunks that were in flight when a pool broke run one at a time, so the one
@@ -119,13 +180,18 @@ class LocalEngine:
 
 
 def _terminate(pool) -> None:
-    processes = list(getattr(pool, "_processes", {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in processes:
-        if p.is_alive():
-            p.terminate()
-    for p in processes:
-        p.join(timeout=5)
+    """End a pool now (an interrupt, an error): its workers get SIGTERM, then SIGKILL."""
+    with outputs.signals_deferred():
+        processes = list((getattr(pool, "_processes", None) or {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for p in processes:
+            if p.is_alive():
+                p.terminate()
+        for p in processes:
+            p.join(timeout=5)
+            if p.is_alive():
+                p.kill()
+                p.join(timeout=5)
 
 
 class RayEngine:

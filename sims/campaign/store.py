@@ -30,7 +30,7 @@ import pyarrow.parquet as pq
 from sims import outputs
 from sims.outputs import OutputError
 
-STATE = "planbench-campaign.json"
+STATE = outputs.CAMPAIGN_STATE  # "planbench-campaign.json"
 TABLE = "table"
 RUNS = "runs"
 RESULTS = "results.parquet"
@@ -72,6 +72,9 @@ class CampaignDir(outputs._Target):
         if real == Path(real.anchor) or real == Path(os.path.realpath(Path.home())) or cwd.is_relative_to(real):
             raise OutputError(f"{self.what} {path} is the root, the home or the current directory (or holds it); "
                               "choose a new directory")
+        # A run's files lie in DIR/runs/NNNNNN/ (staged beside it first), the longest deepest.
+        outputs._check_lengths(self.what, path, len(f"{RUNS}/000000/") + len(outputs.STAGING_PREFIX) + 8 + 1
+                               + outputs._LONGEST_INNER)
         if os.path.islink(path):
             raise OutputError(f"{self.what} {path} is a symbolic link; give the directory itself")
         if os.path.lexists(path):
