@@ -212,7 +212,7 @@ class RayEngine:
             address = self.address or os.environ.get("RAY_ADDRESS")
             options = dict(include_dashboard=False, log_to_driver=False, configure_logging=False)
             if address:
-                ray.init(address=address, **options)
+                _ray_connect(ray, address, options)
             else:
                 ray.init(num_cpus=self.workers or os.cpu_count() or 1, **options)
             started = True
@@ -247,6 +247,60 @@ class RayEngine:
                 ray.shutdown()
 
 
+#: How long ``--engine ray --address HOST:PORT`` waits for the cluster's GCS port to accept a
+#: connection before the campaign is refused (s); ray.init itself would retry for ever.
+RAY_CONNECT_TIMEOUT_S = 30.0
+
+
+def _check_reachable(address: str, timeout: float | None = None) -> None:
+    """ParamError unless a TCP connection to the Ray cluster at ``address`` (HOST:PORT, the
+    GCS) opens within ``timeout`` s (RAY_CONNECT_TIMEOUT_S). "auto", "local" and ray://
+    addresses are left to Ray."""
+    import socket
+
+    from sims.params import ParamError
+
+    timeout = RAY_CONNECT_TIMEOUT_S if timeout is None else timeout
+    if address in ("auto", "local") or "://" in address:
+        return
+    host, sep, port = address.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ParamError(f"--address {address!r} is not HOST:PORT of a Ray cluster's head")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
+            return
+    except ConnectionRefusedError:  # a definite answer: nothing listens there
+        raise ParamError(f"--address {address}: nothing listens there (connection refused); start the "
+                         "cluster (ray start --head) or check the address") from None
+    except OSError as e:  # a timeout, an unknown host, no route
+        raise ParamError(f"--address {address}: no Ray cluster answered within {timeout:g} s "
+                         f"({e.strerror or e or 'timed out'}); start it (ray start --head) or check the "
+                         "address") from None
+
+
+def _ray_connect(ray, address: str, options: dict) -> None:
+    """``ray.init(address=...)`` with Ray's log lines on stderr held back (its GCS client
+    writes one per retry); a failure is a ParamError: one error line. Ray's client gives up
+    by itself (about 20 s with Ray 2.x when a port answers that is not a Ray head)."""
+    import tempfile
+
+    from sims.params import ParamError
+
+    saved = os.dup(2)
+    try:
+        with tempfile.TemporaryFile() as log:
+            os.dup2(log.fileno(), 2)
+            try:
+                ray.init(address=address, **options)
+            except Exception as e:  # noqa: BLE001  (ConnectionError, RuntimeError: Ray's own)
+                raise ParamError(f"--address {address}: no Ray cluster there ({type(e).__name__}: "
+                                 f"{str(e).splitlines()[0] if str(e) else 'no reason given'})") from None
+            finally:
+                os.dup2(saved, 2)
+    finally:
+        os.close(saved)
+
+
 def ray_available() -> bool:
     import importlib.util
 
@@ -266,4 +320,6 @@ def make(engine: str, workers: int | None, address: str | None):
         return LocalEngine(workers)
     if not ray_available():
         raise ParamError("--engine ray needs Ray: pip install 'planbench[ray]'")
+    if address or os.environ.get("RAY_ADDRESS"):
+        _check_reachable(address or os.environ["RAY_ADDRESS"])  # before anything is written
     return RayEngine(address, workers)
