@@ -186,6 +186,10 @@ class BodyWindDrag:
         self._xfrc[:] = row
 
 
+#: Largest |direction| (deg) a wind file may give: one turn either way, as every angle parameter.
+MAX_DIRECTION_DEG = 360.0
+
+
 class WindFileError(ValueError):
     """A measured wind file that cannot be read or is not a wind record."""
 
@@ -197,7 +201,8 @@ class MeasuredWind:
     (``resample``); the direction is interpolated on the unit circle.
 
     Raises WindFileError naming the file, the row and the reason: fewer than two rows, times
-    not increasing, a speed outside [0, MAX_MEAN_SPEED_M_S], a value that is not a number.
+    not increasing, a speed outside [0, MAX_MEAN_SPEED_M_S], a direction beyond +/-360 deg
+    (``MAX_DIRECTION_DEG``: angles are not wrapped), a value that is not a number.
     """
 
     def __init__(self, path):
@@ -232,6 +237,10 @@ class MeasuredWind:
             if not 0.0 <= values[1] <= MAX_MEAN_SPEED_M_S:
                 raise WindFileError(f"wind file {self.path} line {number}: speed {values[1]:g} m/s is outside "
                                     f"[0, {MAX_MEAN_SPEED_M_S:g}] m/s (IEC 61400-1 class I)")
+            if len(values) == 3 and not -MAX_DIRECTION_DEG <= values[2] <= MAX_DIRECTION_DEG:
+                raise WindFileError(f"wind file {self.path} line {number}: direction {values[2]:g} deg is outside "
+                                    f"[-{MAX_DIRECTION_DEG:g}, {MAX_DIRECTION_DEG:g}] deg (one turn either way; "
+                                    "angles are not wrapped)")
             if rows and values[0] <= rows[-1][0]:
                 raise WindFileError(f"wind file {self.path} line {number}: t = {values[0]:g} s does not increase")
             rows.append(values)

@@ -623,6 +623,17 @@ class FastParams(ScenarioParams):
                                           "125, 100, 83.3, 71.4, 62.5, 55.6, 50, ... 10 Hz)")
 
     def check(self) -> None:
+        # The start time first: later checks (the source's zenith angle) compute with it.
+        start = getattr(self, "start_utc", None)
+        if start is not None:
+            try:
+                jd1, jd2 = sky.as_utc_jd(start)
+                year = int(sky.jd_to_iso(np.ravel(jd1)[0], np.ravel(jd2)[0])[:4])
+            except (ValueError, TypeError) as e:
+                raise ParamError(f"start_utc = {start!r} is not a UTC time ({_UTC['reason']}): {e}") from None
+            if not 1972 <= year <= 2099:
+                raise ParamError(f"start_utc = {start!r} is outside the years 1972-2099, where UTC has its leap "
+                                 "seconds")
         if self.cable_segments == 1:
             raise ParamError("cable_segments = 1 is not a chain: 0 (lumped cables) or 2 ... "
                              f"{max_cable_segments()}")
@@ -648,23 +659,15 @@ class FastParams(ScenarioParams):
     def control_dt(self) -> float:
         """The control period, s: a whole number of physics steps."""
         return round(1.0 / (self.control_rate_hz * PHYSICS_DT)) * PHYSICS_DT
-        start = getattr(self, "start_utc", None)
-        if start is not None:
-            try:
-                jd1, jd2 = sky.as_utc_jd(start)
-                year = int(sky.jd_to_iso(np.ravel(jd1)[0], np.ravel(jd2)[0])[:4])
-            except (ValueError, TypeError) as e:
-                raise ParamError(f"start_utc = {start!r} is not a UTC time ({_UTC['reason']}): {e}") from None
-            if not 1972 <= year <= 2099:
-                raise ParamError(f"start_utc = {start!r} is outside the years 1972-2099, where UTC has its leap seconds")
 
 
 @dataclass(frozen=True)
 class FastSourceParams(FastParams):
     """A session on one source: by catalogue name or by RA/Dec, from a start time."""
 
-    source: str | None = param("3C 286", "the source, from the built-in catalogue (sims.fast.SOURCES); none: "
-                               "source_radec", choices=tuple(SOURCES), excludes=("source_radec",))
+    source: str | None = param("3C 286", "the source, from the built-in catalogue (sims.fast.SOURCES); for "
+                               "source_radec instead leave it out (a scenario file: giving source_radec clears "
+                               "it) or --set source=none", choices=tuple(SOURCES), excludes=("source_radec",))
     source_radec: tuple[float, ...] | None = param(
         None, "the source's ICRS (J2000) right ascension and declination; none: source", unit=("deg", "deg"),
         low=(0.0, -90.0), high=(360.0, 90.0), reason="RA and Dec", length=2, excludes=("source",))
@@ -677,8 +680,11 @@ class FastSourceParams(FastParams):
 
     def check(self) -> None:
         super().check()
-        if (self.source is None) == (self.source_radec is None):
-            raise ParamError("give source or source_radec, one of them")
+        if self.source is not None and self.source_radec is not None:
+            raise ParamError(f"source = {self.source!r} and source_radec = {list(self.source_radec)} are both given: "
+                             "give one (leave source out to observe at source_radec)")
+        if self.source is None and self.source_radec is None:
+            raise ParamError("source and source_radec are both none: give one (a catalogue name or [RA, Dec] deg)")
 
 
 @dataclass(frozen=True)
