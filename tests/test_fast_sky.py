@@ -471,7 +471,80 @@ def test_bad_input_names_the_value(call, text):
     assert text in str(info.value)
 
 
-def test_site_is_fast_per_reference_md():
-    assert math.degrees(fs.FAST_SITE.latitude) == pytest.approx(25.653, abs=1e-12)
-    assert math.degrees(fs.FAST_SITE.longitude) == pytest.approx(106.856, abs=1e-12)
-    assert fs.SITE_LATITUDE == fs.FAST_SITE.latitude and 500.0 <= fs.SITE_HEIGHT <= 1500.0
+def test_site_is_fasts_published_itrf_position():
+    """The observatory's ITRF coordinates (-1668557.0, 5506838.0, 2744934.0) m on WGS84."""
+    assert math.degrees(fs.FAST_SITE.latitude) == pytest.approx(25.652946, abs=1e-6)
+    assert math.degrees(fs.FAST_SITE.longitude) == pytest.approx(106.856666, abs=1e-6)
+    assert fs.FAST_SITE.height == pytest.approx(1109.1, abs=0.05)
+    back = erfa.gd2gc(1, fs.FAST_SITE.longitude, fs.FAST_SITE.latitude, fs.FAST_SITE.height)
+    np.testing.assert_allclose(back, fs.FAST_ITRF_XYZ, atol=1e-6)
+    assert fs.SITE_LATITUDE == fs.FAST_SITE.latitude
+
+
+def _independent_azel(ra, dec, jd1, jd2, dut1):
+    """(az, el), rad, by the equinox route from erfa's primitives, not the planner's CIO chain
+    (atco13 / apco13 + atciq + atioq): Sun's light deflection (ld), annual + diurnal
+    aberration from the observer's barycentric velocity (epv00 + the site's rotation) (ab),
+    the IAU 2006/2000A bias-precession-nutation matrix (pnm06a) and Greenwich apparent
+    sidereal time (gst06a) to the terrestrial frame, polar motion 0, then the geodetic
+    horizon of the published ITRF position. No refraction, as the plan."""
+    ctx = _quiet()
+    try:
+        tai1, tai2 = erfa.utctai(jd1, jd2)
+        tt1, tt2 = erfa.taitt(tai1, tai2)
+        ut1, ut2 = erfa.utcut1(jd1, jd2, dut1)
+        pvh, pvb = erfa.epv00(tt1, tt2)
+        rnpb = erfa.pnm06a(tt1, tt2)
+        gast = erfa.gst06a(ut1, ut2, tt1, tt2)
+    finally:
+        ctx.__exit__(None, None, None)
+    r_itrs = np.asarray(fs.FAST_ITRF_XYZ, dtype=float)
+    omega = fs.EARTH_ROTATION_RATE
+    v_itrs = omega * np.array([-r_itrs[1], r_itrs[0], 0.0])  # m/s, the site's rotation
+    r3 = erfa.rz(-gast, np.eye(3))  # true-of-date -> terrestrial is R3(gast); its inverse
+    to_gcrs = rnpb.T @ r3
+    r_obs = to_gcrs @ r_itrs / erfa.DAU
+    v_obs = pvb[1] + (to_gcrs @ v_itrs) / erfa.DAU * 86400.0  # au/d
+    p_sun = pvh[0] + r_obs  # Sun -> observer, au
+    em = np.linalg.norm(p_sun)
+    c_au_d = erfa.CMPS * 86400.0 / erfa.DAU
+    v = v_obs / c_au_d
+    bm1 = math.sqrt(1.0 - v @ v)
+    p = erfa.s2c(ra, dec)
+    p = erfa.ld(1.0, p, p, p_sun / em, em, 1e-6)
+    p = erfa.ab(p, v, em, bm1)
+    t = erfa.rz(gast, np.eye(3)) @ rnpb @ p  # GCRS -> terrestrial (polar motion 0)
+    lon, lat = fs.FAST_SITE.longitude, fs.FAST_SITE.latitude
+    east = np.array([-math.sin(lon), math.cos(lon), 0.0])
+    north = np.array([-math.sin(lat) * math.cos(lon), -math.sin(lat) * math.sin(lon), math.cos(lat)])
+    up = np.array([math.cos(lat) * math.cos(lon), math.cos(lat) * math.sin(lon), math.sin(lat)])
+    return math.atan2(t @ east, t @ north) % (2 * math.pi), math.asin(t @ up)
+
+
+@pytest.mark.parametrize("dut1", [0.0, -0.35, 0.8])
+def test_plan_agrees_with_an_independent_ephemeris_across_a_transit(dut1):
+    """3C 286 tracked for 4 h across its transit (the plan's hourly astrometry and atco13):
+    within 0.5 arcsec of the equinox route above on the sky, at the same UT1 - UTC."""
+    ra, dec = math.radians(202.784533), math.radians(30.509155)
+    transit = fs.meridian_transit(ra, dec, "2026-03-01T00:00:00", dut1=dut1)
+    offsets = np.linspace(-2 * 3600.0, 2 * 3600.0, 9)
+    jd1, jd2 = fs.utc_jd((float(transit[0]), float(transit[1])), offsets)
+    worst = 0.0
+    for exact in (False, True):
+        az, el = fs.observed_azel(ra, dec, (jd1, jd2), exact=exact, dut1=dut1)
+        for i in range(offsets.size):
+            az_i, el_i = _independent_azel(ra, dec, float(jd1[i]), float(jd2[i]), dut1)
+            sep = erfa.seps(az[i], el[i], az_i, el_i)
+            worst = max(worst, sep / ARCSEC)
+    assert worst <= 0.5, f"{worst:.3f} arcsec"
+    if dut1:  # the parameter reaches the plan: 0 instead is off by about dut1 of rotation
+        az0, el0 = fs.observed_azel(ra, dec, (jd1, jd2), dut1=0.0)
+        az1, el1 = fs.observed_azel(ra, dec, (jd1, jd2), dut1=dut1)
+        shift = erfa.seps(az0, el0, az1, el1) / ARCSEC
+        assert np.all(shift > 0.5 * abs(dut1) * 15.0 * math.cos(dec))
+
+
+@pytest.mark.parametrize("dut1", [0.9, -0.9, 1e9, float("nan")])
+def test_ut1_minus_utc_beyond_09_s_is_refused(dut1):
+    with pytest.raises(PlanningError, match="UT1 - UTC"):
+        fs.observed_azel(0.0, 0.0, "2026-03-01T00:00:00", dut1=dut1)

@@ -7,10 +7,12 @@ Table 1 (zenith angle up to 40 deg). Site and astronomy: ``shared/REFERENCE.md``
 
 Site
 ----
-Geodetic latitude 25.653 deg N, longitude 106.856 deg E (REFERENCE.md). The height is an
-assumption: 1000 m above the WGS84 ellipsoid (the dish lies in a karst depression at roughly
-that altitude). For sources at infinity it only enters the diurnal aberration (at most
-0.3 arcsec in all), so it hardly matters.
+FAST's published geocentric (ITRF) coordinates, X = -1668557.0 m, Y = 5506838.0 m,
+Z = 2744934.0 m: the observatory's site file of 2019-09-19 (https://crafts.bao.ac.cn/pub/fast/
+time/fast-coord.txt, the coordinates TEMPO2's observatories.dat and PINT use for FAST, code
+"FA"). On the WGS84 ellipsoid (``erfa.gc2gd``) they are longitude 106.856666 deg E, geodetic
+latitude 25.652946 deg N, height 1109.1 m (``FAST_SITE``). The rounded 106.856 E, 25.653 N
+put the sky about 3 arcsec off.
 
 Astronomy (pyerfa, the IAU SOFA library)
 ----------------------------------------
@@ -20,7 +22,8 @@ with these settings:
 
 * no refraction: a radio telescope; pressure 0 switches ERFA's refraction model off;
 * polar motion xp = yp = 0: at most ~0.5 arcsec;
-* dut1 = UT1 - UTC = 0: |UT1 - UTC| < 0.9 s by the definition of UTC, i.e. at most 0.9 s of
+* dut1 = UT1 - UTC, s: a parameter (``dut1=``, default 0; the IERS Bulletin A gives the day's
+  value). |UT1 - UTC| < 0.9 s by the definition of UTC (``MAX_DUT1``), so 0 is at most 0.9 s of
   Earth rotation, 13.5 arcsec of hour angle: on the sky at most 13.5 arcsec x cos(dec); in
   azimuth (d az/dH = sin(lat) - cos(lat) cos(az) tan(el)) at most 13.5 arcsec x
   cos(lat - ZA) / sin(ZA) -- 6 arcsec at the horizon, 20 at ZA = 40 deg, 27 at 30 deg,
@@ -130,8 +133,13 @@ class Site:
     height: float
 
 
-#: FAST (REFERENCE.md); the 1000 m height is an assumption (module docstring).
-FAST_SITE = Site(latitude=math.radians(25.653), longitude=math.radians(106.856), height=1000.0)
+#: FAST's published ITRF coordinates, m (the observatory's site file of 2019-09-19, module docstring).
+FAST_ITRF_XYZ = (-1668557.0, 5506838.0, 2744934.0)
+_lon, _lat, _height = erfa.gc2gd(1, np.array(FAST_ITRF_XYZ))  # WGS84
+#: FAST on WGS84: 106.856666 deg E, 25.652946 deg N, 1109.1 m.
+FAST_SITE = Site(latitude=float(_lat), longitude=float(_lon), height=float(_height))
+#: |UT1 - UTC| stays below 0.9 s by the definition of UTC.
+MAX_DUT1 = 0.9  # s
 SITE_LATITUDE = FAST_SITE.latitude
 SITE_LONGITUDE = FAST_SITE.longitude
 SITE_HEIGHT = FAST_SITE.height
@@ -169,6 +177,15 @@ def _declination(name: str, value) -> np.ndarray:
         bad = float(d[np.abs(d) > math.pi / 2].flat[0])
         raise PlanningError(f"{name} {math.degrees(bad):.6g} deg is beyond +/-90 deg")
     return d
+
+
+def _dut1(dut1) -> float:
+    """UT1 - UTC, s: finite, |dut1| < 0.9 s."""
+    v = float(_finite("UT1 - UTC", dut1, "s"))
+    if not abs(v) < MAX_DUT1:
+        raise PlanningError(f"UT1 - UTC {v!r} s is outside (-{MAX_DUT1:g}, {MAX_DUT1:g}) s, the range UTC "
+                            "keeps it in")
+    return v
 
 
 def _check_site(site: Site) -> None:
@@ -249,7 +266,7 @@ def jd_to_iso(jd1, jd2) -> str | np.ndarray:
 # ----------------------------------------------------------------------------- astrometry
 
 
-def _astrom(jd1, jd2, site: Site):
+def _astrom(jd1, jd2, site: Site, dut1: float = 0.0):
     """ERFA star-independent astrometry for each UTC (jd1, jd2): ``eraApco13`` on the whole
     clock hours (counted from J2000) around each sample, interpolated linearly in time between
     them (continuous, so finite differences of a path see no steps; the fields -- Earth
@@ -262,7 +279,7 @@ def _astrom(jd1, jd2, site: Site):
     f = hours - k
     anchors, inverse = np.unique(np.concatenate([k.ravel(), k.ravel() + 1.0]), return_inverse=True)
     with _quiet_erfa():
-        table, _ = erfa.apco13(_J2000, anchors / per_day, 0.0, site.longitude, site.latitude,
+        table, _ = erfa.apco13(_J2000, anchors / per_day, dut1, site.longitude, site.latitude,
                                site.height, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         table = np.atleast_1d(table)
         lo = table[inverse[:k.size].reshape(k.shape)]
@@ -271,29 +288,30 @@ def _astrom(jd1, jd2, site: Site):
         for name in table.dtype.names:
             w = f.reshape(f.shape + (1,) * (lo[name].ndim - f.ndim))
             astrom[name] = (1.0 - w) * lo[name] + w * hi[name]
-        ut11, ut12 = erfa.utcut1(jd1, jd2, 0.0)
+        ut11, ut12 = erfa.utcut1(jd1, jd2, dut1)
         return erfa.aper13(ut11, ut12, astrom)
 
 
-def _observed(ra, dec, utc, site: Site, exact: bool):
+def _observed(ra, dec, utc, site: Site, exact: bool, dut1: float = 0.0):
     """(azimuth, zenith distance, hour angle, declination) observed; arrays broadcast."""
     _check_site(site)
+    dut1 = _dut1(dut1)
     ra = _finite("right ascension", ra, "rad")
     dec = _declination("declination", dec)
     jd1, jd2 = as_utc_jd(utc)
     with _quiet_erfa():
         if exact:
             aob, zob, hob, dob, _, _ = erfa.atco13(
-                ra, dec, 0.0, 0.0, 0.0, 0.0, jd1, jd2, 0.0, site.longitude, site.latitude,
+                ra, dec, 0.0, 0.0, 0.0, 0.0, jd1, jd2, dut1, site.longitude, site.latitude,
                 site.height, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         else:
-            astrom = _astrom(jd1, jd2, site)
+            astrom = _astrom(jd1, jd2, site, dut1)
             ri, di = erfa.atciq(ra, dec, 0.0, 0.0, 0.0, 0.0, astrom)
             aob, zob, hob, dob, _ = erfa.atioq(ri, di, astrom)
     return aob, zob, hob, dob
 
 
-def observed_azel(ra, dec, utc, *, site: Site = FAST_SITE, exact: bool = False):
+def observed_azel(ra, dec, utc, *, site: Site = FAST_SITE, exact: bool = False, dut1: float = 0.0):
     """Azimuth and elevation (rad) at the site of ICRS (J2000) positions at UTC times.
 
     Args:
@@ -301,16 +319,16 @@ def observed_azel(ra, dec, utc, *, site: Site = FAST_SITE, exact: bool = False):
       utc: datetime64 / ISO 8601 string(s) / two-part UTC quasi JD ``(jd1, jd2)`` (arrays).
       site: the observatory (default FAST).
       exact: ``eraAtco13`` per sample instead of the hourly astrometry (module docstring).
+      dut1: UT1 - UTC, s (|dut1| < 0.9 s; default 0).
     Returns (az, el): azimuth from north through east in [0, 2 pi), elevation, rad; shape the
-    broadcast of ra, dec and the times. No refraction, dut1 = 0 (< 0.9 s of time, ~13 arcsec
-    of azimuth at most away from the zenith), no polar motion.
+    broadcast of ra, dec and the times. No refraction (radio), no polar motion.
     Raises PlanningError for NaN, |dec| > 90 deg or bad times.
     """
-    aob, zob, _, _ = _observed(ra, dec, utc, site, exact)
+    aob, zob, _, _ = _observed(ra, dec, utc, site, exact, dut1)
     return np.mod(aob, 2.0 * np.pi), np.pi / 2 - zob
 
 
-def sky_position(az, el, utc, *, site: Site = FAST_SITE):
+def sky_position(az, el, utc, *, site: Site = FAST_SITE, dut1: float = 0.0):
     """ICRS (ra, dec), rad, of the direction (az, el) at the site at UTC times (the inverse of
     ``observed_azel``: ``eraAtoiq`` then ``eraAticq``, same settings)."""
     _check_site(site)
@@ -318,13 +336,14 @@ def sky_position(az, el, utc, *, site: Site = FAST_SITE):
     el = _declination("elevation", el)
     jd1, jd2 = as_utc_jd(utc)
     with _quiet_erfa():
-        astrom = _astrom(jd1, jd2, site)
+        astrom = _astrom(jd1, jd2, site, _dut1(dut1))
         ri, di = erfa.atoiq("A", az, np.pi / 2 - el, astrom)
         rc, dc = erfa.aticq(ri, di, astrom)
     return np.mod(rc, 2.0 * np.pi), dc
 
 
-def meridian_transit(ra, dec, near, *, site: Site = FAST_SITE) -> tuple[np.ndarray, np.ndarray]:
+def meridian_transit(ra, dec, near, *, site: Site = FAST_SITE,
+                     dut1: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """UTC (jd1, jd2) of the upper meridian transit (observed hour angle 0) nearest ``near``.
 
     Newton's method on the hour angle from ``observed_azel``'s chain, whose rate is the Earth
@@ -333,7 +352,7 @@ def meridian_transit(ra, dec, near, *, site: Site = FAST_SITE) -> tuple[np.ndarr
     """
     jd1, jd2 = as_utc_jd(near)
     for _ in range(3):
-        _, _, hob, _ = _observed(ra, dec, (jd1, jd2), site, exact=False)
+        _, _, hob, _ = _observed(ra, dec, (jd1, jd2), site, False, dut1)
         h = np.mod(hob + np.pi, 2.0 * np.pi) - np.pi
         jd2 = jd2 - h / EARTH_ROTATION_RATE / SECONDS_PER_DAY
         jd1, jd2 = np.broadcast_arrays(jd1, jd2)
@@ -466,7 +485,7 @@ def _limit(za_limit):
 
 def track(ra: float, dec: float, start, duration: float, *, step: float = 1.0,
           za_limit: float | None = MAX_ZENITH_ANGLE, site: Site = FAST_SITE,
-          exact: bool = False) -> SkyPath:
+          exact: bool = False, dut1: float = 0.0) -> SkyPath:
     """Tracking: the beam follows the fixed ICRS (ra, dec), rad, from ``start`` (UTC, see
     ``utc_jd``) for ``duration`` s, sampled every ``step`` s (and at the end).
 
@@ -480,7 +499,7 @@ def track(ra: float, dec: float, start, duration: float, *, step: float = 1.0,
     limit = _limit(za_limit)
     t = _sample_times(duration, step)
     jd1, jd2 = utc_jd(start, t)
-    az, el = observed_azel(ra, dec, (jd1, jd2), site=site, exact=exact)
+    az, el = observed_azel(ra, dec, (jd1, jd2), site=site, exact=exact, dut1=dut1)
     _check_zenith(f"the source at RA {math.degrees(ra):.4f} deg, Dec {math.degrees(dec):.4f} deg",
                   np.pi / 2 - el, t, jd1, jd2, limit)
     n = t.size
@@ -489,7 +508,8 @@ def track(ra: float, dec: float, start, duration: float, *, step: float = 1.0,
 
 
 def drift_scan(az: float, el: float, start, duration: float, *, step: float = 1.0,
-               za_limit: float | None = MAX_ZENITH_ANGLE, site: Site = FAST_SITE) -> SkyPath:
+               za_limit: float | None = MAX_ZENITH_ANGLE, site: Site = FAST_SITE,
+               dut1: float = 0.0) -> SkyPath:
     """Drift scan: the feed parked at (az, el), rad, while the sky drifts through the beam.
 
     Returns the constant az/el and the ICRS (ra, dec) the beam sees at each sample (RA grows at
@@ -507,7 +527,7 @@ def drift_scan(az: float, el: float, start, duration: float, *, step: float = 1.
     n = t.size
     _check_zenith(f"the parked beam at az {math.degrees(az):.4f} deg, el {math.degrees(el):.4f} deg",
                   np.full(n, np.pi / 2 - el), t, jd1, jd2, limit)
-    ra, dec = sky_position(np.full(n, az), np.full(n, el), (jd1, jd2), site=site)
+    ra, dec = sky_position(np.full(n, az), np.full(n, el), (jd1, jd2), site=site, dut1=dut1)
     return SkyPath(t, jd1, jd2, ra, dec, np.full(n, az), np.full(n, el), np.ones(n, bool),
                    np.zeros(n, int), np.array([0.0]), np.array([duration]))
 
@@ -633,7 +653,7 @@ class MotionScan:
         return np.mod(ra, 2.0 * np.pi), dec, on_leg, k
 
     def path(self, start, *, step: float = 1.0, za_limit: float | None = MAX_ZENITH_ANGLE,
-             site: Site = FAST_SITE, exact: bool = False) -> SkyPath:
+             site: Site = FAST_SITE, exact: bool = False, dut1: float = 0.0) -> SkyPath:
         """The scan from ``start`` (UTC) sampled every ``step`` s and at every leg start and
         end; LimitError at the first sample beyond ``za_limit`` (40 deg; None: no check)."""
         step = _positive("step", step, "s")
@@ -641,7 +661,7 @@ class MotionScan:
         t = _sample_times(self.duration, step, np.concatenate([self.leg_start, self.leg_end]))
         ra, dec, on_leg, leg = self.sky(t)
         jd1, jd2 = utc_jd(start, t)
-        az, el = observed_azel(ra, dec, (jd1, jd2), site=site, exact=exact)
+        az, el = observed_azel(ra, dec, (jd1, jd2), site=site, exact=exact, dut1=dut1)
         _check_zenith(f"the {self.paper_name.split(' (')[0]} centred at RA "
                       f"{math.degrees(self.ra):.4f} deg, Dec {math.degrees(self.dec):.4f} deg",
                       np.pi / 2 - el, t, jd1, jd2, limit)
