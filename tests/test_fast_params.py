@@ -45,3 +45,21 @@ def test_wind_file_direction_beyond_one_turn_is_refused(tmp_path, direction, ok)
     with pytest.raises(WindFileError, match=rf"line 3: direction {re.escape(f'{direction:g}')} deg is outside "
                                             rf"\[-{MAX_DIRECTION_DEG:g}, {MAX_DIRECTION_DEG:g}\] deg"):
         MeasuredWind(path)
+
+
+def test_dut1_reaches_the_plan():
+    """UT1 - UTC = +0.5 s: the transit, hence the default observation's start, 0.5 s earlier in UTC."""
+    from planners.fast import sky
+
+    a = fast.goal_plan(fast.FastTrackingParams(tracking=60.0))
+    b = fast.goal_plan(fast.FastTrackingParams(tracking=60.0, dut1=0.5))
+    ta = sky.as_utc_jd(a.info["observation_start_utc"])
+    tb = sky.as_utc_jd(b.info["observation_start_utc"])
+    shift = ((ta[0] - tb[0]) + (ta[1] - tb[1])) * 86400.0
+    assert float(shift) == pytest.approx(0.5, abs=2e-3)
+
+
+@pytest.mark.parametrize("dut1", [0.9, -0.9, 5.0])
+def test_dut1_outside_09_s_is_refused(dut1):
+    with pytest.raises(ParamError, match=rf"^dut1 = {dut1:g} s is outside \(-0.9, 0.9\) s"):
+        fast.FastTrackingParams(dut1=dut1)

@@ -618,17 +618,18 @@ class FastPlan:
 # ----------------------------------------------------------------------------- motion scans
 
 
-def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX):
+def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX, dut1: float = 0.0):
     """Observation legs and transitions of a motion scan (section 3.3).
 
     ``scan``: a planners.fast.sky.MotionScan; ``start``: its start UTC. Each leg follows the
     sky (``observation_segment``); between legs a transition of the scan's t2 joins the end
     state of one leg to the start state of the next (``transition_segment``). Raises
-    LimitError when a transition would need more than ``a_limit`` (A_t-max).
+    LimitError when a transition would need more than ``a_limit`` (A_t-max). ``dut1``: UT1 -
+    UTC, s.
     """
     from planners.fast.sky import parallactic_angle
 
-    path = scan.path(start, step=step)
+    path = scan.path(start, step=step, dut1=dut1)
     directions = path.directions()
     angles = parallactic_angle(path.az, path.el)
     legs = []
@@ -652,9 +653,9 @@ def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX)
     return segments, path, peaks
 
 
-def _transition_peaks(scan, start, step: float) -> list[float]:
+def _transition_peaks(scan, start, step: float, dut1: float = 0.0) -> list[float]:
     """Peak Hermite accelerations of a scan's transitions (m/s^2)."""
-    path = scan.path(start, step=step)
+    path = scan.path(start, step=step, dut1=dut1)
     directions = path.directions()
     legs = []
     for k in range(scan.n_legs):
@@ -669,11 +670,11 @@ def _transition_peaks(scan, start, step: float) -> list[float]:
 
 
 def minimum_t2(make_scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX,
-               tolerance: float = 0.01) -> float:
+               tolerance: float = 0.01, dut1: float = 0.0) -> float:
     """The shortest t2 (to ``tolerance`` s) whose transitions all keep |a| <= A_t-max: the
     geometric t2. ``make_scan(t2)`` builds the MotionScan; the sky turns during t2, so the
     legs' end states depend on it and every trial rebuilds the raster (bisection)."""
-    feasible = lambda t2: max(_transition_peaks(make_scan(t2), start, step), default=0.0) <= a_limit
+    feasible = lambda t2: max(_transition_peaks(make_scan(t2), start, step, dut1), default=0.0) <= a_limit
     lo, hi = 0.0, 1.0
     while not feasible(hi):
         lo, hi = hi, 2.0 * hi

@@ -79,32 +79,34 @@ def source_name(source) -> str:
     return f"RA {np.degrees(source[0]):.4f} Dec {np.degrees(source[1]):+.4f}"
 
 
-def _transit(source):
+def _transit(source, dut1: float = 0.0):
     ra, dec = _radec(source)
-    return sky.meridian_transit(ra, dec, OBSERVING_NIGHT)
+    return sky.meridian_transit(ra, dec, OBSERVING_NIGHT, dut1=dut1)
 
 
-def _start(source, start_utc: str | None, duration: float):
+def _start(source, start_utc: str | None, duration: float, dut1: float = 0.0):
     """(jd1, jd2) of an observation's start: ``start_utc``, or centred on the transit."""
     if start_utc is not None:
         jd1, jd2 = sky.as_utc_jd(start_utc)
         return float(np.ravel(jd1)[0]), float(np.ravel(jd2)[0])
-    jd1, jd2 = _transit(source)
+    jd1, jd2 = _transit(source, dut1)
     return jd1, jd2 - 0.5 * duration / 86400.0
 
 
-def _observation(source, start_jd, duration: float, name: str):
+def _observation(source, start_jd, duration: float, name: str, dut1: float = 0.0):
     ra, dec = _radec(source)
-    path = sky.track(ra, dec, start_jd, duration, step=TRACK_STEP_S)
+    path = sky.track(ra, dec, start_jd, duration, step=TRACK_STEP_S, dut1=dut1)
     angles = sky.parallactic_angle(path.az, path.el)  # the 19-beam rotation follows it
     return fp.observation_segment(path.t, path.directions(), name=name, angles=angles), path
 
 
-def tracking_plan(duration: float = 1200.0, source="3C 286", start_utc: str | None = None) -> fp.FastPlan:
+def tracking_plan(duration: float = 1200.0, source="3C 286", start_utc: str | None = None,
+                  dut1: float = 0.0) -> fp.FastPlan:
     """Park -> source (switch), start, ``duration`` s of tracking from ``start_utc`` (default
-    centred on the transit), termination. ``source``: a catalogue name or (ra, dec) rad."""
-    obs, path = _observation(source, _start(source, start_utc, duration), duration,
-                             f"observation ({source_name(source)})")
+    centred on the transit), termination. ``source``: a catalogue name or (ra, dec) rad;
+    ``dut1``: UT1 - UTC, s."""
+    obs, path = _observation(source, _start(source, start_utc, duration, dut1), duration,
+                             f"observation ({source_name(source)})", dut1)
     start, stop = fp.start_segment(obs), fp.termination_segment(obs)
     switch, times = fp.switch_segments(PARK, start.start, multifeed1=fp.start_angle(obs, start))
     return fp.FastPlan(switch + [start, obs, stop], info={
@@ -113,15 +115,15 @@ def tracking_plan(duration: float = 1200.0, source="3C 286", start_utc: str | No
 
 
 def source_switch_plan(duration: float = 300.0, sources=("3C 286", "3C 295"),
-                       start_utc: str | None = None) -> fp.FastPlan:
+                       start_utc: str | None = None, dut1: float = 0.0) -> fp.FastPlan:
     """Park -> the first source, track, stop; then for each next source a switch along the
     focal surface, track, stop. The first observation starts at ``start_utc`` (default the
     first source's transit), each next one when the switch to it ends."""
     if start_utc is None:
-        jd1, jd2 = _transit(sources[0])
+        jd1, jd2 = _transit(sources[0], dut1)
     else:
-        jd1, jd2 = _start(sources[0], start_utc, duration)
-    obs_a, _ = _observation(sources[0], (jd1, jd2), duration, f"observation ({source_name(sources[0])})")
+        jd1, jd2 = _start(sources[0], start_utc, duration, dut1)
+    obs_a, _ = _observation(sources[0], (jd1, jd2), duration, f"observation ({source_name(sources[0])})", dut1)
     start_a, stop_a = fp.start_segment(obs_a), fp.termination_segment(obs_a)
     switch_a, times_a = fp.switch_segments(PARK, start_a.start, multifeed1=fp.start_angle(obs_a, start_a))
     segments, all_times = switch_a + [start_a, obs_a, stop_a], [times_a.__dict__]
@@ -134,7 +136,7 @@ def source_switch_plan(duration: float = 300.0, sources=("3C 286", "3C 295"),
         for _ in range(3):
             offset = guess + 1.0  # s from the first observation's start
             obs_b, _ = _observation(source, (jd1, jd2 + offset / 86400.0), duration,
-                                    f"observation ({source_name(source)})")
+                                    f"observation ({source_name(source)})", dut1)
             start_b = fp.start_segment(obs_b)
             switch_b, times_b = fp.switch_segments(p0, start_b.start, multifeed0=fp.end_angle(obs_a, stop_a),
                                                    multifeed1=fp.start_angle(obs_b, start_b))
@@ -197,7 +199,7 @@ def _leg_state(segment, at_end: bool):
     return tuple(x[0] for x in segment.evaluate(tau))
 
 
-def scan_plan(spec: dict, source="3C 286", start_utc: str | None = None) -> fp.FastPlan:
+def scan_plan(spec: dict, source="3C 286", start_utc: str | None = None, dut1: float = 0.0) -> fp.FastPlan:
     """Park -> the raster's start (switch), start, legs with transitions, termination; the
     raster around ``source`` (a catalogue name or (ra, dec) rad), from ``start_utc`` (default
     centred on its transit).
@@ -207,10 +209,10 @@ def scan_plan(spec: dict, source="3C 286", start_utc: str | None = None) -> fp.F
     """
     make = _scan_factory(spec, source)
     first = make(60.0)
-    start_jd = _start(source, start_utc, first.duration)
-    t2 = fp.minimum_t2(make, start_jd)
+    start_jd = _start(source, start_utc, first.duration, dut1)
+    t2 = fp.minimum_t2(make, start_jd, dut1=dut1)
     scan = make(t2)
-    segments, path, peaks = fp.scan_segments(scan, start_jd)
+    segments, path, peaks = fp.scan_segments(scan, start_jd, dut1=dut1)
     start, stop = fp.start_segment(segments[0]), fp.termination_segment(segments[-1])
     switch, times = fp.switch_segments(PARK, start.start, multifeed1=fp.start_angle(segments[0], start))
     legs = [s for s in segments if s.name.startswith("leg")]
@@ -558,13 +560,13 @@ def goal_plan(params: "FastParams") -> fp.FastPlan:
     that leaves FAST's 40 deg zenith-angle range during it is a ParamError naming the keys."""
     try:
         if isinstance(params, FastTrackingParams):
-            return tracking_plan(params.tracking, params.source_of(), params.start_utc)
+            return tracking_plan(params.tracking, params.source_of(), params.start_utc, params.dut1)
         if isinstance(params, FastScanParams):
             spec = {"legs_along": params.legs_along, "speed_deg_h": params.scan_speed, "leg_deg": params.leg_length,
                     "legs": params.legs, "spacing_deg": params.leg_spacing}
-            return scan_plan(spec, params.source_of(), params.start_utc)
+            return scan_plan(spec, params.source_of(), params.start_utc, params.dut1)
         if isinstance(params, FastSwitchParams):
-            return source_switch_plan(params.tracking, params.sources, params.start_utc)
+            return source_switch_plan(params.tracking, params.sources, params.start_utc, params.dut1)
     except fast.ZenithLimitError as e:
         keys = "sources, start_utc" if isinstance(params, FastSwitchParams) else "source, start_utc"
         raise ParamError(f"{keys}: {e} (FAST observes within 40 deg of the zenith, Table 1)") from None
@@ -621,6 +623,9 @@ class FastParams(ScenarioParams):
                                    low=10.0, high=1.0 / PHYSICS_DT,
                                    reason="the 2 ms physics step divided by a whole number (500, 250, 166.7, "
                                           "125, 100, 83.3, 71.4, 62.5, 55.6, 50, ... 10 Hz)")
+    dut1: float = param(0.0, "UT1 - UTC of the observing day (the IERS Bulletin A's value; 0: UTC taken for UT1, "
+                        "at most 0.9 s = 13.5 arcsec of hour angle off)", "s", low=-sky.MAX_DUT1, high=sky.MAX_DUT1,
+                        low_open=True, high_open=True, reason="|UT1 - UTC| < 0.9 s by the definition of UTC")
 
     def check(self) -> None:
         # The start time first: later checks (the source's zenith angle) compute with it.
@@ -698,9 +703,9 @@ class FastTrackingParams(FastSourceParams):
     def check(self) -> None:
         super().check()
         ra, dec = _radec(self.source_of())
-        start = _start(self.source_of(), self.start_utc, self.tracking)
+        start = _start(self.source_of(), self.start_utc, self.tracking, self.dut1)
         try:
-            sky.track(ra, dec, start, self.tracking, step=max(self.tracking / 100.0, 1.0))
+            sky.track(ra, dec, start, self.tracking, step=max(self.tracking / 100.0, 1.0), dut1=self.dut1)
         except fast.ZenithLimitError as e:
             raise ParamError(f"source, start_utc, tracking: {e} (FAST observes within 40 deg of the zenith, "
                              "Table 1)") from None
