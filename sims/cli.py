@@ -75,7 +75,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 #: Options of ``run`` and ``plan`` that are not parameters (no parameter may take these names).
-RUN_OPTIONS = ("out", "video", "camera", "quiet", "planner", "controller", "set", "help")
+RUN_OPTIONS = ("out", "video", "camera", "quiet", "planner", "controller", "set", "help", "timeout")
 
 
 def _flag(name: str) -> str:
@@ -121,6 +121,9 @@ def scenario_parser(command: str, scenario, source: str) -> argparse.ArgumentPar
         parser.add_argument("--video", help="write an H.264 video of the run here (.mp4, .m4v, .mov, .mkv)")
         parser.add_argument("--camera", default=None, help="video camera: overview or closeup")
         parser.add_argument("--quiet", action="store_true", help="no progress bars")
+        parser.add_argument("--timeout", metavar="SECONDS",
+                            help="wall-time limit of the run, s (default: 600 s plus the simulated duration); "
+                                 "a run past it is stopped and fails its wall_time check")
     else:
         parser.add_argument("--out", required=True, help="output directory; replaced only if planbench wrote it")
     return parser
@@ -207,9 +210,41 @@ def _scenario_help(command: str, argv: list[str]) -> int | None:
     return EXIT_OK
 
 
+def _timeout(raw: str | None) -> float | None:
+    """``--timeout SECONDS``: a finite number > 0 (None: the default, sims.supervise)."""
+    if raw is None:
+        return None
+    try:
+        value = float(raw)
+    except ValueError:
+        raise BadInput(f"--timeout {raw!r} is not a number of seconds") from None
+    if not value > 0 or value == float("inf"):
+        raise BadInput(f"--timeout {raw} s must be a finite number of seconds > 0")
+    return value
+
+
+def _plugin_names(plugins: dict) -> str:
+    return ", ".join(f"--{role} {spec}" for role, spec in plugins.items()) or "planbench's own components"
+
+
+def _write_unfinished(out, scenario, params, plugins: dict, check) -> None:
+    """summary.json of a run that did not complete (it hung or its process ended): passed
+    false, the one check that says why; no timeseries (the log died with the process)."""
+    import json
+
+    from sims.outputs import software_versions
+
+    summary = {"scenario": scenario.name, "passed": False, "seed": getattr(params, "seed", None),
+               "completed": False, "parameters": params.to_dict(), "versions": software_versions(),
+               "plugins": plugins, "checks": [check.to_json()], "metrics": {}}
+    with out.staging({"scenario": scenario.name}) as tmp:
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+
+
 def cmd_run(argv: list[str]) -> int:
-    from sims import api, outputs, runner
+    from sims import api, outputs, runner, supervise
     from sims import plugins as plugins_module
+    from sims.checks import Check
 
     shown = _scenario_help("run", argv)
     if shown is not None:
@@ -217,11 +252,12 @@ def cmd_run(argv: list[str]) -> int:
     source, args, params, plant = _resolve_source("run", argv)
     scenario = source.scenario
     camera = _camera(scenario, args.camera)
+    timeout = _timeout(args.timeout)
     plugins = dict(source.plugins)
     plugins.update({role: spec for role, spec in (("planner", args.planner), ("controller", args.controller))
                     if spec is not None})
-    made = {role: plugins_module.make(plugin_spec, role, online_planner=scenario.online_planner)
-            for role, plugin_spec in plugins.items()}
+    for role, spec in plugins.items():  # the spec's form, before anything is reserved
+        plugins_module.split_spec(spec, role)
     if source.recorded_versions:
         now = outputs.software_versions()
         differ = {k: (v, now.get(k)) for k, v in source.recorded_versions.items() if now.get(k) != v}
@@ -231,18 +267,49 @@ def cmd_run(argv: list[str]) -> int:
                   + "; the rerun may differ", file=sys.stderr)
     out = outputs.OutputDir(Path("results") / scenario.name if args.out is None else args.out)
     video = None if args.video is None else outputs.VideoFile(args.video, out)
+
+    def work():
+        # In the supervised child: the plug-ins' code runs here only.
+        made = {role: plugins_module.make(plugin_spec, role, online_planner=scenario.online_planner)
+                for role, plugin_spec in plugins.items()}
+        setup = api.build(scenario, params, plant, **made)
+        supervise.report_duration(setup.duration)
+        result = runner.run(scenario.name, setup, quiet=args.quiet)
+        result.plugins = plugins
+        supervise.phase("writing the outputs (planbench's own code)")
+        outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
+        return ([(scenario.name, c) for c in result.checks], result.passed, result.sim_time_s, result.wall_time_s)
+
     with contextlib.ExitStack() as reserved:  # lock before simulating: a second run is refused
         reserved.enter_context(out.reserved())
         if video is not None:
             reserved.enter_context(video.reserved())
-        setup = api.build(scenario, params, plant, **made)
-        result = runner.run(scenario.name, setup, quiet=args.quiet)
-        result.plugins = plugins
-        outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
-    print(format_checks([(scenario.name, c) for c in result.checks]))
-    print(f"{'PASSED' if result.passed else 'FAILED'}: {scenario.name}, "
-          f"{result.sim_time_s:.2f} s simulated in {result.wall_time_s:.2f} s; outputs in {out}")
-    return EXIT_OK if result.passed else EXIT_CHECK_FAILED
+        try:
+            rows, passed, sim_time_s, wall_time_s = supervise.run_supervised(work, timeout)
+        except supervise.Fault as fault:
+            ended = fault.ended
+            outputs.remove_leftovers(out.path)  # the child's staging directory, if any
+            if video is not None:
+                outputs.remove_leftovers(video.path)
+            who = _plugin_names(plugins)
+            if not ended.timed_out and not ended.phase.startswith(supervise.AFTER_FIRST_STEP):
+                raise BadInput(f"the run ended in {ended.phase} ({who}) before any physics step, without "
+                               f"completing: {ended.how}; nothing was written") from None
+            if ended.timed_out:
+                check = Check("wall_time", round(ended.elapsed_s, 3), ended.limit_s, "s",
+                              note=f"the run passed its time limit in {ended.phase} ({who}) and was stopped")
+            else:
+                check = Check("run_completed", 0.0, 1.0, "count", "==",
+                              note=f"the run ended in {ended.phase} ({who}): {ended.how}")
+            _write_unfinished(out, scenario, params, plugins, check)
+            print(format_checks([(scenario.name, check)]))
+            print(f"planbench: error: {scenario.name}: {check.note}", file=sys.stderr)
+            print(f"FAILED: {scenario.name} did not complete; summary in {out}")
+            return EXIT_CHECK_FAILED
+    print(format_checks(rows))
+    print(f"{'PASSED' if passed else 'FAILED'}: {scenario.name}, "
+          f"{sim_time_s:.2f} s simulated in {wall_time_s:.2f} s; outputs in {out}")
+    return EXIT_OK if passed else EXIT_CHECK_FAILED
 
 
 def cmd_plan(argv: list[str]) -> int:

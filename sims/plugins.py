@@ -16,7 +16,8 @@ import importlib.util
 import sys
 from pathlib import Path
 
-from sims.task import PluginError, _callable_with, check_controller, check_planner
+from sims import supervise
+from sims.task import PluginError, _callable_with, check_controller, check_planner, fault_text
 
 
 def is_file(module_name: str) -> bool:
@@ -49,19 +50,21 @@ def _module(name: str, role: str):
             raise PluginError(f"--{role} {name}: not a Python file")
         module = importlib.util.module_from_spec(spec)
         sys.modules[key] = module
+        supervise.phase(f"importing --{role} {name}")
         try:
             spec.loader.exec_module(module)
-        except Exception as e:
+        except (Exception, SystemExit) as e:
             del sys.modules[key]
-            raise PluginError(f"--{role} {name}: importing it raised {type(e).__name__}: {e}") from None
+            raise PluginError(f"--{role} {name}: importing it raised {fault_text(e)}") from None
         return module
+    supervise.phase(f"importing --{role} {name}")
     try:
         return importlib.import_module(name)
     except ModuleNotFoundError as e:
         raise PluginError(f"--{role} {name}: no module named {e.name!r} (give an importable module or a "
                           "path to a .py file)") from None
-    except Exception as e:
-        raise PluginError(f"--{role} {name}: importing it raised {type(e).__name__}: {e}") from None
+    except (Exception, SystemExit) as e:
+        raise PluginError(f"--{role} {name}: importing it raised {fault_text(e)}") from None
 
 
 def load_factory(spec: str, role: str):
@@ -83,10 +86,11 @@ def make(spec: str, role: str, online_planner: bool = False):
     (``online_planner``: the antenna's planner, ``reset(problem)`` and ``step(t, attitude)``)."""
     factory = load_factory(spec, role)
     _callable_with(factory, 0, f"--{role} {spec}: the factory")
+    supervise.phase(f"the factory of --{role} {spec}")
     try:
         obj = factory()
-    except Exception as e:
-        raise PluginError(f"--{role} {spec}: the factory raised {type(e).__name__}: {e}") from None
+    except (Exception, SystemExit) as e:
+        raise PluginError(f"--{role} {spec}: the factory raised {fault_text(e)}") from None
     if role == "controller":
         check_controller(obj)
     else:

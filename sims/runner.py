@@ -28,8 +28,9 @@ from tqdm import tqdm
 
 from planners.trajectory import Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, controller_check, divergence_check
+from sims import supervise
 from sims.task import (ControlContext, Controller, PluginError, Sensors, check_controller,
-                       check_first_command, nominal_copy)
+                       check_first_command, fault_text, nominal_copy, sample_checked)
 
 #: How often (in control ticks) the loop scans for divergence: NaN or inf in the logged
 #: state since the last scan, and MuJoCo's warning counters (its bad-qacc detection resets the
@@ -217,19 +218,18 @@ def _divergence(data, qpos, qvel, times, i: int, window: int):
     return None
 
 
-def _exception_text(e: BaseException) -> str:
-    """``Type: message`` on one line, at most 300 characters."""
-    text = " ".join(f"{type(e).__name__}: {e}".split())
-    return text if len(text) <= 300 else text[:297] + "..."
+_exception_text = fault_text
 
 
 def _start(role: str, reset, argument) -> None:
-    """``reset(argument)``; any exception but a PluginError becomes one naming ``role``."""
+    """``reset(argument)``; any exception (or SystemExit) but a PluginError becomes one naming
+    ``role``."""
+    supervise.phase(f"the {role}'s reset")
     try:
         reset(argument)
     except PluginError:
         raise
-    except Exception as e:
+    except (Exception, SystemExit) as e:
         raise PluginError(f"the {role}'s reset raised {_exception_text(e)}") from None
 
 
@@ -262,7 +262,7 @@ def start_episode(setup: Setup, controller=None) -> Episode:
     model, data = physics.model.ptr, physics.data.ptr
     k = steps_per_tick(model, setup.control_dt)
     times = control_ticks(setup.duration, setup.control_dt)
-    reference = setup.trajectory.sample(times)
+    reference = sample_checked(setup.trajectory, times)
     controller = setup.controller if controller is None else controller
     check_controller(controller)
     observation = setup.sensors.reset(physics, times, setup.seed)
@@ -336,6 +336,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     last = n - 1
     clock = time.perf_counter
     controller_wall = physics_wall = 0.0
+    supervise.phase("the control loop (the controller's __call__, or an online planner's step in it)")
     start = clock()
     for i in range(n - 1):
         sensors(i, physics)
@@ -348,7 +349,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
                 ctrl_now[:] = command if i else check_first_command(command, model.nu, context.actuators)
         except PluginError:
             raise
-        except Exception as e:  # a controller's fault ends the run as a failed check
+        except (Exception, SystemExit) as e:  # a controller's fault ends the run as a failed check
             log.controller_error = (float(times[i]), _exception_text(e))
             last = i
             break
@@ -384,6 +385,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
         if i % update_every == 0:
             bar.update(update_every)
     log.loop_wall_s = clock() - start
+    supervise.phase("evaluating the run (planbench's own code)")
     if profile:
         log.controller_wall_s, log.physics_wall_s = controller_wall, physics_wall
     bar.close()

@@ -367,12 +367,17 @@ def check_trajectory(trajectory, labels: tuple, duration_min: float = 0.0) -> No
     if not isinstance(duration, (int, float, np.floating, np.integer)) or not math.isfinite(duration) \
             or duration <= 0:
         raise PluginError(f"the planner's trajectory has duration {duration!r}; it must be a finite number > 0 s")
-    if len(trajectory.labels) != len(labels):
-        raise PluginError(f"the planner's trajectory has {len(trajectory.labels)} channels "
-                          f"({', '.join(map(str, trajectory.labels))}); this task needs {len(labels)}: "
-                          f"{', '.join(labels)}")
+    try:
+        given = tuple(str(label) for label in trajectory.labels)
+    except (Exception, SystemExit) as e:
+        raise PluginError(f"the planner's trajectory labels are not a sequence of names ({fault_text(e)})") from None
+    if given != tuple(labels):
+        # The channels are matched by name, not by count: a trajectory whose third channel
+        # is another strut's would drive the wrong actuator.
+        raise PluginError(f"the planner's trajectory has {len(given)} channels ({', '.join(given)}); this "
+                          f"task needs {len(labels)}: {', '.join(labels)}, in that order")
     t = np.linspace(0.0, float(duration), 5)
-    sample = trajectory.sample(t)
+    sample = sample_checked(trajectory, t)
     for part in ("position", "velocity", "acceleration"):
         values = np.asarray(getattr(sample, part, None), dtype=float)
         if values.shape != (t.size, len(labels)):
@@ -380,6 +385,26 @@ def check_trajectory(trajectory, labels: tuple, duration_min: float = 0.0) -> No
                               f"{t.size} times; expected {(t.size, len(labels))}")
         if not np.isfinite(values).all():
             raise PluginError(f"the planner's trajectory has non-finite {part} within [0, {duration:g}] s")
+
+
+def fault_text(e: BaseException) -> str:
+    """``Type: message`` of plug-in code's exception (or SystemExit) on one line, at most 300
+    characters."""
+    if isinstance(e, SystemExit):
+        text = f"SystemExit({e.code!r}): plug-in code may not end the process"
+    else:
+        text = f"{type(e).__name__}: {e}"
+    text = " ".join(text.split())
+    return text if len(text) <= 300 else text[:297] + "..."
+
+
+def sample_checked(trajectory, t: np.ndarray):
+    """``trajectory.sample(t)``; an exception or SystemExit in it is a PluginError."""
+    try:
+        return trajectory.sample(t)
+    except (Exception, SystemExit) as e:
+        raise PluginError(f"the planner's trajectory ({type(trajectory).__name__}) sample() raised "
+                          f"{fault_text(e)}") from None
 
 
 def check_first_command(command, nu: int, actuators) -> np.ndarray | None:
@@ -422,11 +447,15 @@ def plan_checked(planner, problem, labels) -> Trajectory:
     from planners.errors import PlanningError
 
     check_planner(planner, online=False)
+    from sims import supervise
+
+    supervise.phase(f"the planner's plan ({type(planner).__name__})")
     try:
         trajectory = planner.plan(problem)
     except PlanningError:
         raise
-    except Exception as e:
-        raise PluginError(f"planner {type(planner).__name__} raised {type(e).__name__}: {e}") from None
+    except (Exception, SystemExit) as e:
+        raise PluginError(f"planner {type(planner).__name__} raised {fault_text(e)}") from None
+    supervise.phase(f"the planner's trajectory ({type(planner).__name__})")
     check_trajectory(trajectory, tuple(labels))
     return trajectory
