@@ -625,7 +625,7 @@ class FastParams(ScenarioParams):
                                           "125, 100, 83.3, 71.4, 62.5, 55.6, 50, ... 10 Hz)")
     dut1: float = param(0.0, "UT1 - UTC of the observing day (the IERS Bulletin A's value; 0: UTC taken for UT1, "
                         "at most 0.9 s = 13.5 arcsec of hour angle off)", "s", low=-sky.MAX_DUT1, high=sky.MAX_DUT1,
-                        low_open=True, high_open=True, reason="|UT1 - UTC| < 0.9 s by the definition of UTC")
+                        low_open=True, high_open=True, reason="UTC keeps UT1 - UTC within 0.9 s, by its definition")
 
     def check(self) -> None:
         # The start time first: later checks (the source's zenith angle) compute with it.
