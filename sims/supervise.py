@@ -72,6 +72,15 @@ def phase(text: str) -> None:
         _board.write_phase(text)
 
 
+def in_worker() -> _Board:
+    """Phases recorded in this process (a campaign's worker), for its own timeout messages."""
+    global _board
+    if _board is None:
+        _board = _Board()
+    _board.write_phase("planbench's own code, before any plug-in")
+    return _board
+
+
 def report_duration(seconds: float) -> None:
     """Tell the parent the run's simulated duration, s (its default time limit follows it)."""
     if _board is not None:

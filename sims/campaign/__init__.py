@@ -40,7 +40,31 @@ class Outcome:
 def context_of(spec) -> worker.Context:
     return worker.Context(spec.scenario.name, spec.base_params.to_dict(),
                           None if spec.base_plant is None else spec.base_plant.to_dict(),
-                          dict(spec.plugins), spec.mode, spec.save, tuple(a.column for a in spec.axes))
+                          dict(spec.plugins), spec.mode, spec.save, tuple(a.column for a in spec.axes),
+                          spec.timeout)
+
+
+def check_plugins(spec) -> None:
+    """Make every plug-in of ``spec`` once, supervised (import, factory, contract), before any
+    run: a PluginError (one line, exit 2) when one is missing, broken, exits or hangs."""
+    if not spec.plugins:
+        return
+    from sims import plugins, supervise
+    from sims.task import PluginError
+
+    online = spec.scenario.online_planner
+
+    def make_all():
+        for role, plugin_spec in spec.plugins.items():
+            plugins.make(plugin_spec, role, online_planner=online and role == "planner")
+
+    limit = spec.timeout if spec.timeout is not None else supervise.DEFAULT_TIMEOUT_BASE_S
+    try:
+        supervise.run_supervised(make_all, limit)
+    except supervise.Fault as fault:
+        names = ", ".join(f"{role} = {s!r}" for role, s in spec.plugins.items())
+        raise PluginError(f"{spec.path.name}: making its plug-ins ({names}) ended in {fault.ended.phase} "
+                          f"without completing: {fault.ended.how}") from None
 
 
 def tasks_of(spec, runs) -> list[worker.RunTask]:
@@ -73,6 +97,7 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
         raise ParamError("--rerun-worst replays simulated runs; a planner-only campaign has none")
     if spec.invalid == "refuse":
         check_runs(spec, spec.iter_runs(), quiet, spec.size)
+    check_plugins(spec)
     with target.reserved():
         target.open(spec, spec.path.read_text())
         done = target.done()

@@ -51,7 +51,7 @@ from scipy import stats
 from sims.params import ParamError, Params, _bound, field_types
 
 SPEC_KEYS = ("scenario", "planner", "controller", "mode", "seed", "seeds", "samples", "invalid", "save",
-             "parameters", "plant", "grid", "random")
+             "timeout", "parameters", "plant", "grid", "random")
 MODES = ("simulate", "plan")
 SAVE_CHOICES = ("timeseries", "video")
 DISTRIBUTIONS = {
@@ -277,6 +277,7 @@ class CampaignSpec:
     random: list[Axis]
     fingerprint: str
     data: dict = field(repr=False, default_factory=dict)
+    timeout: float | None = None  # each run's wall-time limit, s (None: sims.supervise's default)
 
     @property
     def axes(self) -> list[Axis]:
@@ -455,6 +456,13 @@ def _parse(path: Path, data: dict, get_scenario, known_names, scenario_files) ->
         raise ParamError(f"save = {save!r} must be a list of {', '.join(SAVE_CHOICES)}")
     if save and mode == "plan":
         raise ParamError("save: a planner-only campaign writes no per-run outputs")
+    timeout = data.get("timeout")
+    if timeout is not None:
+        if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not math.isfinite(timeout) \
+                or timeout <= 0:
+            raise ParamError(f"timeout = {timeout!r} must be a finite number of seconds > 0 (each run's "
+                             "wall-time limit)")
+        timeout = float(timeout)
     try:
         if "parameters" in data:
             if not isinstance(data["parameters"], dict):
@@ -478,7 +486,7 @@ def _parse(path: Path, data: dict, get_scenario, known_names, scenario_files) ->
     if "seed" in {a.key for a in grid + random if not a.plant}:
         raise ParamError("seed is the campaign's: use seeds = N (or a list) instead of an axis of seed")
     spec = CampaignSpec(path, scenario, base_params, base_plant, plugins, mode, seed, seeds, replicates,
-                        samples, invalid, tuple(save), grid, random, "", data)
+                        samples, invalid, tuple(save), grid, random, "", data, timeout)
     if spec.size > MAX_RUNS:
         raise ParamError(f"{spec.size} runs ({spec.points} points x {samples} samples x {replicates} seeds) "
                          f"is more than {MAX_RUNS}")

@@ -13,7 +13,10 @@ timeseries.npz, report.png and a video) as bytes, which the campaign writes unde
 
 from __future__ import annotations
 
+import contextlib
 import json
+import signal
+import threading
 import tempfile
 import time
 from dataclasses import dataclass
@@ -33,6 +36,7 @@ class Context:
     mode: str
     save: tuple
     axes: tuple  # column names, in the order of RunTask.values
+    timeout: float | None = None  # each run's wall-time limit, s (None: 600 s + its simulated duration)
 
 
 @dataclass(frozen=True)
@@ -124,7 +128,7 @@ def _judge(scenario, resolved, plugin_specs, plugins, meta) -> None:
         if "planner" in plugin_specs:
             planner = plugins.make(plugin_specs["planner"], "planner")
         checks = scenario.judge_plans([p for _, _, p, _ in resolved], planner=planner)
-    except Exception as e:  # noqa: BLE001  (the chunk's rows carry it)
+    except (Exception, SystemExit) as e:  # noqa: BLE001  (the chunk's rows carry it)
         for _, row, _, _ in resolved:
             row.update(status="error", passed=None, error=_exception_text(e), wall_s=0.0, sim_s=None)
         return
@@ -135,16 +139,48 @@ def _judge(scenario, resolved, plugin_specs, plugins, meta) -> None:
         row.update(status="passed" if passed else "failed", passed=passed, error=None, wall_s=wall, sim_s=None)
 
 
+class RunTimeout(BaseException):
+    """A run passed its wall-time limit (raised by SIGALRM in the worker's main thread; a
+    BaseException, so plug-in code's ``except Exception`` does not swallow it)."""
+
+
+def _alarm(signum, frame):
+    raise RunTimeout
+
+
+@contextlib.contextmanager
+def _watchdog(limit_s: float):
+    """SIGALRM after ``limit_s`` s of wall time, in a worker's main thread (elsewhere: none).
+    Python code that hangs (a sleep, a loop) is stopped; native code that never returns to
+    the interpreter is not, and holds its worker until the campaign ends."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.setitimer(signal.ITIMER_REAL, limit_s)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
 def _simulate(scenario, context, params, plant, plugin_specs, plugins, row, meta) -> dict:
     """One run in MuJoCo; its row filled in, its files returned."""
-    from sims import api, outputs, runner
+    from sims import api, outputs, runner, supervise
 
     start = time.perf_counter()
+    board = supervise.in_worker()
+    limit = context.timeout if context.timeout is not None else supervise.DEFAULT_TIMEOUT_BASE_S
     try:
-        made = {role: plugins.make(spec, role, online_planner=scenario.online_planner)
-                for role, spec in plugin_specs.items()}
-        setup = api.build(scenario, params, plant, **made)
-        result = runner.run(scenario.name, setup)
+        with _watchdog(limit):
+            made = {role: plugins.make(spec, role, online_planner=scenario.online_planner)
+                    for role, spec in plugin_specs.items()}
+            setup = api.build(scenario, params, plant, **made)
+            if context.timeout is None:  # the default limit follows the simulated duration
+                limit += setup.duration
+                signal.setitimer(signal.ITIMER_REAL, max(1e-3, limit - (time.perf_counter() - start)))
+            result = runner.run(scenario.name, setup)
         result.plugins = dict(plugin_specs)
         if context.save:
             with tempfile.TemporaryDirectory(prefix="planbench-run-") as tmp:
@@ -155,7 +191,11 @@ def _simulate(scenario, context, params, plant, plugin_specs, plugins, row, meta
                          if p.is_file() and p.name != outputs.MANIFEST}
         else:
             files = {"summary.json": (json.dumps(outputs.summary_dict(result), indent=2) + "\n").encode()}
-    except Exception as e:  # noqa: BLE001  (a run that raises is a row with its error)
+    except RunTimeout:
+        row.update(status="error", passed=None, error=f"timed out: the run passed its wall-time limit of "
+                   f"{limit:g} s in {board.read_phase()}", wall_s=time.perf_counter() - start, sim_s=None)
+        return {}
+    except (Exception, SystemExit) as e:  # noqa: BLE001  (a run that raises is a row with its error)
         row.update(status="error", passed=None, error=_exception_text(e), wall_s=time.perf_counter() - start,
                    sim_s=None)
         return {}
