@@ -257,6 +257,10 @@ class OnlinePlanner(Protocol):
     def step(self, t: float, attitude: np.ndarray) -> np.ndarray: ...
 
 
+class StepTimeError(ValueError):
+    """An online planner stepped at a time that does not come after its previous step."""
+
+
 class RecordingPlanner:
     """The task's record of an online planner: every (t, attitude given, Theta returned).
 
@@ -283,6 +287,14 @@ class RecordingPlanner:
         self.planner.reset(problem)
 
     def step(self, t: float, attitude: np.ndarray) -> np.ndarray:
+        """The planner's ``step(t, attitude)``, recorded. ``t`` (s) must come after the previous
+        step's, and the first after the problem's start (t = 0, where ``theta0`` holds): a step
+        at the same time is an interval of zero, whose angular velocity (eq. 6) does not exist."""
+        last = float(self.t[self.count - 1]) if self.count else 0.0
+        if not float(t) > last:
+            since = "its previous step at" if self.count else "the problem's start (theta0) at"
+            raise StepTimeError(f"the online planner was stepped at t = {float(t):.6g} s, not after {since} "
+                                f"{last:.6g} s: steps must have increasing times")
         start = time.perf_counter()
         theta = np.array(self.planner.step(t, attitude), dtype=float)
         self.wall_s += time.perf_counter() - start

@@ -583,6 +583,10 @@ class CrrPlanner:
         self.t = 0.0
 
     def step(self, t: float, attitude: np.ndarray) -> np.ndarray:
+        """Joint angles for ``attitude`` at ``t`` (s), after the previous step (or reset, t = 0)."""
+        if not t > self.t:
+            raise PlanningError(f"CRR step at t = {t:.6g} s does not come after the previous one at {self.t:.6g} s: "
+                                "the angular velocity (eq. 6) needs an interval > 0")
         p = self.problem
         theta, info = crr_step(self.theta, self.attitude, attitude, t - self.t, p.weights, limits=p.limits,
                                omega_method=self.omega_method, full_correction=self.method == "crr-full")
