@@ -119,7 +119,20 @@ def _child(work, board: _Board, write_fd: int, parent: int) -> None:
     ("interrupted", None). Never returns."""
     global _board
     code = 0
+    signalled = []
+
+    def interrupted(signum, frame):
+        # The first signal interrupts; what is raised while cleaning up after it (ffmpeg
+        # killed by the same Ctrl-C: a broken pipe) is its consequence, not a fault.
+        if not signalled:
+            signalled.append(signum)
+            raise KeyboardInterrupt
+
     try:
+        from sims.outputs import INTERRUPT_SIGNALS
+
+        for s in INTERRUPT_SIGNALS:
+            signal.signal(s, interrupted)
         _die_with_parent(parent)
         _board = board
         try:
@@ -127,9 +140,12 @@ def _child(work, board: _Board, write_fd: int, parent: int) -> None:
         except KeyboardInterrupt:
             payload = ("interrupted", None)
         except BaseException as e:  # noqa: BLE001  (sent to the parent, which decides)
-            if not _one_line(e):
-                traceback.print_exc()
-            payload = ("raised", e)
+            if signalled:
+                payload = ("interrupted", None)
+            else:
+                if not _one_line(e):
+                    traceback.print_exc()
+                payload = ("raised", e)
         try:
             data = pickle.dumps(payload)
         except Exception:  # noqa: BLE001  (an exception that does not pickle)

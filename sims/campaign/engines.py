@@ -58,6 +58,8 @@ def contain_worker(parent: int | None) -> None:
 
     from sims.outputs import INTERRUPT_SIGNALS
 
+    if parent == os.getpid():  # an in-process stand-in for a pool (tests): this is the driver
+        return
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
