@@ -8,7 +8,7 @@ from sims import runner, scenarios
 from sims import hexapod as sim_hexapod
 from sims.wind import AIR_DENSITY, kaimal_spectrum, wind_speed_series
 
-EXPECTED = {"strut_velocity", "strut_accel", "following_error", "pose_error_final",
+EXPECTED = {"strut_velocity", "strut_accel", "hexapod_speed", "following_error", "pose_error_final",
             "strut_force", "stroke", "simulation_warnings", "controller_errors"}
 WIND_M_S = 10.0
 

@@ -420,6 +420,32 @@ def hexapod_space_min_time(displacement, limits: HexapodLimits = RUBIN_LIMITS) -
     return np.max(2.0 * half / speeds, axis=-1)
 
 
+#: The four hexapod-space speeds of ``hexapod_space_min_time`` and ``hexapod_speed_ratios``.
+HEXAPOD_SPEED_LABELS = ("radial", "axial", "radial-angular", "axial-angular")
+
+
+def hexapod_speed_ratios(pose, strut_velocity, limits: HexapodLimits = RUBIN_LIMITS,
+                         geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
+    """(..., 4) the pose's hexapod-space speeds over their limits v'_max (paper, step 1).
+
+    The pose rate is J(pose)^-1 times the strut speeds (``jacobian``: x, y, z and the rates of
+    rx, ry, rz, the coordinates ``hexapod_space_min_time`` measures a move in); the four
+    speeds are |(vx, vy)| and |vz| over ``linear_speed``, |(d rx, d ry)| and |d rz| over
+    ``angular_speed``, in the order of HEXAPOD_SPEED_LABELS.
+
+    Args:
+      pose: (..., 6) poses, m and rad.
+      strut_velocity: (..., 6) strut speeds there, m/s.
+    """
+    rate = np.linalg.solve(jacobian(pose, geometry), np.asarray(strut_velocity, dtype=float)[..., None])[..., 0]
+    return np.stack([
+        np.hypot(rate[..., 0], rate[..., 1]) / limits.linear_speed,
+        np.abs(rate[..., 2]) / limits.linear_speed,
+        np.hypot(rate[..., 3], rate[..., 4]) / limits.angular_speed,
+        np.abs(rate[..., 5]) / limits.angular_speed,
+    ], axis=-1)
+
+
 def strut_min_time(half_distance, limits: HexapodLimits = RUBIN_LIMITS) -> np.ndarray:
     """t_i,max: minimum half time of a strut's half distance d_i under v_max, a_max (paper)."""
     d = np.asarray(half_distance, dtype=float)

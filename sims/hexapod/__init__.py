@@ -29,7 +29,7 @@ from scipy.spatial.transform import Rotation
 
 import models
 from planners import hexapod as hexapod_planner
-from planners.errors import LimitError
+from planners.errors import LimitError, PlanningError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
 from planners.rotations import wxyz
 from planners.trajectory import PiecewiseTrajectory, TrajectorySample
@@ -54,6 +54,23 @@ FOLLOWING_LIMIT_UM = 40.0
 POSE_FINAL_LIMIT_UM = 1.0
 #: Synchronous moves end within one tick.
 ARRIVAL_SPREAD_LIMIT_S = CONTROL_DT
+#: Asynchronous moves: each strut ends no later than two ticks after its minimum time.
+OWN_TIME_LIMIT_S = 2 * CONTROL_DT
+
+#: Rest and arrival (README.md, "How the hexapod is judged"). Rubin's strut encoders count
+#: 0.1 um (10 counts/um, ts_mthexapod). A strut whose commanded length changes by less than
+#: STRUT_MOVE_THRESHOLD_M (1/100 of a count) is idle in the arrival checks; a strut has
+#: arrived from the first tick after which its commanded position stays within its tolerance
+#: of its target and its commanded speed within the tolerance per tick: 1e-9 of its move
+#: (at most 28 pm, 1/3500 of a count, on the longest move the stroke allows), at least
+#: ARRIVAL_ULPS units in the last place of its position (a planner's own round-off).
+ENCODER_COUNT_M = 0.1e-6
+STRUT_MOVE_THRESHOLD_M = 1e-2 * ENCODER_COUNT_M
+ARRIVAL_TOLERANCE = 1e-9
+ARRIVAL_ULPS = 4
+#: The measured struts have settled once every encoder stays within this of its target, m
+#: (the 1 um end-of-move limit, per strut): reported per move, ``encoder_settle_s``.
+ENCODER_SETTLE_M = 1e-6
 
 #: The moves: a few mm and ~0.1 deg, inside the pose limits and the stroke (m, rad).
 #: In the parameters' units, x, y, z mm and rx, ry, rz deg.
@@ -426,32 +443,65 @@ class HexapodController(ServoFeedforwardController):
 # ----------------------------------------------------------------------------- evaluation
 
 
-def arrival_times(reference: TrajectorySample, tolerance: float = 0.0) -> np.ndarray:
-    """(6,) first time after which each channel's reference rests on its final value, s."""
-    final = reference.position[-1]
-    moving = (np.abs(reference.position - final) > tolerance) | (reference.velocity != 0.0)
-    last_moving = np.where(moving.any(axis=0), moving.shape[0] - 1 - np.argmax(moving[::-1], axis=0), -1)
-    index = np.minimum(last_moving + 1, reference.t.size - 1)
-    return np.where(last_moving >= 0, reference.t[index], 0.0)
+def hexapod_speed_check(peaks, what: str) -> Check:
+    """hexapod_speed from the peak ratios (4,) of the radial, axial, radial-angular and
+    axial-angular pose speeds to Rubin's hexapod-space limits (``hexapod_speed_ratios``)."""
+    peaks = np.asarray(peaks, dtype=float)
+    worst = int(np.argmax(peaks))
+    names = hexapod_planner.HEXAPOD_SPEED_LABELS
+    return Check("hexapod_speed", float(peaks[worst]), 1.0, "ratio",
+                 note=f"{what} pose speed over the hexapod-space limit, peak of each: "
+                      + ", ".join(f"{n} {v:.3f}" for n, v in zip(names, peaks)) + f" (worst {names[worst]})")
+
+
+def strut_tolerances(start, target) -> tuple[np.ndarray, np.ndarray]:
+    """(tolerance (..., 6) m, moving (..., 6) bool) of the struts of moves from ``start`` to
+    ``target`` (strut positions, m): a moving strut's tolerance is ARRIVAL_TOLERANCE of its
+    move, at least ARRIVAL_ULPS ulps of its position; an idle strut's (a move of at most
+    STRUT_MOVE_THRESHOLD_M) is that threshold."""
+    start, target = np.asarray(start, dtype=float), np.asarray(target, dtype=float)
+    distance = np.abs(target - start)
+    moving = distance > STRUT_MOVE_THRESHOLD_M
+    round_off = ARRIVAL_ULPS * np.spacing(np.maximum(np.abs(start), np.abs(target)))
+    tolerance = np.where(moving, np.maximum(ARRIVAL_TOLERANCE * distance, round_off), STRUT_MOVE_THRESHOLD_M)
+    return tolerance, moving
+
+
+def arrival_times(reference: TrajectorySample, target, tolerance, dt: float) -> np.ndarray:
+    """(6,) each strut's arrival in the sample's times, s: the first sample after which its
+    position stays within ``tolerance`` (m, per strut) of ``target`` and its speed within
+    ``tolerance / dt``; NaN for a strut not at rest on its target at the last sample."""
+    off = ((np.abs(reference.position - target) > tolerance)
+           | (np.abs(reference.velocity) * dt > tolerance))
+    n = off.shape[0]
+    last_off = np.where(off.any(axis=0), n - 1 - np.argmax(off[::-1], axis=0), -1)
+    index = np.minimum(last_off + 1, n - 1)
+    return np.where(last_off < n - 1, reference.t[index], np.nan)
 
 
 class HexapodEvaluation:
     """Checks and outputs of a hexapod run: one move, or a list of moves one after another.
 
-    Move i runs from ``starts[i]``; its window of the log runs from there to the next move's
-    start (inclusive: at that tick the next move has not acted yet), the last one's to the end.
-    Each move's arrival is judged in its window (synchronous: the arrival spread;
-    asynchronous: each strut against its own time); its pose error over the window's last
-    SETTLE_WINDOW_S, after SETTLE_S of settling. A check reports the worst move.
+    Everything is counted in control ticks (log row k is tick k). Move i starts on tick
+    ``start_ticks[i]`` (``plan_moves``). Its arrival is judged on the ticks from there to the
+    tick before the next move's start (the last move's: to the run's end): each strut's
+    commanded position must come to rest on the target within its tolerance
+    (``strut_tolerances``, ``arrival_times``). Its following error is judged from its start
+    to its last strut's arrival; its pose error over the SETTLE_WINDOW_S up to the next
+    move's start tick (at that tick the next move has not acted yet; the last move's: the
+    run's end), once SETTLE_S have passed after the arrival. A check reports the worst move.
     """
 
     def __init__(self, physics: HexapodPhysics, moves, starts, durations, wind: BodyWindDrag | None):
         self.physics = physics
         self.moves = list(moves)
         self.starts = np.asarray(starts, dtype=float)
+        self.start_ticks = np.rint(self.starts / CONTROL_DT).astype(np.int64)
         self.planned = np.asarray(durations, dtype=float)  # of each trajectory the planner returned
         self.wind = wind
         self.own_times = [hexapod_planner.own_move_times(m) for m in self.moves]
+        self.strut_starts = [hexapod_planner.strut_positions(np.asarray(m.start_pose, dtype=float)) for m in self.moves]
+        self.strut_targets = [hexapod_planner.strut_positions(np.asarray(m.target_pose, dtype=float)) for m in self.moves]
 
     def _strut_log(self, log: RunLog):
         p = self.physics
@@ -472,51 +522,81 @@ class HexapodEvaluation:
         wanted = hexapod_planner.pivot_positions(np.asarray(target_pose))
         return 1e6 * np.linalg.norm(actual - wanted, axis=-1).max(axis=-1)
 
-    def move_index(self, t: np.ndarray) -> np.ndarray:
-        """(n,) the move whose window each time lies in."""
-        return np.clip(np.searchsorted(self.starts, t + 1e-9, side="right") - 1, 0, len(self.moves) - 1)
+    def move_index(self, n: int) -> np.ndarray:
+        """(n,) the move each of the ticks 0 ... n - 1 belongs to (from its start tick on)."""
+        return np.searchsorted(self.start_ticks, np.arange(n), side="right") - 1
 
-    def targets(self, t: np.ndarray) -> np.ndarray:
-        """(n, 6) the target pose of the move each time belongs to."""
-        return np.array([m.target_pose for m in self.moves])[self.move_index(t)]
+    def targets(self, n: int) -> np.ndarray:
+        """(n, 6) the target pose of the move each of the ticks 0 ... n - 1 belongs to."""
+        return np.array([m.target_pose for m in self.moves])[self.move_index(n)]
 
-    def _window(self, log: RunLog, i: int) -> np.ndarray:
-        lo = self.starts[i] - 1e-9
-        hi = self.starts[i + 1] + 1e-9 if i + 1 < len(self.moves) else np.inf
-        return np.flatnonzero((log.t >= lo) & (log.t <= hi))
+    def _not_arrived_reason(self, log: RunLog, i: int, arrivals: np.ndarray, end: int) -> str:
+        several = len(self.moves) > 1
+        which = f" of move {i}" if several else ""
+        planned_end = self.starts[i] + self.planned[i]
+        if end == log.t.size and log.t[-1] < planned_end - 1e-9:
+            return (f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion{which} "
+                    f"(planned to t = {planned_end:.3f} s) came to rest")
+        ref = log.reference
+        strut = int(np.flatnonzero(np.isnan(arrivals))[0])
+        off = ref.position[end - 1, strut] - self.strut_targets[i][strut]
+        return (f"the commanded motion{which} does not come to rest on its target by t = {log.t[end - 1]:.3f} s: "
+                f"{STRUT_LABELS[strut]} {off:.3g} m off at {ref.velocity[end - 1, strut]:.3g} m/s")
 
     def _judge_move(self, log: RunLog, i: int, q, poses) -> dict:
-        """One move's arrival, following error and settled pose error."""
-        rows = self._window(log, i)
-        if rows.size == 0:  # the run ended before this move began
-            return {"arrived": False, "ended": False, "arrivals": np.zeros(6), "spread": 0.0, "late": 0.0,
-                    "move_end": self.planned[i], "during": rows, "following": np.zeros(6),
-                    "pose_error": float("nan"), "settled_at": self.starts[i] + self.planned[i] + SETTLE_S}
+        """One move's arrival, following error and settled pose error (class docstring)."""
+        n = log.t.size
+        lo = int(self.start_ticks[i])
+        nxt = int(self.start_ticks[i + 1]) if i + 1 < len(self.moves) else n
+        end = min(nxt, n)        # arrival ticks lo ... end - 1
+        last = min(nxt, n - 1)   # the pose's settling window ends on this tick
+        settle_ticks = end_tick(SETTLE_S)
+        if lo >= n:  # the run ended before this move began
+            return {"arrived": False, "ended": False, "arrivals": np.full(6, np.nan), "spread": 0.0, "late": 0.0,
+                    "move_end": self.planned[i], "during": np.arange(0), "following": np.zeros(6),
+                    "pose_error": float("nan"), "encoder_settle": None,
+                    "settled_at": self.starts[i] + self.planned[i] + SETTLE_S,
+                    "reason": f"the run ended at t = {log.t[-1]:.3f} s, before move {i} began (t = {self.starts[i]:.3f} s)"}
         ref = log.reference
-        t = log.t[rows] - self.starts[i]
-        window_ref = TrajectorySample(t, ref.position[rows], ref.velocity[rows], ref.acceleration[rows])
-        moving = np.abs(window_ref.position[-1] - window_ref.position[0]) > 0
-        arrivals = arrival_times(window_ref)
-        spread = float(arrivals[moving].max() - arrivals[moving].min()) if moving.any() else 0.0
-        move_end = float(arrivals.max())
-        during = rows[t <= move_end + 1e-9]
-        settled = rows[t >= t[-1] - SETTLE_WINDOW_S - 1e-9]
+        rows = np.arange(lo, end)
+        local = TrajectorySample((rows - lo) * CONTROL_DT, ref.position[rows], ref.velocity[rows], ref.acceleration[rows])
+        target = self.strut_targets[i]
+        tolerance, moving = strut_tolerances(self.strut_starts[i], target)
+        arrivals = arrival_times(local, target, tolerance, CONTROL_DT)
+        arrived = bool(np.all(np.isfinite(arrivals)))
+        own = self.own_times[i]
+        if arrived:
+            arrival_tick = int(np.rint(arrivals.max() / CONTROL_DT))
+            spread = float(arrivals[moving].max() - arrivals[moving].min()) if moving.any() else 0.0
+            late = float((arrivals - own)[moving].max()) if moving.any() else 0.0
+        else:
+            arrival_tick, spread, late = end - lo - 1, 0.0, 0.0
+        move_end = arrival_tick * CONTROL_DT
+        during = rows[: arrival_tick + 1]
+        settled = np.arange(max(lo, last - end_tick(SETTLE_WINDOW_S)), last + 1)
         # Against this move's own target (the window's last tick is the next move's first).
         wanted = hexapod_planner.pivot_positions(np.asarray(self.moves[i].target_pose))
         pivots = 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(poses[settled]) - wanted, axis=-1).max(axis=-1)
-        arrived = not np.any(window_ref.velocity[-1] != 0.0)
-        own = self.own_times[i]
+        # The measured struts: from the arrival on, when every encoder stays within ENCODER_SETTLE_M.
+        encoder_settle = None
+        if arrived:
+            after = np.arange(lo + arrival_tick, last + 1)
+            off = (np.abs(q[after] - target) > ENCODER_SETTLE_M).any(axis=1)
+            if not off[-1]:
+                encoder_settle = float((np.flatnonzero(off)[-1] + 1 if off.any() else 0) * CONTROL_DT)
         return {
             "arrived": arrived,
-            "ended": arrived and t[-1] >= move_end + SETTLE_S - 1e-9,
+            "ended": arrived and last - lo >= arrival_tick + settle_ticks,
             "arrivals": arrivals,
             "spread": spread,
-            "late": float(np.abs(arrivals - own)[moving].max()) if moving.any() else 0.0,
+            "late": late,
             "move_end": move_end,
             "during": during,
             "following": 1e6 * np.abs(q - ref.position)[during].max(axis=0) if during.size else np.zeros(6),
             "pose_error": float(pivots.max()),
-            "settled_at": self.starts[i] + (move_end if arrived else self.planned[i]) + SETTLE_S,
+            "encoder_settle": encoder_settle,
+            "settled_at": (lo + arrival_tick + settle_ticks) * CONTROL_DT,
+            "reason": None if arrived else self._not_arrived_reason(log, i, arrivals, end),
         }
 
     def __call__(self, log: RunLog):
@@ -537,15 +617,12 @@ class HexapodEvaluation:
         def per_move(key, fmt=".3g"):
             return "; per move " + ", ".join(f"{j[key]:{fmt}}" for j in judged) if several else ""
 
-        # Arrivals exist only if the run saw the whole commanded motion of a move, i.e. its
-        # reference rests at the window's last tick (a short run's last tick would pass for
-        # every strut's arrival); the settling window only comes after them.
+        # Arrivals exist only where the commanded motion of every move comes to rest on its
+        # target inside its window (a short run's last tick would pass for every arrival);
+        # the settling window only comes after them.
         late_move = next((i for i, j in enumerate(judged) if not j["arrived"]), None)
         arrived = late_move is None
-        short = "" if arrived else (
-            f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion"
-            + (f" of move {late_move}" if several else "")
-            + f" (planned to t = {self.starts[late_move] + self.planned[late_move]:.3f} s) came to rest")
+        short = "" if arrived else judged[late_move]["reason"]
         sync = [i for i, m in enumerate(self.moves) if m.synchronous]
         asyn = [i for i, m in enumerate(self.moves) if not m.synchronous]
         if sync:
@@ -555,11 +632,11 @@ class HexapodEvaluation:
                           Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=short))
         if asyn:
             spread_text = ", ".join(f"{judged[i]['spread']:.3f}" for i in asyn)
-            checks.append(Check("arrival_vs_own_time", max(judged[i]["late"] for i in asyn), 2 * CONTROL_DT, "s",
-                                note=f"each strut ends within two ticks of its own time 2 T_i; "
-                                     f"arrival spread {spread_text} s")
+            checks.append(Check("arrival_vs_own_time", max(judged[i]["late"] for i in asyn), OWN_TIME_LIMIT_S, "s",
+                                note=f"each strut's arrival minus its minimum time 2 max(t_i, t'_min) (early is "
+                                     f"negative); arrival spread {spread_text} s")
                           if arrived else
-                          Check.not_evaluated("arrival_vs_own_time", 2 * CONTROL_DT, "s", reason=short))
+                          Check.not_evaluated("arrival_vs_own_time", OWN_TIME_LIMIT_S, "s", reason=short))
         ended_all = all(j["ended"] for j in judged)
         unsettled = next((i for i, j in enumerate(judged) if not j["ended"]), len(judged) - 1)
         settled_at = judged[unsettled]["settled_at"]
@@ -572,6 +649,7 @@ class HexapodEvaluation:
                        f"{1e6 * np.abs(qd).max():.1f} um/s"),
             Check("strut_accel", 1e6 * a_cmd, 1e6 * limits.strut_accel, "um/s2",
                   note="commanded by the generator, per tick"),
+            self._hexapod_speed(ref, poses),
             Check("following_error", following, FOLLOWING_LIMIT_UM, "um",
                   note=(f"encoder minus reference, t <= {move_end:.3f} s" if not several else
                         "encoder minus reference during each move" + per_move("move_end", fmt=".3f") + " s")),
@@ -594,13 +672,14 @@ class HexapodEvaluation:
         metrics = {
             "elevation_deg": p.elevation_deg,
             "move_duration_s": move_end,
-            "arrival_times_s": dict(zip(STRUT_LABELS, arrivals.round(4).tolist())),
+            "arrival_times_s": dict(zip(STRUT_LABELS, [None if np.isnan(a) else a for a in arrivals.round(4).tolist()])),
             "arrival_spread_s": last["spread"],
             "final_translation_error_um": (1e6 * pose_diff[:3]).round(4).tolist(),
             "final_rotation_error_urad": (1e6 * pose_diff[3:]).round(4).tolist(),
             "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist() if during.size else [0.0] * 6)),
             "peak_drive_force_N": dict(zip(STRUT_LABELS, np.abs(demanded).max(0).round(1).tolist())),
             "static_drive_force_start_N": dict(zip(STRUT_LABELS, demanded[0].round(1).tolist())),
+            "encoder_settle_s": last["encoder_settle"],
             "measured_peak_strut_speed_um_s": float(1e6 * np.abs(qd).max()),
             "loop_closure_um": float(1e6 * self.closure_mismatch(log)[window].max()),
         }
@@ -613,6 +692,7 @@ class HexapodEvaluation:
                 "arrival_vs_own_time_s": None if m.synchronous else j["late"],
                 "following_error_um": float(j["following"].max()),
                 "pose_error_um": j["pose_error"] if j["ended"] else None,
+                "encoder_settle_s": j["encoder_settle"],
             } for i, (m, j) in enumerate(zip(self.moves, judged))]
         if self.wind is not None and self.wind.speed is not None:
             n = log.t.size
@@ -620,6 +700,18 @@ class HexapodEvaluation:
             metrics["wind_speed_std_m_s"] = float(np.std(self.wind.speed[:n]))
             metrics["wind_force_peak_N"] = float(np.linalg.norm(self.wind.force[:n], axis=1).max())
         return checks, metrics
+
+    def _hexapod_speed(self, ref: TrajectorySample, poses: np.ndarray) -> Check:
+        """The commanded pose's peak hexapod-space speeds against Rubin's (``HEXAPOD_SPEED``):
+        the pose of the commanded struts by forward kinematics (from the measured pose), its
+        rate from the commanded strut speeds (``hexapod_speed_ratios``)."""
+        try:
+            commanded, _ = hexapod_planner.forward_kinematics(ref.position + RUBIN_CAMERA.nominal_lengths,
+                                                              initial=poses, tolerance=1e-12)
+        except PlanningError as e:
+            return Check.not_evaluated("hexapod_speed", 1.0, "ratio", reason=f"the commanded pose: {e}")
+        return hexapod_speed_check(hexapod_planner.hexapod_speed_ratios(commanded, ref.velocity).max(axis=0),
+                                   "commanded")
 
     def timeseries(self, log: RunLog) -> dict:
         p = self.physics
@@ -650,7 +742,7 @@ class HexapodEvaluation:
         if len(self.moves) == 1:
             return self.pivot_errors_um(log, self.moves[0].target_pose)
         poses = self.physics.poses_from_qpos(log.qpos)
-        wanted = hexapod_planner.pivot_positions(self.targets(log.t))
+        wanted = hexapod_planner.pivot_positions(self.targets(log.t.size))
         return 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(poses) - wanted, axis=-1).max(axis=-1)
 
     def report(self, log: RunLog, checks, path) -> None:
@@ -705,15 +797,30 @@ def problems(params: "HexapodParams") -> list[hexapod_planner.MoveProblem]:
 
 def plan_moves(params: "HexapodParams", planner=None):
     """(trajectory, moves, starts, durations): every move planned by ``planner`` (default the
-    paper's generator), each starting ``params.dwell`` s after the one before ended; one move
-    is its own trajectory."""
+    paper's generator), each starting on the first control tick at least ``params.dwell`` s
+    after the tick on which the trajectory before it ended (``end_tick``); one move is its
+    own trajectory. ``starts`` are those ticks times the control period, s."""
     planner = hexapod_planner.PaperMovePlanner() if planner is None else planner
     moves = problems(params)
     pieces = [plan_checked(planner, move, STRUT_LABELS) for move in moves]
     durations = [piece.duration for piece in pieces]
-    starts = np.concatenate([[0.0], np.cumsum([d + params.dwell for d in durations[:-1]])])
+    ticks = [0]
+    for d in durations[:-1]:
+        ticks.append(ticks[-1] + end_tick(d) + end_tick(params.dwell))
+    starts = np.array(ticks) * CONTROL_DT
     trajectory = pieces[0] if len(pieces) == 1 else PiecewiseTrajectory(pieces, starts)
     return trajectory, moves, starts, durations
+
+
+def end_tick(duration: float) -> int:
+    """The first control tick at or after ``duration`` s (to 1e-9 of a tick)."""
+    return int(math.ceil(duration / CONTROL_DT - 1e-9))
+
+
+def default_duration(starts, durations) -> float:
+    """The run's simulated time when none is given, s: to the tick of the last trajectory's
+    end plus SETTLE_S, every move's arrival and its settling inside the run."""
+    return (int(round(starts[-1] / CONTROL_DT)) + end_tick(durations[-1]) + end_tick(SETTLE_S)) * CONTROL_DT
 
 
 def plan(params: "HexapodParams"):
@@ -761,7 +868,7 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
     """
     plant = HexapodPlant() if plant is None else plant
     trajectory, moves, starts, durations = plan_moves(params, planner)
-    duration = params.duration if params.duration is not None else trajectory.duration + SETTLE_S
+    duration = params.duration if params.duration is not None else default_duration(starts, durations)
     run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(params.wind > 0))
     physics = HexapodPhysics.load(params.elevation, plant)
     start = moves[0].start_pose
@@ -848,7 +955,8 @@ class HexapodParams(ScenarioParams):
     moves: tuple[HexapodMove, ...] = param(
         (HexapodMove(),), "the moves, one after another: [[moves]] tables of target and synchronous",
         min_items=1, max_items=100, reason="at least one move; a hundred fill a night")
-    dwell: float = param(SETTLE_S, "time from one move's end to the next move's start", "s", low=SETTLE_S,
+    dwell: float = param(SETTLE_S, "time from the tick one move's trajectory ends on to the next move's start "
+                         "(on the first tick after it)", "s", low=SETTLE_S,
                          high=600.0, reason="each arrival is judged after the integral action's 1 s of settling")
     elevation: float = param(DEFAULT_ELEVATION_DEG, "telescope elevation: gravity's direction in the hexapod frame",
                              "deg", low=ELEVATION_RANGE_DEG[0], high=ELEVATION_RANGE_DEG[1],
@@ -856,7 +964,8 @@ class HexapodParams(ScenarioParams):
     wind: float = param(DEFAULT_WIND_M_S, "mean wind on the camera (Kaimal turbulence), 0 for none", "m/s",
                         low=0.0, high=MAX_MEAN_SPEED_M_S,
                         reason="IEC 61400-1 class I reference speed, the Kaimal model's range")
-    duration: float | None = param(None, "simulated time; none: the moves plus 1 s of settling", "s",
+    duration: float | None = param(None, "simulated time; none: to the tick the last move's trajectory ends on, "
+                                   "plus 1 s of settling", "s",
                                    low=CONTROL_DT, reason="at least one control tick (5 ms)")
 
     def check(self) -> None:

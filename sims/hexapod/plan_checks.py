@@ -14,11 +14,15 @@ check                  unit   passes when                  what
 arrival_spread         s      <= ARRIVAL_SPREAD_LIMIT_S    synchronous moves: last minus first arrival
                               (one tick, 5 ms)             of the moving struts (paper, "all struts
                                                            should arrive ... at the same time")
-arrival_vs_own_time    s      <= 2 CONTROL_DT (10 ms)      asynchronous moves: largest |arrival - 2 T_i|,
-                                                           T_i = max(t_i,max, t'_min) (paper, steps 1-3;
+arrival_vs_own_time    s      <= 2 CONTROL_DT (10 ms)      asynchronous moves: largest arrival - 2 T_i
+                                                           (one-sided: early is negative), T_i =
+                                                           max(t_i,max, t'_min) (paper, steps 1-3;
                                                            ``own_move_times``)
 strut_velocity         um/s   <= v_max (500)               peak planned strut speed
 strut_accel            um/s2  <= a_max (500)               peak planned strut acceleration
+hexapod_speed          ratio  <= 1                         peak planned pose speed of the four
+                                                           hexapod-space speeds over v'_max
+                                                           (``hexapod_speed_ratios``)
 plan_stroke            mm     <= stroke (14.1)             peak |planned strut length change| (the
                                                            run's ``stroke`` is the encoders')
 pose_limits            ratio  <= 1                         largest |pose - centre| / half range of any
@@ -48,7 +52,11 @@ position is one quadratic in t, so
 
 * the speed is linear in t and the acceleration constant: their peaks over all ticks are at
   switching ticks; a strut's position is monotone, its peak magnitude at its start or end;
-* the arrivals are the ticks n_i (the planned motion rests exactly on the target after them);
+* the arrivals are the ticks n_i (the planned motion rests exactly on the target after them,
+  and one tick earlier a moving strut is at least D_i / (2 n_a (n - n_a)) > 1e-8 D_i from it,
+  beyond the arrival tolerance of ``sims.hexapod.strut_tolerances``);
+* the hexapod-space speeds (``hexapod_speed_ratios``: norms of the pose rate J^-1 qdot) peak at
+  switching ticks too, the Jacobian being constant to ~1e-6 over a move of millimetres;
 * the pose, the forward kinematics of six quadratics, is smooth inside a piece: its largest
   excursion is at a piece's end or at an interior extreme of one axis. The pose is computed
   exactly (forward kinematics) at every switching tick and at each piece's midpoint; each axis
@@ -97,11 +105,8 @@ from planners.errors import PlanningError
 from planners.hexapod import POSE_LABELS, RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS, StrutMove
 from planners.trajectory import PiecewiseTrajectory, control_ticks
 from sims.checks import Check
-from sims.hexapod import (ARRIVAL_SPREAD_LIMIT_S, CONTROL_DT, POSE_FINAL_LIMIT_UM, HexapodParams,
-                          arrival_times, plan_moves, problems)
-
-#: arrival_vs_own_time's limit, s: the run's (each strut within two ticks of its own time).
-OWN_TIME_LIMIT_S = 2 * CONTROL_DT
+from sims.hexapod import (ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM, HexapodParams,
+                          arrival_times, hexapod_speed_check, plan_moves, problems, strut_tolerances)
 #: Forward kinematics stops for a pose once its largest strut-length residual is below this,
 #: m (0.1 nm: 1e-8 of the smallest pose limit, 1e-4 of the 1 um end-pose limit).
 FK_TOLERANCE_M = 1e-10
@@ -315,13 +320,18 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     axis = np.where(better, vaxis, axis)
     when = np.where(better, t_vertex[index, vpoint], when)
 
-    moving = np.abs(moves.target - moves.start) > 0
+    # Hexapod-space speeds: the strut speeds are linear in t inside a piece and the Jacobian
+    # nearly constant over a move, so each speed (a norm of a linear function) peaks at a
+    # switching tick.
+    hex_speed = hexapod_planner.hexapod_speed_ratios(poses, sample.velocity.reshape(count, points, 6)).max(axis=1)
+    _, moving = strut_tolerances(moves.start, moves.target)
     arrival = moves.n_ticks * dt
     own = _own_times(moves)
     big, small = np.where(moving, arrival, -np.inf).max(1), np.where(moving, arrival, np.inf).min(1)
     return {
         "spread": np.where(moving.any(axis=1), big - small, 0.0),
-        "late": np.where(moving, np.abs(arrival - own), 0.0).max(axis=1),
+        "late": np.where(moving.any(axis=1), np.where(moving, arrival - own, -np.inf).max(axis=1), 0.0),
+        **{key: np.where(converged, hex_speed[:, k], np.nan) for k, key in enumerate(_HEX_KEYS)},
         "speed": speed.max(axis=1), "speed_strut": speed.argmax(axis=1),
         "accel": accel.max(axis=1),
         "stroke": stroke.max(axis=1), "stroke_strut": stroke.argmax(axis=1),
@@ -366,8 +376,9 @@ def _plan_group(start: np.ndarray, target: np.ndarray, synchronous: bool):
 # --------------------------------------------------------------------------- checks
 
 #: The per-move quantities a run's checks are made of (``_judge_strut_moves``).
+_HEX_KEYS = ("hex_radial", "hex_axial", "hex_radial_angular", "hex_axial_angular")
 _KEYS = ("spread", "late", "speed", "speed_strut", "accel", "stroke", "stroke_strut", "ratio",
-         "ratio_axis", "ratio_value", "ratio_time", "end_error")
+         "ratio_axis", "ratio_value", "ratio_time", "end_error", *_HEX_KEYS)
 
 
 def _worst(values: np.ndarray) -> int:
@@ -389,7 +400,8 @@ def _run_checks(m: dict, synchronous: np.ndarray, lo: int, hi: int) -> list[Chec
                             note="last minus first strut arrival of the planned motion"))
     if not sync.all():
         checks.append(Check("arrival_vs_own_time", float(m["late"][lo:hi][~sync].max()), OWN_TIME_LIMIT_S, "s",
-                            note="each planned strut ends within two ticks of its own time 2 T_i"))
+                            note="each planned strut's arrival minus its minimum time 2 max(t_i, t'_min) "
+                                 "(early is negative)"))
     if several:
         ws, wv, wr, we = (lo + _worst(m[k][lo:hi]) for k in ("speed", "stroke", "ratio", "end_error"))
     else:
@@ -404,6 +416,7 @@ def _run_checks(m: dict, synchronous: np.ndarray, lo: int, hi: int) -> list[Chec
               note=f"planned, peak on {STRUT_LABELS[int(m['speed_strut'][ws])]}"),
         Check("strut_accel", 1e6 * float(m["accel"][lo:hi].max()), 1e6 * limits.strut_accel, "um/s2",
               note="planned, per tick"),
+        _hex_speed(m, lo, hi, no_fk),
         Check("plan_stroke", 1e3 * float(m["stroke"][wv]), 1e3 * limits.stroke, "mm",
               note=f"planned strut length change, peak on {STRUT_LABELS[int(m['stroke_strut'][wv])]}"),
         Check("pose_limits", ratio, 1.0, "ratio",
@@ -418,6 +431,13 @@ def _run_checks(m: dict, synchronous: np.ndarray, lo: int, hi: int) -> list[Chec
     return checks
 
 
+def _hex_speed(m: dict, lo: int, hi: int, no_fk: str) -> Check:
+    peaks = np.array([m[key][lo:hi].max() for key in _HEX_KEYS])
+    if np.isnan(peaks).any():
+        return Check.not_evaluated("hexapod_speed", 1.0, "ratio", reason=no_fk)
+    return hexapod_speed_check(peaks, "planned")
+
+
 def _refused_checks(synchronous: np.ndarray, move: int, message: str, several: bool) -> list[Check]:
     """Every check of a run not evaluated: the planner refused its move ``move``."""
     reason = f"the planner refused {'move ' + str(move) if several else 'the move'}: {message}"
@@ -429,6 +449,7 @@ def _refused_checks(synchronous: np.ndarray, move: int, message: str, several: b
         checks.append(Check.not_evaluated("arrival_vs_own_time", OWN_TIME_LIMIT_S, "s", reason=reason))
     for name, limit, unit in (("strut_velocity", 1e6 * limits.strut_speed, "um/s"),
                               ("strut_accel", 1e6 * limits.strut_accel, "um/s2"),
+                              ("hexapod_speed", 1.0, "ratio"),
                               ("plan_stroke", 1e3 * limits.stroke, "mm"), ("pose_limits", 1.0, "ratio"),
                               ("plan_pose_error_final", POSE_FINAL_LIMIT_UM, "um")):
         checks.append(Check.not_evaluated(name, limit, unit, reason=reason))
@@ -506,16 +527,17 @@ def judge_trajectories(moves: Sequence[hexapod_planner.MoveProblem], trajectorie
     if len(moves) != len(trajectories) or not moves:
         raise ValueError(f"{len(moves)} moves and {len(trajectories)} trajectories: give one per move")
     m = {k: np.zeros(len(moves)) for k in _KEYS}
-    resting = True
+    not_resting = None
     for i, (problem, trajectory) in enumerate(zip(moves, trajectories)):
         t = control_ticks(float(trajectory.duration), problem.dt)
         ref = trajectory.sample(t)
         position = np.asarray(ref.position, dtype=float)
         start = hexapod_planner.strut_positions(problem.start_pose)
         target = hexapod_planner.strut_positions(problem.target_pose)
-        moving = np.abs(target - start) > 0
-        resting &= not np.any(np.asarray(ref.velocity)[-1] != 0.0)
-        arrivals = arrival_times(ref)
+        tolerance, moving = strut_tolerances(start, target)
+        arrivals = arrival_times(ref, target, tolerance, problem.dt)
+        if not_resting is None and np.isnan(arrivals).any():
+            not_resting = i
         own = hexapod_planner.own_move_times(problem)
         # Forward kinematics of every tick, linearized at the nearer end of the move.
         near_target = (np.abs(position - target).max(axis=1) < np.abs(position - start).max(axis=1))[:, None]
@@ -527,19 +549,23 @@ def judge_trajectories(moves: Sequence[hexapod_planner.MoveProblem], trajectorie
         u = np.abs(pose_ratio(poses))
         tick, axis = np.unravel_index(int(np.argmax(u)), u.shape)
         speed, stroke = np.abs(ref.velocity).max(axis=0), np.abs(position).max(axis=0)
+        hex_speed = hexapod_planner.hexapod_speed_ratios(poses, ref.velocity).max(axis=0)
         m["spread"][i] = arrivals[moving].max() - arrivals[moving].min() if moving.any() else 0.0
-        m["late"][i] = np.abs(arrivals - own)[moving].max() if moving.any() else 0.0
+        m["late"][i] = (arrivals - own)[moving].max() if moving.any() else 0.0
         m["speed"][i], m["speed_strut"][i] = speed.max(), speed.argmax()
         m["accel"][i] = np.abs(ref.acceleration).max()
         m["stroke"][i], m["stroke_strut"][i] = stroke.max(), stroke.argmax()
         m["ratio"][i] = u[tick, axis] if ok else np.nan
         m["ratio_axis"][i], m["ratio_value"][i], m["ratio_time"][i] = axis, poses[tick, axis], t[tick]
         m["end_error"][i] = pivot_error_um(poses[-1:], np.asarray(problem.target_pose)[None])[0] if ok else np.nan
+        for k, key in enumerate(_HEX_KEYS):
+            m[key][i] = hex_speed[k] if ok else np.nan
     synchronous = np.array([p.synchronous for p in moves], dtype=bool)
     checks = _run_checks(m, synchronous, 0, len(moves))
-    if not resting:
-        # As in a run: arrivals exist only where the planned motion comes to rest at its end.
-        reason = "a planned move does not come to rest at its end (nonzero velocity at its last tick)"
+    if not_resting is not None:
+        # As in a run: arrivals exist only where the planned motion comes to rest on its target.
+        reason = ("the planned move" + (f" {not_resting}" if len(moves) > 1 else "")
+                  + " does not come to rest on its target at its end (arrival_times' tolerance)")
         checks = [Check.not_evaluated(c.name, c.limit, c.unit, reason=reason)
                   if c.name in ("arrival_spread", "arrival_vs_own_time") else c for c in checks]
     return checks
