@@ -44,7 +44,7 @@ class TaskAdapter(control.Task):
         self._state_spec = mujoco.mjtState.mjSTATE_INTEGRATION
         self._initial = np.empty(mujoco.mj_stateSize(model, self._state_spec))
         mujoco.mj_getState(model, physics.data.ptr, self._initial, self._state_spec)
-        self._controlled = np.asarray(setup.controlled if setup.controlled is not None else np.arange(model.nu))
+        self._controlled = runner.controlled_actuators(setup)
         self.tick = 0
 
     @property

@@ -253,6 +253,33 @@ class Episode:
     steps_per_tick: int
 
 
+def controlled_actuators(setup: Setup) -> np.ndarray:
+    """Indices of the actuators the controller drives (``Setup.controlled``; None: all)."""
+    nu = setup.physics.model.ptr.nu
+    return np.arange(nu) if setup.controlled is None else np.asarray(setup.controlled, dtype=int)
+
+
+def controlled_names(setup: Setup) -> tuple:
+    """The names of the actuators the controller drives, in its command's order."""
+    model = setup.physics.model.ptr
+    return tuple(model.actuator(int(j)).name for j in controlled_actuators(setup))
+
+
+def controlled_views(setup: Setup):
+    """(command, act addresses): the controller's command, a view of ``data.ctrl`` for its
+    actuators (a contiguous run of them: the others, such as the antenna's deck drives, belong
+    to the disturbance and are neither seen nor written), and the activation addresses of
+    its drives' set-points (all activations when it drives every actuator)."""
+    model, data = setup.physics.model.ptr, setup.physics.data.ptr
+    ids = controlled_actuators(setup)
+    if ids.size == 0 or np.any(np.diff(ids) != 1):
+        raise ValueError(f"the controlled actuators {ids.tolist()} must be one contiguous run")
+    if ids.size == model.nu:
+        return data.ctrl, slice(None)
+    adr = model.actuator_actadr[ids]
+    return data.ctrl[ids[0]:ids[-1] + 1], adr[adr >= 0]
+
+
 def start_episode(setup: Setup, controller=None) -> Episode:
     """Put ``setup`` at the start of its run: reset the sensors (seeded from ``setup.seed``),
     the online planner, ``controller`` (default ``setup.controller``: its ``reset`` with the
@@ -266,19 +293,20 @@ def start_episode(setup: Setup, controller=None) -> Episode:
     controller = setup.controller if controller is None else controller
     check_controller(controller)
     observation = setup.sensors.reset(physics, times, setup.seed)
+    command, act_adr = controlled_views(setup)
     context = ControlContext(
         model=setup.nominal_physics().model.ptr, nominal_physics=setup.nominal_physics,
         problem=setup.problem, trajectory=setup.trajectory if setup.reference_visible else None,
         reference=reference if setup.reference_visible else None,
-        control_dt=setup.control_dt, command=data.ctrl, setpoint=data.act.copy(),
-        actuators=tuple(model.actuator(j).name for j in range(model.nu)), observation=observation,
+        control_dt=setup.control_dt, command=command, setpoint=data.act[act_adr].copy(),
+        actuators=controlled_names(setup), observation=observation,
         sensors=tuple(setup.sensors.specs),
         planner=setup.planner if hasattr(setup.planner, "step") else None)
     # Before the first tick a plug-in that cannot start is bad input, not a failed run.
     if context.planner is not None:  # an online planner starts from the problem
         _start("planner", context.planner.reset, setup.problem)
     _start("controller", controller.reset, context)
-    data.act[:] = context.setpoint
+    data.act[act_adr] = context.setpoint
     if setup.disturbance is not None:
         setup.disturbance.reset(physics, times, np.random.default_rng(setup.seed))
     mujoco.mj_forward(model, data)
@@ -328,7 +356,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     record(0)
     initial_ctrl = data.ctrl.copy()
     sensors, disturbance = setup.sensors, setup.disturbance
-    ctrl_now = data.ctrl
+    ctrl_now = context.command
     contacts = log.contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
                desc="simulating")
@@ -346,7 +374,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             command = controller(i, observation)
             if command is not None:
                 # At the first call a wrong shape is a broken contract (bad input), not a fault.
-                ctrl_now[:] = command if i else check_first_command(command, model.nu, context.actuators)
+                ctrl_now[:] = command if i else check_first_command(command, ctrl_now.size, context.actuators)
         except PluginError:
             raise
         except (Exception, SystemExit) as e:  # a controller's fault ends the run as a failed check

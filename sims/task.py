@@ -199,12 +199,14 @@ class ControlContext:
         which no controller can know.
       reference: the trajectory sampled at every control tick (None with it).
       control_dt: the control period, s.
-      command: the actuators' commands (``ctrl``, in the model's actuator order): write it
-        every tick, or return the vector from ``__call__``.
-      setpoint: the drives' position set-points (the integrator actuators' activations) at the
+      command: the commands (``ctrl``) of the actuators this controller drives, in the
+        order of ``actuators``: write it every tick, or return the vector from ``__call__``.
+        Actuators that belong to the task's disturbance (the antenna's deck drives, moved by
+        the sea) are not in it.
+      setpoint: the position set-points (the integrator activations) of those drives at the
         start; a controller may set them in ``reset`` (the set-points a motion controller
         loads when it enables the drives). Writing it later has no effect.
-      actuators: the actuator names, in ``command``'s order.
+      actuators: the names of the actuators the controller drives, in ``command``'s order.
       observation: the task's observation (the same dict every tick, updated in place).
       sensors: the ``SensorSpec`` of every reading (rate, latency, noise: the datasheets).
       planner: the antenna's online planner (its ``step`` records every update for the

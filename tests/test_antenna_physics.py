@@ -160,7 +160,7 @@ def test_dm_control_environment_with_an_imu_driven_controller():
     planner = ant.CrrPlanner()
     planner.reset(problem)
     period = problem.update_dt
-    seen, target, rewards = -1, observation["joint_positions"], []
+    seen, target, rewards = 0, observation["joint_positions"], []
     while not step.last():
         observation = step.observation
         if observation["imu_count"][0] != seen:

@@ -25,7 +25,7 @@ class SampleAndHold:
         self.antenna = [context.actuators.index(name) for name in JOINT_LABELS]  # the four drives
         self.command = context.command
         self.target = context.observation["joint_positions"].copy()
-        self.seen = -1
+        self.seen = 0  # imu_count: no sample has arrived yet
 
     def __call__(self, tick: int, observation) -> None:
         count = int(observation["imu_count"][0])

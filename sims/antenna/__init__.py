@@ -283,8 +283,15 @@ class AntennaImu(Sensors):
     The IMU is sampled every ``imu.ticks`` control ticks from MuJoCo's ``imu_quat`` and
     ``imu_gyro`` sensors; its attitude error is a first-order Gauss-Markov process, its gyro
     noise white (``ImuModel``); a sample reaches the controller ``latency`` ticks later (the
-    newest that has arrived by a tick is the one it sees). The first sample is taken and
-    delivered at t = 0 (the run starts in steady tracking).
+    newest that has arrived by a tick is the one it sees), the first one too: it is taken at
+    t = 0 and arrives at t = latency (with no latency, at once). Until then ``imu_count`` is 0
+    and the other IMU keys hold placeholders (identity, zeros) that describe no measurement.
+
+    Each sample's time stamp is when MuJoCo's sensors saw the state it reports: a tick's
+    ``imu_quat`` and ``imu_gyro`` after ``mj_step`` describe the start of the tick's last
+    physics step, so the samples after t = 0 are stamped one physics step (1 ms) before their
+    tick (0.019, 0.039, ... s at 50 Hz). The stamp is the sample's true time, not a clock's
+    error; its age on arrival is the latency plus that step.
 
     ``errors`` (an ``AntennaPlant``; None: none) are the true IMU's errors that its datasheet
     (``imu``, the published SensorSpecs) does not state, so the controller does not know them:
@@ -296,7 +303,8 @@ class AntennaImu(Sensors):
       imu_gyro (3,): the measured angular rate, rad/s, in the IMU frame.
       imu_time (1,): when that sample was taken, s (MuJoCo's sensors after a step describe
         the start of its last physics step).
-      imu_count (1,): samples delivered so far (a new one arrived when it changes).
+      imu_count (1,): samples delivered so far (a new one arrived when it changes; 0 before
+        the first arrives).
       joint_positions, joint_velocities, setpoints (4,): the antenna's encoders (exact) and
         its drives' set-points, rad and rad/s.
     """
@@ -343,7 +351,8 @@ class AntennaImu(Sensors):
                    imu_count=np.zeros(1, dtype=int))
         self.observation = obs
         self._measure(0, lag=0.0)  # mj_forward just evaluated the sensors at t = 0
-        self._deliver(self.queue.popleft()[1])
+        if self.queue[0][0] <= 0:  # no latency: it has arrived
+            self._deliver(self.queue.popleft()[1])
         return obs
 
     def _measure(self, tick: int, lag: float | None = None) -> None:
@@ -363,8 +372,7 @@ class AntennaImu(Sensors):
             gyro = gyro + self.rng.normal(0.0, self.gyro_sigma, 3)
         # After mj_step the sensors hold the state at the start of its last physics step.
         lag = self.physics_dt if lag is None else lag
-        arrival = tick + self.latency if tick > 0 else 0
-        self.queue.append((arrival, (tick * self.dt - lag, rotation, gyro)))
+        self.queue.append((tick + self.latency, (tick * self.dt - lag, rotation, gyro)))
 
     def _deliver(self, sample) -> None:
         obs = self.observation
@@ -413,26 +421,29 @@ class AntennaController:
         self.period = int(round(1.0 / (imu.rate_hz * self.dt)))
         self.latency = int(round(imu.latency_s / self.dt))
         model = context.model
-        self.actuators = np.array([model.actuator(n).id for n in JOINTS])
-        self.act_adr = model.actuator_actadr[self.actuators]
-        kp = model.actuator_gainprm[self.actuators, 0]
-        kv = -model.actuator_biasprm[self.actuators, 2]
+        ids = np.array([model.actuator(n).id for n in JOINTS])
+        self.actuators = np.array([context.actuators.index(n) for n in JOINTS])  # in the command
+        kp = model.actuator_gainprm[ids, 0]
+        kv = -model.actuator_biasprm[ids, 2]
         self.lead = kv / kp  # s: velocity feed-forward through the set-point
         obs = context.observation
         theta = obs["joint_positions"].copy()
-        self.theta_from, self.theta_to = theta.copy(), theta.copy()
-        self.ff_from = obs["joint_velocities"].copy()
-        self.ff_to = self.ff_from.copy()
-        self.tick_from, self.tick_to = 0, 0
+        rate = obs["joint_velocities"].copy()
+        # Until the first IMU sample arrives (at its latency), the joints go on at the rates
+        # their encoders show at the start (the run starts in steady tracking).
+        first = self.latency
+        self.theta_from, self.theta_to = theta, theta + rate * first * self.dt
+        self.ff_from, self.ff_to = rate, rate.copy()
+        self.tick_from, self.tick_to = 0, first
         self.last_gyro = None
         self.command = context.command
-        # The first sample arrived at t = 0: the first update is planned now.
         self.seen = int(obs["imu_count"][0])
-        self._update(0, obs)
+        if self.seen:  # no latency: the first sample is here, the first update is planned now
+            self._update(0, obs)
 
     def _update(self, tick: int, obs) -> None:
         measured_t, rotation, gyro = float(obs["imu_time"][0]), obs["imu_attitude"], obs["imu_gyro"].copy()
-        target_tick = tick + self.period if tick > 0 else self.period + self.latency
+        target_tick = tick + self.period
         rate = gyro
         if self.predict:
             tau = target_tick * self.dt - measured_t

@@ -1,0 +1,81 @@
+"""A controller sees and writes only the actuators it drives: the antenna's four joint drives,
+not the four deck drives (heave, yaw, pitch, roll) that belong to the sea; every other
+mechanism's controller drives all of its actuators."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from planners.antenna import JOINT_LABELS
+from sims import runner, scenarios
+from sims.antenna import AntennaController
+from sims.plugins import PluginError
+
+DECK = ("heave", "yaw", "pitch", "roll")
+
+
+class Spy(AntennaController):
+    """Our controller, recording what its context offers."""
+
+    def reset(self, context):
+        self.names, self.size = context.actuators, context.command.size
+        self.setpoint_size = context.setpoint.size
+        super().reset(context)
+
+
+class Returns:
+    """Returns a command vector of ``size`` zeros."""
+
+    def __init__(self, size):
+        self.size = size
+
+    def reset(self, context):
+        pass
+
+    def __call__(self, tick, observation):
+        return np.zeros(self.size)
+
+
+def build(name, controller, duration=0.5):
+    scenario = scenarios.get(name)
+    return scenario.build(scenario.resolve(duration=duration), controller=controller)
+
+
+@pytest.mark.parametrize("name", ["antenna-paper-motion", "antenna-sea-state"])
+def test_the_antenna_controller_gets_only_its_four_drives(name):
+    spy = Spy()
+    setup = build(name, spy)
+    result = runner.run(name, setup)
+    assert spy.names == tuple(JOINT_LABELS) and spy.size == 4 and spy.setpoint_size == 4
+    assert not set(spy.names) & set(DECK)
+    # The sea still moves the deck through its own drives.
+    model = setup.physics.model.ptr
+    deck = [model.actuator(n).id for n in DECK]
+    assert np.abs(np.diff(result.log.ctrl[:, deck], axis=0)).max() > 0
+
+
+def test_a_command_for_every_actuator_is_refused_naming_the_four():
+    setup = build("antenna-sea-state", Returns(8))
+    with pytest.raises(PluginError, match=r"shape \(8,\); this task has 4 actuators \(azimuth, elevation"):
+        runner.run("antenna-sea-state", setup)
+
+
+def test_a_controller_returning_zeros_leaves_the_deck_to_the_sea():
+    """Zero joint rates: the antenna's set-points stay where they started; the deck's drives are
+    the sea's as in a run with our controller."""
+    ours = runner.run("antenna-sea-state", build("antenna-sea-state", None))
+    setup = build("antenna-sea-state", Returns(4))
+    idle = runner.run("antenna-sea-state", setup)
+    model = setup.physics.model.ptr
+    deck = [model.actuator(n).id for n in DECK]
+    joints = [model.actuator(n).id for n in JOINT_LABELS]
+    np.testing.assert_array_equal(idle.log.ctrl[:, deck], ours.log.ctrl[:, deck])
+    np.testing.assert_array_equal(idle.log.ctrl[:, joints], 0.0)
+
+
+@pytest.mark.parametrize("name", ["loader-supply", "hexapod-sync-move", "fast-tracking"])
+def test_other_controllers_drive_every_actuator(name):
+    setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=0.1))
+    model = setup.physics.model.ptr
+    assert runner.controlled_names(setup) == tuple(model.actuator(j).name for j in range(model.nu))
