@@ -195,7 +195,13 @@ def _convert(kind: _Type, value, key: str, declared: Declared, column: int | Non
         if not isinstance(value, str):
             raise ParamError(f"{key} = {value!r} is not a name (a string)")
         if declared.choices is not None and value not in declared.choices:
-            raise ParamError(f"{key} = {value!r} is not {range_text(declared)}")
+            unset = ""
+            if kind.optional and value.strip().lower() in ("none", "null"):
+                # A typed value (a scenario file's) is never parsed: "none" is the flag syntax.
+                unset = (f"; to leave {key} unset, omit it from the file"
+                         + (f" (and give {', '.join(declared.excludes)})" if declared.excludes else "")
+                         + f" or pass --set {key}=none")
+            raise ParamError(f"{key} = {value!r} is not {range_text(declared)}{unset}")
         return value
     if kind.kind == "nested":
         if isinstance(value, kind.cls):

@@ -65,6 +65,13 @@ CASES = [
     (["run", "loader-supply", "--out", "{tmp}/r", "--set", "duration=5\nseed=3"], {}, ["line break", "'seed'"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--duration", "5\nseed=3"], {}, ["--duration", "line break"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--set", "duration=" + "[" * 5000], {}, ["nested too deep"]),
+    # TOML has no none: a file that writes the flags' "none" is told to leave the key out.
+    (["run", "radec.toml", "--out", "{tmp}/r"],
+     {"radec.toml": 'scenario = "fast-tracking"\n[parameters]\nsource = "none"\nsource_radec = [202.78, 30.51]\n'},
+     ["source = 'none'", "omit it from the file", "give source_radec"]),
+    (["run", "both.toml", "--out", "{tmp}/r"],
+     {"both.toml": 'scenario = "fast-tracking"\n[parameters]\nsource = "3C 286"\nsource_radec = [202.78, 30.51]\n'},
+     ["both given", "leave source out"]),
 ]
 
 
