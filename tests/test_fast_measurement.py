@@ -176,8 +176,10 @@ def test_sensor_options_reach_the_run_from_the_scenario_parameters():
     assert {s.name: s for s in at_100_hz.sensors.specs}["platform_ts"].rate_hz == pytest.approx(100 / 12)
     ideal = build_scenario(FastTrackingParams(duration=0.5, sensors=SensorOptions(system="ideal")))
     assert {s.name for s in ideal.sensors.specs} >= {"cabin_pose_ts", "cabin_pose"}
-    # The ideal system's specs too: its 10 ms stabilizer latency is no tick at 50 Hz, one at 100.
-    assert {s.name: s for s in ideal.sensors.specs}["cabin_pose"].latency_s == 0.0
+    # The ideal system's specs too: its 10 ms stabilizer latency rounds up to one 20 ms tick at
+    # 50 Hz (never sooner than the datasheet), one 10 ms tick at 100; GPS/RTK's 50 ms to 60 ms.
+    assert {s.name: s for s in ideal.sensors.specs}["cabin_pose"].latency_s == pytest.approx(0.02)
+    assert spec["cabin_rtk"].latency_s == pytest.approx(0.06)
     ideal_100 = build_scenario(FastTrackingParams(duration=0.5, sensors=SensorOptions(system="ideal"),
                                                   control_rate_hz=100.0))
     specs = {s.name: s for s in ideal_100.sensors.specs}

@@ -178,8 +178,8 @@ class IdealSensors(Sensors):
         o = self.options = options
         self.dt = control_dt
         self.every = _ticks(1.0 / o.pose_rate_hz, control_dt, 1)
-        self.pose_lag = _ticks(o.pose_latency_s, control_dt, 0)
-        self.stewart_lag = _ticks(o.stewart_latency_s, control_dt, 0)
+        self.pose_lag = _latency_ticks(o.pose_latency_s, control_dt)
+        self.stewart_lag = _latency_ticks(o.stewart_latency_s, control_dt)
         rate = 1.0 / control_dt
         # The rates and latencies as simulated: whole numbers of ticks (as FusedSensors').
         self.specs = [
@@ -478,8 +478,8 @@ class FusedSensors(Sensors):
         self.gravity = model.opt.gravity.copy()
         self.fix_every = {"cabin": _ticks(1.0 / o.rtk_rate_hz, control_dt, 1),
                           "platform": _ticks(1.0 / o.ts_rate_hz, control_dt, 1)}
-        self.fix_lag = {"cabin": _ticks(o.rtk_latency_s, control_dt, 0),
-                        "platform": _ticks(o.ts_latency_s, control_dt, 0)}
+        self.fix_lag = {"cabin": _latency_ticks(o.rtk_latency_s, control_dt),
+                        "platform": _latency_ticks(o.ts_latency_s, control_dt)}
         self.body_ids = {"cabin": physics.cabin_body, "platform": int(model.body("feed_platform").id)}
         self.point_sites = {"cabin": [model.site(f"rtk{i}").id for i in (1, 2, 3)],
                             "platform": [model.site(f"prism{i}").id for i in (1, 2, 3)]}
@@ -612,7 +612,14 @@ class FusedSensors(Sensors):
 
 
 def _ticks(seconds: float, dt: float, least: int) -> int:
+    """A sensor's period in control ticks: the nearest whole number, at least ``least``."""
     return max(least, int(round(seconds / dt)))
+
+
+def _latency_ticks(seconds: float, dt: float) -> int:
+    """A latency in control ticks, rounded up (to 1e-9 of a tick): a reading never reaches the
+    controller sooner than its datasheet says (50 ms at 50 Hz: 3 ticks, 60 ms)."""
+    return int(math.ceil(seconds / dt - 1e-9))
 
 
 def make_sensors(physics, options: SensorOptions, control_dt: float = CONTROL_DT) -> Sensors:
