@@ -1,6 +1,6 @@
 """Errors raised by planners on bad input.
 
-Every error names the offending value and the limit it breaks (ARCHITECTURE.md, Conventions).
+Every error names the offending value and the limit it breaks (README.md, "Conventions").
 They subclass ValueError so callers can catch them as bad input; the CLI turns them into exit
 code 2 with one line on stderr.
 """

@@ -5,7 +5,7 @@ body's frame). With the moving body at position ``p`` and orientation ``R``,
 
     l_i = p + R b_i - a_i,     L_i = |l_i|,     u_i = l_i / L_i
 
-(ARCHITECTURE.md: "a cable and a Stewart leg are the same |a - (p + R b)|"). This module is the
+(a cable and a Stewart leg are the same |a - (p + R b)|). This module is the
 one implementation of that formula; the hexapod struts, the FAST Stewart stabilizer and the
 FAST cables all call it. Every function is vectorized over leading pose dimensions.
 

@@ -1,7 +1,7 @@
 """1-D motion profiles with first-degree (piecewise-linear) acceleration: the FAST paper's Figure 6.
 
 Paper: Yao et al. 2020, "A motion planning algorithm for the feed support system of FAST"
-(``shared/papers/fast-feed-support-motion-planning.txt``), section 3: "all the acceleration
+(REFERENCE.md "Papers"), section 3: "all the acceleration
 curves adopted in this paper are first degree curves, so that the velocity planning curves are
 quadratic" (Figure 6). Every segment of a FAST plan uses them: start/termination (section 3.1),
 the source switching straight line and focal segments with their times T_line, T_focal

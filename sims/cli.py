@@ -1,4 +1,4 @@
-"""The ``planbench`` command line (ARCHITECTURE.md, "Contracts").
+"""The ``planbench`` command line (README.md, "Command line").
 
   planbench list
   planbench run NAME|FILE.toml|DIR/summary.json [--PARAMETER VALUE ...] [--set KEY=VALUE ...]

@@ -1,4 +1,6 @@
-"""Typed scenario parameters, declared once (ARCHITECTURE.md, "Typed scenario parameters").
+"""Typed scenario parameters, declared once.
+
+The user's view: README.md, "Scenario parameters, scenario files and reruns".
 
 Each scenario's parameters are one frozen dataclass, a subclass of ``Params``. Every field is
 declared with ``param``: its default, unit, valid range and the reason for the range, and a

@@ -2,7 +2,7 @@
 
 ``planbench run NAME --controller MODULE:FACTORY --planner MODULE:FACTORY``: ``MODULE`` is an
 importable module (``my_package.controllers``) or a path to a ``.py`` file
-(``examples/loader/pd.py``); ``FACTORY`` a callable in it (a class or a function, dots for
+(``examples/loader/pd_controller.py``); ``FACTORY`` a callable in it (a class or a function, dots for
 nested attributes) that takes no arguments and returns the controller or the planner. What a
 controller and a planner must provide is the Task contract (``sims.task``); a plug-in that
 breaks it is refused with one line (``PluginError``) before the run starts.

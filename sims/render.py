@@ -1,6 +1,6 @@
 """Offscreen video of a run: replay the logged states through ``mujoco.Renderer``.
 
-The OpenGL back end is chosen in ``sims/__init__`` (EGL, falling back to OSMesa). Videos are
+The OpenGL back end is chosen in ``sims/__init__.py`` (EGL, falling back to OSMesa). Videos are
 H.264 written by mediapy through the ffmpeg binary that the imageio-ffmpeg package ships, so
 no system ffmpeg is needed.
 """

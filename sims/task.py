@@ -2,7 +2,7 @@
 
 Modelled on ``dm_control.rl.control.Task``. A scenario builds a task (``runner.Setup``); the
 task owns the plant's initial state, its disturbances (wind, the sea), its **sensors** and its
-evaluation. The runner drives every run the same way (ARCHITECTURE.md, "Task contract"):
+evaluation. The runner drives every run the same way (README.md, "Your own planner or controller"):
 
 * The **planner** gets the task's planning problem, a typed object (``planning_problem`` of
   each mechanism: key points and limits, start and target poses, the satellite and the

@@ -847,7 +847,7 @@ _FIXTURE = {
 
 
 # ============================================================================ the papers' constants
-# Pinned by what they do, with the papers' literal numbers (shared/papers/): a permutation or
+# Pinned by what they do, with the papers' literal numbers (REFERENCE.md "Papers"): a permutation or
 # a scaling of the constants in planners/ changes a planned motion or a solution here.
 
 #: Ship-antenna paper, section 3.3, eq. (7): "W = [10 5 2 1]^T" (w1 > w2 > w3 > w4).

@@ -2,7 +2,7 @@
 independent computations: kinematics, statics, the continuous generator and its tick-grid
 realization.
 
-The paper (shared/papers/hexapod-trajectory-generator.txt) plans *half* moves: its T values
+The paper (REFERENCE.md "Papers") plans *half* moves: its T values
 are half-move times, so a whole move of a strut takes 2 T.
 """
 

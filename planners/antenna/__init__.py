@@ -2,8 +2,8 @@
 constant-rotation-ratio (CRR) joint-position algorithm.
 
 Paper: Wu, Chen and Ding, "Joints position approach for satellite antenna attitude
-stabilization system based on constant rotation ratio" (``shared/papers/ship-antenna-crr-
-joint-position.txt``, "the paper" below). Errata and conventions: ``shared/REFERENCE.md``,
+stabilization system based on constant rotation ratio" (REFERENCE.md
+"Papers", "the paper" below). Errata and conventions: REFERENCE.md,
 "Ship antenna".
 
 Frames and conventions

@@ -1,8 +1,8 @@
 """FAST feed support: geometry, kinematics (eq. 1-9) and cable statics.
 
 Paper: Yao et al. 2020, "A motion planning algorithm for the feed support system of FAST"
-(``shared/papers/fast-feed-support-motion-planning.txt``, "the paper"). Numbers: its Table 1
-and ``shared/REFERENCE.md`` ("FAST", with the CASPR geometry and the errata).
+(REFERENCE.md "Papers", "the paper"). Numbers: its Table 1
+and REFERENCE.md ("FAST feed support system" and "Errata of the papers").
 
 Frames (the paper's section 2)
 ------------------------------

@@ -1,6 +1,6 @@
 """FAST feed support: the complete motion plan (the paper's section 3).
 
-Paper: Yao et al. 2020 (``shared/papers/fast-feed-support-motion-planning.txt``). A plan is a
+Paper: Yao et al. 2020 (REFERENCE.md "Papers"). A plan is a
 sequence of feed segments (Figure 5): source switching P0 -> Ph (a straight line to the closest
 focal-surface point) -> P1 (along the focal surface), start planning P1 -> Ps, the observation
 Ps -> Pt (tracking, or a motion scan with transition segments), termination planning Pt -> P2.

@@ -2,8 +2,8 @@
 observation modes (tracking, drift scan, motion scans in RA and Dec) as horizon paths.
 
 Paper: Yao et al. 2020, "A motion planning algorithm for the feed support system of FAST"
-(``shared/papers/fast-feed-support-motion-planning.txt``, "the paper"), section 3.3 and
-Table 1 (zenith angle up to 40 deg). Site and astronomy: ``shared/REFERENCE.md`` ("FAST").
+(REFERENCE.md "Papers", "the paper"), section 3.3 and
+Table 1 (zenith angle up to 40 deg). Site and astronomy: REFERENCE.md ("FAST feed support system").
 
 Site
 ----

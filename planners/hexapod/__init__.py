@@ -1,7 +1,7 @@
 """Rubin-style hexapod: kinematics and the synchronous/asynchronous trajectory generator.
 
-Paper: the trajectory page of lsst-ts/ts_mthexapod, ``shared/papers/hexapod-trajectory-
-generator.txt`` ("the paper" below). Geometry and limits: ``shared/REFERENCE.md``, "Rubin
+Paper: the trajectory page of lsst-ts/ts_mthexapod, REFERENCE.md
+"Papers" ("the paper" below). Geometry and limits: REFERENCE.md, "Rubin
 hexapod" (from ts_mthexapod's ``constants.py``, camera hexapod).
 
 Conventions

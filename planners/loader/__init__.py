@@ -1,7 +1,7 @@
 """PRR-3R ammunition loading robot: Table 1 key points, the supply plans, forward kinematics.
 
 Paper: Li, Xu, Luo, "Trajectory Planning of Ammunition Loading Robot Based on Cubic-B Spline"
-(``shared/papers/loader-cubic-bspline.txt``). Table 1 gives theta1 (prismatic, read as mm)
+(REFERENCE.md "Papers"). Table 1 gives theta1 (prismatic, read as mm)
 and theta2 ... theta6 (degrees) at the start point P2, the obstacle-avoiding key points
 M1 ... M4 and the end point P3, at t = 0, 0.5, ... 2.5 s. The mapping of these values onto the
 model's joints is in ``models/loader/README.md``.

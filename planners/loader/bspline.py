@@ -2,7 +2,7 @@
 
 This is the joint-space planner of the ammunition loading robot paper
 (Li, Xu, Luo, "Trajectory Planning of Ammunition Loading Robot Based on Cubic-B Spline",
-``shared/papers/loader-cubic-bspline.txt``), written from its definitions:
+REFERENCE.md "Papers"), written from its definitions:
 
 * eq. (10): segment i, local parameter u in [0, 1],
   theta_i(u) = 1/6 [u^3 u^2 u 1] B [P_i, P_i+1, P_i+2, P_i+3]^T with the basis matrix B below;
