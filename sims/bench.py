@@ -120,8 +120,8 @@ def format_table(rows: list[dict]) -> str:
     for r in rows:
         if r["scenario"] == "fast-tracking":
             lines.append(f"fast-tracking: 20 min of observation (the plan's {r['sim_time_s']:.0f} s with the "
-                         f"switch) in {r['wall_time_s']:.1f} s of wall time (target <= 60 s, issue 6)")
-    lines.append("loop/bare target >= 0.8 (issue 2); realtime x = simulated / wall time of the whole run")
+                         f"switch) in {r['wall_time_s']:.1f} s of wall time (target <= 60 s)")
+    lines.append("loop/bare target >= 0.8; realtime x = simulated / wall time of the whole run")
     return "\n".join(lines)
 
 
@@ -188,7 +188,7 @@ def format_campaign(rows: list[dict]) -> str:
     for r in rows:
         lines.append(f"{r['engine'] + ' x' + str(r['workers']):<40} {r['wall_s']:>7.2f} {r['runs_per_s']:>7.3f} "
                      f"{r['runs_per_s'] / base['runs_per_s']:>11.2f} {r['runs_per_s'] / two['runs_per_s']:>11.2f}")
-    lines.append("targets: local x2 >= 1.7 x local x1; ray x2 >= 0.9 x local x2 (issue 15); tables equal run for run: "
+    lines.append("targets: local x2 >= 1.7 x local x1; ray x2 >= 0.9 x local x2; tables equal run for run: "
                  + ("yes" if rows and rows[0]["same_table"] else "NO"))
     return "\n".join(lines)
 

@@ -1,7 +1,8 @@
 """What a run may ask for: its duration against the control tick and the memory its log
-needs, and the range of angle options. Checked before anything is built (README, "Bad
-input"), by the scenarios' ``validate`` (which ``planbench run`` calls while it reads its
-options) and again by every mechanism's ``build`` (the Python API).
+needs, and the range of angle options. Checked before anything is built (README.md,
+"Scenario parameters, scenario files and reruns"), by the parameters' ``check`` (which
+``planbench run`` calls while it reads its options) and again by every mechanism's ``build``
+(the Python API).
 
 Duration:
   * at least one control tick of the scenario: a shorter run takes no physics step and its
@@ -10,15 +11,17 @@ Duration:
     t, qpos, qvel, act, ctrl, actuator_force, sensordata, mocap, the reference sampled at
     every tick) and the controllers and disturbances preallocate their own per-tick arrays;
     each mechanism states those per tick (``log_bytes_per_tick`` in sims/loader/__init__.py,
-    hexapod.py, antenna.py, fast.py; tests/test_run_options.py measures them). A run whose
+    sims/hexapod/__init__.py, sims/antenna/__init__.py, sims/fast/__init__.py;
+    tests/test_run_options.py measures them). A run whose
     estimate exceeds ``log_memory_limit()``, a quarter of the machine's physical memory, is
     refused: evaluating the checks and writing the outputs needs about as much again as the
     log (measured peaks of 1.2-2.5 times the log), so a quarter leaves the rest of the machine
     its memory.
 
-Angles (wave heading, wind direction): refused beyond +-ANGLE_LIMIT_DEG, used as given inside
-(every use is periodic: -90 and 270 deg are the same direction). A larger value is no
-direction anyone means: at 1e308 deg a double cannot even tell 1 deg apart.
+Angles (wave heading, wind direction, a wind file's directions): refused beyond
++-ANGLE_LIMIT_DEG (``ANGLE``, the one declaration of their range), used as given inside (every
+use is periodic: -90 and 270 deg are the same direction). A larger value is no direction
+anyone means: at 1e308 deg a double cannot even tell 1 deg apart.
 """
 
 from __future__ import annotations
@@ -35,6 +38,9 @@ LOG_MEMORY_FRACTION = 0.25
 FALLBACK_LOG_LIMIT_BYTES = 4 * 2**30
 #: Angle options are refused beyond +- this, deg (one turn either way).
 ANGLE_LIMIT_DEG = 360.0
+#: The range of an angle parameter (``sims.params.param`` keywords).
+ANGLE = dict(unit="deg", low=-ANGLE_LIMIT_DEG, high=ANGLE_LIMIT_DEG,
+             reason="one turn either way; angles are not wrapped")
 
 _BYTES_PER_FLOAT = 8
 
@@ -119,10 +125,3 @@ def check_duration(duration: float | None, control_dt: float, bytes_per_tick: fl
     return duration
 
 
-def check_angle(name: str, value: float) -> float:
-    """``value`` (deg) if it is finite and within +-ANGLE_LIMIT_DEG, else a RunLimitError."""
-    value = float(value)
-    if not math.isfinite(value) or abs(value) > ANGLE_LIMIT_DEG:
-        raise RunLimitError(f"{name} {value:g} deg is outside [-{ANGLE_LIMIT_DEG:g}, "
-                            f"{ANGLE_LIMIT_DEG:g}] deg (one turn either way; angles are not wrapped)")
-    return value

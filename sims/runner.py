@@ -280,17 +280,17 @@ def controlled_views(setup: Setup):
     return data.ctrl[ids[0]:ids[-1] + 1], adr[adr >= 0]
 
 
-def start_episode(setup: Setup, controller=None) -> Episode:
+def start_episode(setup: Setup) -> Episode:
     """Put ``setup`` at the start of its run: reset the sensors (seeded from ``setup.seed``),
-    the online planner, ``controller`` (default ``setup.controller``: its ``reset`` with the
-    ControlContext, the drives' initial set-points it chose) and the disturbance (seeded
+    the online planner, ``setup.controller`` (its ``reset`` with the ControlContext, the
+    drives' initial set-points it chose) and the disturbance (seeded
     from ``setup.seed``), and evaluate the physics."""
     physics = setup.physics
     model, data = physics.model.ptr, physics.data.ptr
     k = steps_per_tick(model, setup.control_dt)
     times = control_ticks(setup.duration, setup.control_dt)
     reference = sample_checked(setup.trajectory, times)
-    controller = setup.controller if controller is None else controller
+    controller = setup.controller
     check_controller(controller)
     observation = setup.sensors.reset(physics, times, setup.seed)
     command, act_adr = controlled_views(setup)

@@ -21,6 +21,8 @@ from typing import Callable
 
 import numpy as np
 
+from sims.run_limits import ANGLE_LIMIT_DEG
+
 AIR_DENSITY = 1.2  # kg/m^3; about 1.0 at Rubin's 2700 m and FAST's 1000 m: conservative
 #: Largest mean wind speed accepted, m/s: the reference wind speed V_ref of IEC 61400-1
 #: (ed. 3, 2005) class I, the 10-min mean 50-year extreme of the windiest class of the
@@ -187,7 +189,7 @@ class BodyWindDrag:
 
 
 #: Largest |direction| (deg) a wind file may give: one turn either way, as every angle parameter.
-MAX_DIRECTION_DEG = 360.0
+MAX_DIRECTION_DEG = ANGLE_LIMIT_DEG
 
 
 class WindFileError(ValueError):

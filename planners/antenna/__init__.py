@@ -62,8 +62,6 @@ PAPER_DT = 0.01  # s, the simulation interval of section 5.1
 #: starboard, z_a (boresight) to the bow.
 C0 = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 
-_E3 = np.array([0.0, 0.0, 1.0])
-
 
 class SingularityError(PlanningError):
     """The weighted Jacobian is singular and no damping was allowed."""

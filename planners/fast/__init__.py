@@ -53,8 +53,7 @@ GRAVITY = 9.81
 
 # Table 1 of the paper.
 REFLECTOR_RADIUS = 300.0  # m
-FOCAL_RATIO = 0.4621
-FOCAL_SURFACE_RADIUS = 162.15  # m (R - f R = 161.4 m; the paper's Table 1 value is used)
+FOCAL_SURFACE_RADIUS = 162.15  # m (R - f R = 161.4 m at the focal ratio f = 0.4621; the paper's Table 1 value is used)
 MAX_ZENITH_ANGLE = math.radians(40.0)
 A_MAX = 0.010  # m/s^2: start, termination, observation
 A_T_MAX = 0.015  # m/s^2: observation transition segments

@@ -12,7 +12,7 @@ focal-sphere radius (P_feed = -r s), the tilt is split between the cabin and the
 by the smooth tilt law (``fast.tilt_law``: the max-min-tension split tabulated over the sky),
 eq. (3)-(9) give the cabin pose and the A-B angles, the cable lengths and
 static tensions follow, and the Stewart stabilizer sits at its nominal pose (its corrections
-are the controller's, issue 6).
+are the controller's).
 """
 
 from __future__ import annotations

@@ -31,7 +31,6 @@ TABLE1 = np.array(
     ]
 )
 TABLE1_TIMES = np.arange(6) * 0.5  # s
-TABLE1_LABELS = ("P2", "M1", "M2", "M3", "M4", "P3")
 
 #: How far a joint may be beyond its range and still count as within it, m for the slide and
 #: rad for the hinges: 1 nm and 1 nrad, the same for the planner's refusal and for the
@@ -76,22 +75,6 @@ class LoaderProblem:
     upper: np.ndarray
     rate_limit: np.ndarray
     force_limit: np.ndarray
-
-
-def supply_problem(spec: SerialChainSpec | None = None) -> LoaderProblem:
-    """The paper's supply stage: Table 1's P2, M1 ... M4, P3 at t = 0, 0.5, ... 2.5 s."""
-    return _problem(TABLE1_TIMES, table1_to_si(TABLE1), spec or loader_spec())
-
-
-def direct_problem(spec: SerialChainSpec | None = None) -> LoaderProblem:
-    """P2 to P3 in the same 2.5 s, with no key points between (the obstacles are the
-    planner's to avoid)."""
-    return _problem(TABLE1_TIMES[[0, -1]], table1_to_si(TABLE1)[[0, -1]], spec or loader_spec())
-
-
-def _problem(times, points, spec: SerialChainSpec) -> LoaderProblem:
-    return LoaderProblem(np.asarray(times, dtype=float), np.asarray(points, dtype=float), tuple(spec.names),
-                         spec.lower, spec.upper, spec.rate_limit, spec.force_limit)
 
 
 class CubicBSplinePlanner:

@@ -901,7 +901,7 @@ MIN_SATELLITE_ELEVATION_DEG = 5.0
 #: and 5 km turn the local vertical by 0.045 deg (d / R_earth), under a quarter of the 0.2 deg
 #: pointing limit.
 MAX_SAILED_M = 5000.0
-_ANGLE = dict(unit="deg", low=-360.0, high=360.0, reason="one turn either way; angles are not wrapped")
+_ANGLE = run_limits.ANGLE
 
 
 @dataclass(frozen=True)

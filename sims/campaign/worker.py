@@ -22,9 +22,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-STATUSES = ("passed", "failed", "error", "invalid")
-
-
 @dataclass(frozen=True)
 class Context:
     """What every run of a campaign shares, as plain data."""

@@ -587,7 +587,7 @@ def build_scenario(params: "FastParams", planner=None, controller=None, plant: F
 
 from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
 
-_ANGLE = dict(unit="deg", low=-360.0, high=360.0, reason="one turn either way; angles are not wrapped")
+_ANGLE = run_limits.ANGLE
 _UTC = dict(unit="UTC", reason="ISO 8601, e.g. 2026-03-01T14:30:00; years 1972-2099, where UTC has its leap seconds")
 
 

@@ -107,11 +107,11 @@ class SensorOptions(Params):
     rtk_drift_time_s: float = param(15.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
                                     "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
 
-    pose_rate_hz: float = param(10.0, "ideal system: rate of the cable loop's cabin pose fixes (total stations; the issue's "
-                                "10 Hz)", "Hz", low=0.1, high=1.0 / PHYSICS_DT,
+    pose_rate_hz: float = param(10.0, "ideal system: rate of the cable loop's cabin pose fixes (total stations; "
+                                "10 Hz assumed)", "Hz", low=0.1, high=1.0 / PHYSICS_DT,
                                 reason="a fix at least every 10 s (assumed), at most one per control tick (checked "
                                        "against control_rate_hz)")
-    pose_latency_s: float = param(0.15, "their latency (the issue's 150 ms)", "s", low=0.0, high=10.0,
+    pose_latency_s: float = param(0.15, "their latency (150 ms, the low end measured)", "s", low=0.0, high=10.0,
                                   reason="total stations lag 150-240 ms (REFERENCE.md); 10 s is an assumed bound")
     pose_noise_m: float = param(1e-3, "their white position noise per axis, 1 sigma (assumed: a total station's "
                                 "class at 150-300 m)", "m", low=0.0, high=1.0, reason="an assumed bound")

@@ -776,10 +776,6 @@ def pose_si(pose_mm_deg) -> np.ndarray:
     return np.concatenate([pose[:3] / 1000.0, np.radians(pose[3:])])
 
 
-SYNC_TARGET = pose_si(SYNC_TARGET_MM_DEG)
-ASYNC_TARGET = pose_si(ASYNC_TARGET_MM_DEG)
-
-
 def pose_mm_deg(pose_si) -> tuple:
     pose = np.asarray(pose_si, dtype=float)
     return tuple(float(v) for v in np.concatenate([pose[:3] * 1000.0, np.degrees(pose[3:])]))
