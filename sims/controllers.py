@@ -28,8 +28,9 @@ class ServoFeedforwardController:
     With an integral time T_i, ``z <- z + dt / T_i (q_ref - q)`` each tick, limited so
     ``kp z`` stays inside the force limit.
 
-    It drives the model's first ``nu`` actuators (``nu`` = the reference's channels), and
-    reads the task's observation (``sims.task``): ``joint_positions`` (the encoders, for
+    It drives the actuators its trajectory's channels name, which must be the first ``nu``
+    of its command (``ControlContext.actuators``; ``nu`` = the channels; checked in
+    ``reset``), and reads the task's observation (``sims.task``): ``joint_positions`` (the encoders, for
     the integral action) and ``setpoints`` (the drives' set-points), in that order.
 
     Args:
@@ -90,6 +91,10 @@ class ServoFeedforwardController:
         reference = context.reference
         model = context.model
         nu = reference.position.shape[1]
+        labels = getattr(context.trajectory, "labels", None)
+        if labels is not None and tuple(labels) != tuple(context.actuators[:nu]):
+            raise ValueError(f"the trajectory's channels {tuple(labels)} are not the first {nu} actuators "
+                             f"{tuple(context.actuators[:nu])}")
         if self.kp is None:
             self.kp = model.actuator_gainprm[:nu, 0].copy()
         if self.kv is None:

@@ -178,3 +178,15 @@ def test_wind_series_by_fft_equals_the_direct_sum(start, n):
     jittered = t + np.r_[0.0, np.full(n - 1, 1e-4)]  # not a uniform grid: the direct sum
     slow = wind_speed_series(jittered, mean, np.random.default_rng(7), df=df)
     np.testing.assert_allclose(slow[0], direct[0], atol=1e-11)
+
+
+def test_named_indices_are_the_model_s():
+    """The platform's free joint ends qpos (the keyframe's layout), and each strut's drive,
+    set-point and tendon are found by name."""
+    physics = sim_hexapod.HexapodPhysics.load(45.0)
+    model = physics.model.ptr
+    assert model.joint("platform").qposadr[0] == model.nq + sim_hexapod.PLATFORM_KEY_QPOS
+    for j, name in enumerate(sim_hexapod.STRUT_LABELS):
+        assert model.actuator(int(physics.strut_actuators[j])).name == name
+        assert model.tendon(int(physics.strut_tendons[j])).name == f"{name}_length"
+        assert physics.strut_act[j] == model.actuator(name).actadr[0]

@@ -127,6 +127,11 @@ class AntennaPhysics(dm_mujoco.Physics):
     def antenna_actuators(self) -> np.ndarray:
         return self._ids(JOINTS, "actuator")
 
+    @property
+    def deck_actuators(self) -> np.ndarray:
+        """The sea's drives of the deck joints (heave, yaw, pitch, roll), actuator indices."""
+        return self._ids(DECK_JOINTS, "actuator")
+
     def _actuator_param(self, names, field, column):
         ids = self._ids(names, "actuator")
         return np.array(getattr(self.model.ptr, field)[ids, column])
@@ -207,11 +212,11 @@ class ShipMotionDrive:
         self.reference = None
 
     def reset(self, physics, times, rng) -> None:
-        # The deck drives are the model's first four actuators; the sea's servo reads the
-        # deck joints exactly (it is the plant, not a controller under test).
+        # The sea's servo reads the deck joints exactly (it is the plant, not a controller
+        # under test).
         self.reference = ShipMotionTrajectory(self.motion, times[-1]).sample(times)
         model, data = physics.model.ptr, physics.data.ptr
-        encoders = JointEncoders(physics.deck_qpos, physics.deck_dofs, model.actuator_actadr[:4],
+        encoders = JointEncoders(physics.deck_qpos, physics.deck_dofs, model.actuator_actadr[physics.deck_actuators],
                                  "deck joints", "m|rad", CONTROL_DT)
         self.observation = encoders.reset(physics, times, 0)
         self.encoders = encoders

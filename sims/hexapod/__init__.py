@@ -129,6 +129,11 @@ def _compiled_plant(elevation_deg: float, plant: "HexapodPlant") -> mujoco.MjMod
     return spec.compile()
 
 
+#: Where the platform's free joint sits in the keyframe's qpos: it is the model's last joint
+#: (models/hexapod/hexapod.xml; tests/test_hexapod_physics.py checks it), so its 7 values end qpos.
+PLATFORM_KEY_QPOS = -7
+
+
 def _spec(elevation_deg: float) -> mujoco.MjSpec:
     """The scene's MjSpec with the top end tilted to ``elevation_deg`` (deg)."""
     spec = mujoco.MjSpec.from_file(str(models.scene_path("hexapod")))
@@ -143,8 +148,9 @@ def _spec(elevation_deg: float) -> mujoco.MjSpec:
     platform.quat = quat
     key = spec.key("home")
     qpos = np.array(key.qpos)
-    qpos[-7:-4] = platform_pos
-    qpos[-4:] = quat
+    free = PLATFORM_KEY_QPOS
+    qpos[free:free + 3] = platform_pos
+    qpos[free + 3:] = quat
     key.qpos = qpos
     return spec
 
@@ -233,6 +239,23 @@ class HexapodPhysics(dm_mujoco.Physics):
         return np.array([model.joint(n).dofadr[0] for n in STRUT_LABELS])
 
     @functools.cached_property
+    def strut_actuators(self) -> np.ndarray:
+        """actuator index of each strut's drive."""
+        model = self.model.ptr
+        return np.array([model.actuator(n).id for n in STRUT_LABELS])
+
+    @functools.cached_property
+    def strut_act(self) -> np.ndarray:
+        """activation index of each strut drive's set-point."""
+        return self.model.ptr.actuator_actadr[self.strut_actuators].copy()
+
+    @functools.cached_property
+    def strut_tendons(self) -> np.ndarray:
+        """tendon index of each strut's pivot-to-pivot length."""
+        model = self.model.ptr
+        return np.array([model.tendon(f"{n}_length").id for n in STRUT_LABELS])
+
+    @functools.cached_property
     def _free_qpos(self) -> int:
         return int(self.model.ptr.joint("platform").qposadr[0])
 
@@ -246,15 +269,15 @@ class HexapodPhysics(dm_mujoco.Physics):
     # ---- drive constants (from the compiled model: one source of truth)
     @property
     def kp(self) -> np.ndarray:
-        return self.model.ptr.actuator_gainprm[:6, 0].copy()
+        return self.model.ptr.actuator_gainprm[self.strut_actuators, 0].copy()
 
     @property
     def kv(self) -> np.ndarray:
-        return -self.model.ptr.actuator_biasprm[:6, 2].copy()
+        return -self.model.ptr.actuator_biasprm[self.strut_actuators, 2].copy()
 
     @property
     def force_limit(self) -> np.ndarray:
-        return self.model.ptr.actuator_forcerange[:6, 1].copy()
+        return self.model.ptr.actuator_forcerange[self.strut_actuators, 1].copy()
 
     # ---- state
     def strut_positions(self) -> np.ndarray:
@@ -271,11 +294,11 @@ class HexapodPhysics(dm_mujoco.Physics):
 
     def strut_drive_forces(self) -> np.ndarray:
         """Drive forces along each strut, N; positive pushes (compression)."""
-        return self.data.actuator_force[:6].copy()
+        return self.data.actuator_force[self.strut_actuators].copy()
 
     def strut_lengths(self) -> np.ndarray:
         """Pivot-to-pivot lengths (MuJoCo's spatial tendons), m."""
-        return self.data.ten_length[:6].copy()
+        return self.data.ten_length[self.strut_tendons].copy()
 
     def gravity_in_hexapod_frame(self) -> np.ndarray:
         _, rotation = self.top_end_frame
@@ -607,7 +630,7 @@ class HexapodEvaluation:
         poses = p.poses_from_qpos(log.qpos)
         judged = [self._judge_move(log, i, q, poses) for i in range(len(self.moves))]
         several = len(self.moves) > 1
-        demanded = demanded_force(p.kp, p.kv, log.act[:, :6], p.drive_positions(q), qd)
+        demanded = demanded_force(p.kp, p.kv, log.act[:, p.strut_act], p.drive_positions(q), qd)
         force = np.abs(demanded).max()
         stroke = np.abs(q).max()
         v_cmd = np.abs(ref.velocity).max()
@@ -723,9 +746,9 @@ class HexapodEvaluation:
             "strut_accel_planned": log.reference.acceleration,
             "strut_position_actual": q,
             "strut_velocity_actual": qd,
-            "setpoint": log.act[:, :6],
-            "drive_force": log.actuator_force[:, :6],
-            "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, :6], p.drive_positions(q), qd),
+            "setpoint": log.act[:, p.strut_act],
+            "drive_force": log.actuator_force[:, p.strut_actuators],
+            "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, p.strut_act], p.drive_positions(q), qd),
             "drive_force_limit": p.force_limit,
             "pose_actual": p.poses_from_qpos(log.qpos),
             "target_pose": (np.asarray(self.moves[0].target_pose) if len(self.moves) == 1
