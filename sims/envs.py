@@ -15,7 +15,6 @@ the feed's distance from its goal path (FAST).
 from __future__ import annotations
 
 import collections
-import dataclasses
 
 import mujoco
 import numpy as np
@@ -131,29 +130,33 @@ def loader_environment(plan: str = "supply") -> control.Environment:
     return make(f"loader-{plan}")
 
 
-def hexapod_environment(synchronous: bool = True, elevation_deg: float = 45.0) -> control.Environment:
-    """The hexapod's sync (or async) move at an elevation; the action is the six drives'
-    set-point rates (m/s)."""
-    return make(f"hexapod-{'sync' if synchronous else 'async'}-move", elevation=elevation_deg)
+def _given(**values) -> dict:
+    """The parameters a caller gave (None: the scenario's own default, declared once)."""
+    return {key: value for key, value in values.items() if value is not None}
 
 
-def antenna_environment(sea_state: bool = True, duration: float = 60.0) -> control.Environment:
-    """The ship antenna holding its satellite (default: the default sea state); the action is
-    the four antenna drives' set-point rates (rad/s), the deck follows the sea by itself."""
-    return make("antenna-sea-state" if sea_state else "antenna-paper-motion", duration=duration)
+def hexapod_environment(synchronous: bool = True, elevation_deg: float | None = None) -> control.Environment:
+    """The hexapod's sync (or async) move at an elevation (None: the scenario's); the action
+    is the six drives' set-point rates (m/s)."""
+    return make(f"hexapod-{'sync' if synchronous else 'async'}-move", **_given(elevation=elevation_deg))
 
 
-def fast_environment(duration: float = 60.0, wind: float = 4.0, seed: int = 0,
+def antenna_environment(sea_state: bool = True, duration: float | None = None) -> control.Environment:
+    """The ship antenna holding its satellite (default: the default sea state) for
+    ``duration`` s (None: the scenario's); the action is the four antenna drives' set-point
+    rates (rad/s), the deck follows the sea by itself."""
+    return make("antenna-sea-state" if sea_state else "antenna-paper-motion", **_given(duration=duration))
+
+
+def fast_environment(duration: float = 60.0, wind: float | None = None, seed: int | None = None,
                      cable_segments: int | None = None) -> control.Environment:
     """FAST's feed support: ``duration`` s of tracking 3C 286 (no switch: the episode starts
-    on the source at rest), in ``wind`` m/s, on the cables of ``cable_segments`` (None: the
-    default, sims.fast.FastParams). The action is every actuator's ctrl: the six winches'
-    unstretched lengths (m), the A-B set-points (rad), the six Stewart legs' set-point rates
-    (m/s) and the multi-beam angle (rad)."""
+    on the source at rest), in ``wind`` m/s, seeded by ``seed``, on the cables of
+    ``cable_segments`` (None: each the default of sims.fast.FastParams). The action is every
+    actuator's ctrl: the six winches' unstretched lengths (m), the A-B set-points (rad), the
+    six Stewart legs' set-point rates (m/s) and the multi-beam angle (rad)."""
     from sims import fast
 
-    params = fast.FastParams(wind=wind, seed=seed)
-    if cable_segments is not None:
-        params = dataclasses.replace(params, cable_segments=cable_segments)
+    params = fast.FastParams(**_given(wind=wind, seed=seed, cable_segments=cable_segments))
     setup = fast.build(fast.observation_plan(duration), params)
     return environment(setup, fast.environment_reward(setup))

@@ -29,6 +29,9 @@ AIR_DENSITY = 1.2  # kg/m^3; about 1.0 at Rubin's 2700 m and FAST's 1000 m: cons
 #: standard whose Kaimal turbulence model this module uses. Beyond it the turbulence model
 #: (and any telescope) is outside its range.
 MAX_MEAN_SPEED_M_S = 50.0
+#: The range of a mean wind speed parameter (``sims.params.param`` keywords), m/s.
+MEAN_SPEED = dict(unit="m/s", low=0.0, high=MAX_MEAN_SPEED_M_S,
+                  reason="IEC 61400-1 class I reference speed, the Kaimal model's range")
 IEC_KAIMAL_LENGTH = 8.1 * 42.0  # m, IEC 61400-1 longitudinal integral scale above 60 m hub
 IEC_TURBULENCE_B = 0.14  # I_ref of IEC class B
 

@@ -46,7 +46,7 @@ from sims.fast.measurement import FusedSensors, SensorOptions, estimate_errors, 
 from sims.runner import RunLog, Setup
 from sims.params import ParamError, ScenarioParams, param
 from sims.task import nominal_copy, plan_checked
-from sims.wind import MAX_MEAN_SPEED_M_S, SPECTRA, MeasuredWind, WindFileError
+from sims.wind import MEAN_SPEED, SPECTRA, MeasuredWind, WindFileError
 
 #: The built-in catalogue: ICRS (J2000) RA and Dec, rad, of calibrators and pulsars FAST
 #: observes (NED and ATNF; 3C 286 13h31m08.29s +30d30m33.0s, 3C 295 14h11m20.5s +52d12m21s).
@@ -595,8 +595,7 @@ _UTC = dict(unit="UTC", reason="ISO 8601, e.g. 2026-03-01T14:30:00; years 1972-2
 class FastParams(ScenarioParams):
     """What every FAST run shares: the wind, the cables, the stabilizer."""
 
-    wind: float = param(DEFAULT_WIND_M_S, "mean wind at the cabin", "m/s", low=0.0, high=MAX_MEAN_SPEED_M_S,
-                        reason="IEC 61400-1 class I reference speed, the Kaimal model's range")
+    wind: float = param(DEFAULT_WIND_M_S, "mean wind at the cabin", **MEAN_SPEED)
     wind_direction: float = param(WIND_AZIMUTH_DEG, "azimuth the wind blows toward, from east toward north", **_ANGLE)
     turbulence_intensity: float | None = param(
         None, "sigma_u / U of the turbulence; none: the spectrum's own (Kaimal: IEC class B)", "", low=0.0, high=0.5,
