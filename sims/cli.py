@@ -107,6 +107,8 @@ def scenario_parser(command: str, scenario, source: str) -> argparse.ArgumentPar
             metavar = "|".join(declared.choices)
         group.add_argument(_flag(name), dest=f"param_{name}", metavar=metavar,
                            help=describe(kind, declared, getattr(scenario.params, name)).replace("%", "%%"))
+    for old in getattr(cls, "RENAMED", {}):  # a flag of an earlier name: refused with its name now
+        parser.add_argument(_flag(old), dest=f"renamed_{old}", help=argparse.SUPPRESS)
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="set any parameter (TOML value syntax: --set 'moves=[{target=[1,0,0,0,0,0]}]'), "
                              "or a field of the plant's uncertainty: --set plant.KEY=VALUE (README, \"Campaigns\")")
@@ -152,6 +154,9 @@ def _resolve_source(command: str, argv: list[str]):
     args = scenario_parser(command, scenario, argv[0]).parse_args(argv[1:])
     flags = {k[len("param_"):]: v for k, v in vars(args).items() if k.startswith("param_") and v is not None}
     cls = type(scenario.params)
+    for old, new in getattr(cls, "RENAMED", {}).items():
+        if getattr(args, f"renamed_{old}", None) is not None:
+            raise BadInput(f"{_flag(old)}: the parameter is now {new}: --set {new}=VALUE")
     plant_set = [a[len("plant."):] for a in args.set if a.startswith("plant.")]
     try:
         overrides = scenario_files.overrides_from_flags(cls, flags, [a for a in args.set if not a.startswith("plant.")])

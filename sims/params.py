@@ -312,6 +312,10 @@ class Params:
             return v
         return {f.name: plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
 
+    #: Parameters that had another name: {old name: its name now} (an old name in a file or
+    #: on the command line is refused with the new name).
+    RENAMED = {}  # not annotated: no dataclass field
+
     @classmethod
     def from_mapping(cls, mapping: dict, base: "Params | None" = None, prefix: str = "") -> "Params":
         """``base`` (default: the declared defaults) with the keys of ``mapping`` replaced.
@@ -324,7 +328,8 @@ class Params:
         names = cls.names()
         unknown = [k for k in mapping if k not in names]
         if unknown:
-            raise ParamError(f"unknown parameter '{prefix}{unknown[0]}'; {cls.__name__} has: {', '.join(names)}")
+            raise ParamError(f"unknown parameter '{prefix}{unknown[0]}'{_renamed(cls, unknown[0])}; "
+                             f"{cls.__name__} has: {', '.join(names)}")
         values = {} if base is None else {n: getattr(base, n) for n in names}
         declared = {n: d for n, _, d, _ in cls.declarations()}
         kinds = {n: k for n, k, _, _ in cls.declarations()}
@@ -461,7 +466,8 @@ def set_overrides(cls: type[Params], assignments: list[str], prefix: str = "") -
             out.setdefault(head, {}).update(inner)
             continue
         if key not in hints:
-            raise ParamError(f"--set: unknown parameter {prefix + key!r}; {cls.__name__} has: {', '.join(cls.names())}")
+            raise ParamError(f"--set: unknown parameter {prefix + key!r}{_renamed(cls, key)}; "
+                             f"{cls.__name__} has: {', '.join(cls.names())}")
         out[key] = parse_value(hints[key], value, f"--set {prefix}{key}")
     return out
 
@@ -484,6 +490,12 @@ def describe(kind: _Type, declared: Declared, default) -> str:
     if declared.reason:
         parts.append(f"({declared.reason})")
     return " ".join(parts)
+
+
+def _renamed(cls, key: str) -> str:
+    """", now NEW" for a parameter that was renamed (``Params.RENAMED``), else ""."""
+    new = getattr(cls, "RENAMED", {}).get(key)
+    return f" (its name is now {new!r})" if new else ""
 
 
 def markdown_table(cls: type[Params]) -> str:

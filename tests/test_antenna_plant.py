@@ -22,7 +22,7 @@ from sims.params import ParamError
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("antenna-sea-state")
 #: The IMU without noise: what a perturbation does is then not hidden by the noise.
-QUIET = dict(imu_attitude_noise=0.0, imu_gyro_noise=0.0)
+QUIET = dict(imu={"attitude_noise_deg": 0.0, "gyro_noise_deg_s": 0.0})
 #: Every field off nominal at once, inside its range.
 EVERYTHING = dict(mass_error=0.1, imbalance_offset=(4.0, -3.0, 2.0), joint_friction=1.0, torque_limit_scale=0.8,
                   imu_bias=(0.05, -0.02, 0.1))

@@ -168,8 +168,8 @@ def test_antenna_sea_state_run_with_sea_options(tmp_path):
     (("antenna-paper-motion", "--hs", "4"), ("unrecognized arguments", "--hs")),
     (("hexapod-sync-move", "--wave-heading", "90"), ("unrecognized arguments", "--wave-heading")),
     (("antenna-sea-state", "--wind", "5"), ("unrecognized arguments", "--wind")),
-    (("antenna-sea-state", "--imu-rate", "30"), ("IMU rate 30 Hz", "whole number")),
-    (("antenna-paper-motion", "--imu-latency", "0.012"), ("IMU latency 0.012 s", "5 ms")),
+    (("antenna-sea-state", "--set", "imu.rate_hz=30"), ("IMU rate 30 Hz", "whole number")),
+    (("antenna-paper-motion", "--set", "imu.latency_s=0.012"), ("IMU latency 0.012 s", "5 ms")),
     (("loader-supply", "--prediction", "off"), ("unrecognized arguments", "--prediction")),
 ])
 def test_antenna_bad_options_exit_2(tmp_path, args, words):
@@ -192,8 +192,8 @@ def test_antenna_plan(tmp_path):
 
 def test_antenna_without_prediction_fails_the_paper_motion(tmp_path):
     """--prediction off: the 20 ms IMU latency and the 20 ms update interval become lag."""
-    proc = planbench("run", "antenna-paper-motion", "--prediction", "off", "--imu-rate", "25",
-                     "--imu-latency", "0.04", "--duration", "3", "--out", tmp_path / "np", "--quiet")
+    proc = planbench("run", "antenna-paper-motion", "--prediction", "off", "--set", "imu.rate_hz=25",
+                     "--set", "imu.latency_s=0.04", "--duration", "3", "--out", tmp_path / "np", "--quiet")
     assert proc.returncode == 1, proc.stdout + proc.stderr
     summary = json.loads((tmp_path / "np" / "summary.json").read_text())
     metrics = summary["metrics"]

@@ -82,11 +82,14 @@ BAD_RUNS = [
     (("fast-tracking", "--wind", "1e308"), ("wind = 1e+308 m/s", "[0, 50] m/s", "IEC 61400-1")),
     (("hexapod-sync-move", "--wind", "50.5"), ("wind = 50.5 m/s", "[0, 50] m/s")),
     # the IMU
-    (("antenna-paper-motion", "--imu-rate", "1e-300"), ("imu_rate = 1e-300 Hz", "[1, 200] Hz")),
-    (("antenna-sea-state", "--imu-rate", "0.5"), ("imu_rate = 0.5 Hz", "[1, 200] Hz")),
-    (("antenna-paper-motion", "--imu-latency", "1e9"), ("imu_latency = 1e+09 s", "[0, 1] s")),
-    (("antenna-sea-state", "--imu-latency", "1.005"), ("imu_latency = 1.005 s", "[0, 1] s")),
-    (("antenna-sea-state", "--imu-rate", "33"), ("imu_rate", "IMU rate 33 Hz", "whole number")),
+    (("antenna-paper-motion", "--set", "imu.rate_hz=1e-300"), ("imu.rate_hz = 1e-300 Hz", "[1, 200] Hz")),
+    (("antenna-sea-state", "--set", "imu.rate_hz=0.5"), ("imu.rate_hz = 0.5 Hz", "[1, 200] Hz")),
+    (("antenna-paper-motion", "--set", "imu.latency_s=1e9"), ("imu.latency_s = 1e+09 s", "[0, 1] s")),
+    (("antenna-sea-state", "--set", "imu.latency_s=1.005"), ("imu.latency_s = 1.005 s", "[0, 1] s")),
+    (("antenna-sea-state", "--set", "imu.rate_hz=33"), ("imu.rate_hz", "IMU rate 33 Hz", "whole number")),
+    # the IMU's earlier names: refused with the names now
+    (("antenna-sea-state", "--imu-rate", "25"), ("--imu-rate", "now imu.rate_hz", "--set imu.rate_hz=VALUE")),
+    (("antenna-sea-state", "--set", "imu_latency=0.01"), ("'imu_latency'", "now 'imu.latency_s'")),
     # cable segments: the real limit, from the model
     (("fast-tracking", "--cable-segments", "15"), ("cable_segments = 15", "[0, SEGMENTS]")),
     (("fast-tracking", "--cable-segments", "50"), ("cable_segments = 50", "[0, SEGMENTS]")),
@@ -147,8 +150,8 @@ def test_the_cable_segment_limit_is_the_models():
     ("fast-ra-scan", "--wind-direction", "-90", "--wind", "50"),
     ("fast-tracking", "--cable-segments", "14"),
     ("hexapod-sync-move", "--elevation", "15", "--wind", "0"),
-    ("antenna-paper-motion", "--imu-rate", "1", "--imu-latency", "1"),
-    ("antenna-paper-motion", "--imu-rate", "200", "--imu-latency", "0"),
+    ("antenna-paper-motion", "--set", "imu.rate_hz=1", "--set", "imu.latency_s=1"),
+    ("antenna-paper-motion", "--set", "imu.rate_hz=200", "--set", "imu.latency_s=0"),
     ("antenna-sea-state", "--duration", "600"),
 ])
 def test_the_limits_themselves_are_accepted(args):
@@ -231,7 +234,7 @@ def test_log_estimate_matches_the_arrays_a_run_holds(name, estimate):
     controller, sensors, planner, disturbance, trajectory): the difference of their bytes over the difference
     of their ticks. Within 10 %, never below."""
     scenario = scenarios.get(name)
-    extra = {"hexapod-async-move": {"wind": 0.0}, "antenna-paper-motion": {"imu_rate": 25.0},
+    extra = {"hexapod-async-move": {"wind": 0.0}, "antenna-paper-motion": {"imu": {"rate_hz": 25.0}},
              "fast-source-switch": {"cable_segments": 3}}.get(name, {})
     held = []
     for ticks in (20, 120):
@@ -335,10 +338,10 @@ def test_angles_winds_and_the_imu_are_refused_in_the_python_api():
                  lambda: wind.wind_speed_series(np.arange(3.0), 51.0, np.random.default_rng(0))):
         with pytest.raises(ValueError, match=r"above 50 m/s"):
             make()
-    with pytest.raises(ValueError, match="IMU rate 1e-300 Hz is below 1 Hz"):
-        antenna.ImuModel(rate_hz=1e-300).ticks(antenna.CONTROL_DT)
-    with pytest.raises(ValueError, match=r"imu_latency = 1e\+09 s is outside \[0, 1\] s"):
-        antenna.AntennaPaperParams(imu_latency=1e9)
+    with pytest.raises(ValueError, match=r"rate_hz = 1e-300 Hz is outside \[1, 200\] Hz"):
+        antenna.ImuModel(rate_hz=1e-300)
+    with pytest.raises(ValueError, match=r"latency_s = 1e\+09 s is outside \[0, 1\] s"):
+        antenna.AntennaPaperParams(imu=antenna.ImuModel(latency_s=1e9))
     with pytest.raises(ValueError, match=r"cable_segments = 20 is outside \[0, 14\]"):
         fast.FastParams(cable_segments=20)
     with pytest.raises(ValueError, match=r"cable_segments = 2\.5 is not an integer"):

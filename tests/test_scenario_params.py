@@ -95,7 +95,7 @@ def antenna_sea_params(draw):
         hs=draw(st.floats(0.1, 0.95)) * hs_max, tp=tp, gamma=draw(st.floats(1.0, 7.0)),
         wave_heading=draw(st.floats(-360.0, 360.0)), ship_heading=draw(st.floats(-360.0, 360.0)),
         ship_speed=draw(st.floats(0.0, 15.0)), ship_lat=lat, ship_lon=lon,
-        imu_rate=200.0 / draw(st.integers(1, 200)), imu_latency=0.005 * draw(st.integers(0, 200)),
+        imu=dict(rate_hz=200.0 / draw(st.integers(1, 200)), latency_s=0.005 * draw(st.integers(0, 200))),
         duration=5.0, seed=draw(st.integers(0, 2**32)), **satellite))
 
 
@@ -294,6 +294,8 @@ def test_every_example_scenario_file_runs_through_the_cli(tmp_path, capsys, path
     for key, value in data["parameters"].items():
         if key == "wind_file":
             assert Path(summary["parameters"][key]) == path.parent / value
+        elif isinstance(value, dict):  # a nested table: the keys the file gives, the rest defaults
+            assert {k: summary["parameters"][key][k] for k in value} == value, key
         elif key != "duration" or not extra:
             assert summary["parameters"][key] == value, key
 

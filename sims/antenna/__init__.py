@@ -43,7 +43,7 @@ from sims.runner import RunLog, Setup
 from sims.task import ControlContext, JointEncoders, nominal_copy, RecordingPlanner, Sensors, SensorSpec, check_planner
 from sims.antenna.ship_motion import (SEA_HS_MAX_M, SEA_TP_RANGE_S, PaperShipMotion, SeaStateMotion, check_sea_state,
                                      world_from_ship)
-from sims.params import ParamError, PlantParams, ScenarioParams, override, param
+from sims.params import ParamError, Params, PlantParams, ScenarioParams, override, param
 from sims.plant import set_inertial
 
 CONTROL_DT = 0.005  # s: the runner's tick; the IMU rate is a whole number of ticks
@@ -241,23 +241,32 @@ class ShipMotionDrive:
 
 
 @dataclass(frozen=True)
-class ImuModel:
-    """The attitude sensor as the controller sees it.
+class ImuModel(Params):
+    """The pedestal IMU's datasheet, as the controller sees it: the scenarios' ``imu`` table
+    (typed and ranged as every parameter, sims.params), declared here once.
 
-    Attributes:
-      rate_hz: samples per second (the paper: 20-50).
-      latency_s: time from sampling to the controller, s (a whole number of control ticks).
-      attitude_noise_deg: standard deviation per axis of the orientation error, deg.
-      attitude_noise_time_s: its correlation time, s (first-order Gauss-Markov:
-        e_k+1 = e_k exp(-h / T) + sigma sqrt(1 - exp(-2 h / T)) n_k); 0 for white noise.
-      gyro_noise_deg_s: white noise per axis on the angular rate, deg/s (1 sigma).
+    The attitude error is first-order Gauss-Markov, e_k+1 = e_k exp(-h / T) +
+    sigma sqrt(1 - exp(-2 h / T)) n_k (T = attitude_noise_time_s; 0 for white noise).
     """
 
-    rate_hz: float = IMU_RATE_HZ
-    latency_s: float = IMU_LATENCY_S
-    attitude_noise_deg: float = IMU_ATTITUDE_NOISE_DEG
-    attitude_noise_time_s: float = IMU_ATTITUDE_NOISE_TIME_S
-    gyro_noise_deg_s: float = IMU_GYRO_NOISE_DEG_S
+    rate_hz: float = param(IMU_RATE_HZ, "samples per second (200 / a whole number; the paper: 20-50)", "Hz",
+                           low=IMU_RATE_MIN_HZ, high=1.0 / CONTROL_DT,
+                           reason="1 Hz is the slowest the controller models; at most one per control tick")
+    latency_s: float = param(IMU_LATENCY_S, "time from sampling to the controller (a whole number of 5 ms ticks)",
+                             "s", low=0.0, high=IMU_LATENCY_MAX_S,
+                             reason="a marine AHRS: a few to tens of ms; 1 s at most")
+    attitude_noise_deg: float = param(IMU_ATTITUDE_NOISE_DEG, "attitude error per axis (1 sigma, Gauss-Markov)",
+                                      "deg", low=0.0, high=5.0, reason="a marine AHRS: 0.01-1 deg")
+    attitude_noise_time_s: float = param(IMU_ATTITUDE_NOISE_TIME_S, "correlation time of the attitude error, 0 "
+                                         "for white", "s", low=0.0, high=3600.0, reason="up to an hour's drift")
+    gyro_noise_deg_s: float = param(IMU_GYRO_NOISE_DEG_S, "gyro white noise per axis and sample (1 sigma)",
+                                    "deg/s", low=0.0, high=1.0, reason="MEMS to fibre-optic gyros: 0.001-0.1 deg/s")
+
+    def check(self) -> None:
+        try:
+            self.ticks(CONTROL_DT)
+        except PlanningError as e:
+            raise ParamError(f"rate_hz / latency_s: {e}") from None
 
     def ticks(self, control_dt: float) -> tuple[int, int]:
         """(ticks per sample, latency in ticks); raises PlanningError if not whole numbers."""
@@ -782,13 +791,6 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
     )
 
 
-def imu_of(params: "AntennaParams") -> ImuModel:
-    """The run's IMU datasheet (rate, latency, noise) from its parameters."""
-    return ImuModel(rate_hz=params.imu_rate, latency_s=params.imu_latency,
-                    attitude_noise_deg=params.imu_attitude_noise,
-                    attitude_noise_time_s=params.imu_attitude_noise_time, gyro_noise_deg_s=params.imu_gyro_noise)
-
-
 def satellite_of(params: "AntennaParams") -> tuple[float, float, float]:
     """(azimuth, elevation, polarization), rad: given, or from the satellite's orbital
     longitude and the ship's position (``look_angles``)."""
@@ -822,7 +824,7 @@ def build(params: "AntennaParams", planner=None, controller=None,
     ``plant``: the plant's uncertainty (``AntennaPlant``; None or nominal: the model as it
     is); the planner and the controller keep the nominal model and the IMU's datasheet."""
     if antenna_options is None:
-        antenna_options = AntennaOptions(imu=imu_of(params), predict=params.prediction)
+        antenna_options = AntennaOptions(imu=params.imu, predict=params.prediction)
     run_limits.check_duration(params.duration, CONTROL_DT, log_bytes_per_tick(antenna_options.imu))
     az, el, pol = satellite_of(params)
     motion = motion_of(params)
@@ -913,6 +915,10 @@ _ANGLE = run_limits.ANGLE
 class AntennaParams(ScenarioParams):
     """What both antenna runs share: the satellite, the ship's position and course, the IMU."""
 
+    RENAMED = {"imu_rate": "imu.rate_hz", "imu_latency": "imu.latency_s",
+               "imu_attitude_noise": "imu.attitude_noise_deg", "imu_attitude_noise_time": "imu.attitude_noise_time_s",
+               "imu_gyro_noise": "imu.gyro_noise_deg_s"}
+
     satellite_lon: float | None = param(
         None, "the geostationary satellite's orbital longitude (east positive); none: satellite_look",
         "deg", low=-180.0, high=180.0, reason="a longitude", excludes=("satellite_look",))
@@ -927,17 +933,8 @@ class AntennaParams(ScenarioParams):
     ship_lon: float = param(SHIP_LON_DEG, "the ship's longitude (east positive)", "deg", low=-180.0, high=180.0,
                             reason="a longitude")
     ship_heading: float = param(0.0, "the ship's mean course, clockwise from north (compass)", **_ANGLE)
-    imu_rate: float = param(IMU_RATE_HZ, "IMU samples per second (200 / a whole number)", "Hz",
-                            low=IMU_RATE_MIN_HZ, high=1.0 / CONTROL_DT,
-                            reason="1 Hz is the slowest the controller models; at most one per control tick")
-    imu_latency: float = param(IMU_LATENCY_S, "IMU latency (a whole number of 5 ms ticks)", "s", low=0.0,
-                               high=IMU_LATENCY_MAX_S, reason="a marine AHRS: a few to tens of ms; 1 s at most")
-    imu_attitude_noise: float = param(IMU_ATTITUDE_NOISE_DEG, "IMU attitude error per axis (1 sigma, Gauss-Markov)",
-                                      "deg", low=0.0, high=5.0, reason="a marine AHRS: 0.01-1 deg")
-    imu_attitude_noise_time: float = param(IMU_ATTITUDE_NOISE_TIME_S, "correlation time of the attitude error, 0 "
-                                           "for white", "s", low=0.0, high=3600.0, reason="up to an hour's drift")
-    imu_gyro_noise: float = param(IMU_GYRO_NOISE_DEG_S, "gyro white noise per axis and sample (1 sigma)", "deg/s",
-                                  low=0.0, high=1.0, reason="MEMS to fibre-optic gyros: 0.001-0.1 deg/s")
+    imu: ImuModel = param(ImuModel(), "the pedestal IMU (sims.antenna.ImuModel: rate_hz, latency_s, "
+                          "attitude_noise_deg, attitude_noise_time_s, gyro_noise_deg_s)")
     prediction: bool = param(True, "the controller predicts the IMU's latency away with its gyro")
     duration: float = param(SEA_DURATION_S, "simulated time", "s", low=CONTROL_DT, reason="at least one control tick (5 ms)")
 
@@ -946,10 +943,6 @@ class AntennaParams(ScenarioParams):
             raise ParamError("satellite_lon or satellite_look must be given")
         if self.satellite_lon is not None and self.satellite_look is not None:
             raise ParamError("give satellite_lon or satellite_look, not both")
-        try:
-            imu_of(self).ticks(CONTROL_DT)
-        except PlanningError as e:
-            raise ParamError(f"imu_rate / imu_latency: {e}") from None
         if self.satellite_lon is not None:
             try:
                 _, el, _ = satellite_of(self)
@@ -963,7 +956,7 @@ class AntennaParams(ScenarioParams):
         elif self.satellite_look[1] < MIN_SATELLITE_ELEVATION_DEG:
             raise ParamError(f"satellite_look elevation = {self.satellite_look[1]:g} deg is below the "
                              f"{MIN_SATELLITE_ELEVATION_DEG:g} deg a ship's dish tracks down to")
-        run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(imu_of(self)))
+        run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.imu))
 
 
 @dataclass(frozen=True)
