@@ -16,7 +16,9 @@ from pathlib import Path
 import numpy as np
 
 MODELS_DIR = Path(__file__).resolve().parent
-MECHANISMS = ("loader", "hexapod", "antenna", "fast")
+#: Every mechanism: each folder of models/ with a scene.xml, in name order (found as MuJoCo
+#: Menagerie finds its model folders, no hand list). Its simulation is the package sims/<name>/.
+MECHANISMS = tuple(sorted(path.parent.name for path in MODELS_DIR.glob("*/scene.xml")))
 
 
 def model_dir(name: str) -> Path:

@@ -5,8 +5,9 @@ tuple of ``Scenario``), plan-only entries (``PLANS``, optional), the scenario th
 bench`` times (``BENCHMARK``: name and number of runs) and the reward of its dm_control
 environment (``environment_reward``). The registry imports the packages of the mechanisms
 that ``models.MECHANISMS`` lists (one folder per model, as in MuJoCo Menagerie) the first
-time it is asked, as dm_control's suite builds its registry from its domain modules: a fifth
-mechanism is its own folders plus its name in that tuple. ``planbench list``, ``run``,
+time it is asked, as dm_control's suite builds its registry from its domain modules; the
+tuple is the folders of models/ that hold a scene.xml, so a fifth mechanism is its own
+folders (models/<name>/ and sims/<name>/) and nothing else. ``planbench list``, ``run``,
 ``plan``, ``demo``, ``bench`` and the environments (``sims.envs``) all come from here.
 """
 
@@ -86,8 +87,16 @@ class Scenario:
 @functools.lru_cache(maxsize=1)
 def mechanisms() -> tuple:
     """The mechanisms' simulation packages (``sims.<name>`` for each of models.MECHANISMS), in
-    that order."""
-    return tuple(importlib.import_module(f"sims.{name}") for name in models.MECHANISMS)
+    that order; a model folder without its package is an error naming both."""
+    packages = []
+    for name in models.MECHANISMS:
+        try:
+            packages.append(importlib.import_module(f"sims.{name}"))
+        except ModuleNotFoundError as e:
+            if e.name != f"sims.{name}":
+                raise
+            raise ImportError(f"models/{name}/scene.xml has no simulation package sims/{name}/") from None
+    return tuple(packages)
 
 
 @functools.lru_cache(maxsize=1)

@@ -27,9 +27,10 @@ def test_list_names_every_scenario():
     proc = planbench("list")
     assert proc.returncode == 0
     names = [line.split()[0] for line in proc.stdout.splitlines()]
-    assert names == ["loader-supply", "loader-direct", "hexapod-sync-move", "hexapod-async-move",
-                     "antenna-paper-motion", "antenna-sea-state", "fast-tracking", "fast-ra-scan",
-                     "fast-source-switch"]
+    # The mechanisms in their folders' name order, each's scenarios in the order it declares them.
+    assert names == ["antenna-paper-motion", "antenna-sea-state", "fast-tracking", "fast-ra-scan",
+                     "fast-source-switch", "hexapod-sync-move", "hexapod-async-move", "loader-supply",
+                     "loader-direct"]
 
 
 def test_run_writes_summary_timeseries_report_and_video(tmp_path):

@@ -1,0 +1,28 @@
+"""The mechanisms are found from their folders: every models/<name>/ with a scene.xml, whose
+simulation is sims/<name>/."""
+
+from __future__ import annotations
+
+import pytest
+
+import models
+from sims import scenarios
+
+
+def test_the_mechanisms_are_the_model_folders():
+    folders = sorted(p.parent.name for p in models.MODELS_DIR.glob("*/scene.xml"))
+    assert list(models.MECHANISMS) == folders == ["antenna", "fast", "hexapod", "loader"]
+    assert [p.__name__ for p in scenarios.mechanisms()] == [f"sims.{n}" for n in folders]
+    # every scenario comes from one of them
+    assert {scenarios.mechanism_of(n).__name__ for n in scenarios.SCENARIOS} == {f"sims.{n}" for n in folders}
+
+
+def test_a_model_folder_without_its_simulation_package_is_named(monkeypatch):
+    monkeypatch.setattr(models, "MECHANISMS", (*models.MECHANISMS, "crane"))
+    scenarios.mechanisms.cache_clear()
+    try:
+        with pytest.raises(ImportError, match=r"models/crane/scene.xml has no simulation package sims/crane/"):
+            scenarios.mechanisms()
+    finally:
+        monkeypatch.undo()
+        scenarios.mechanisms.cache_clear()
