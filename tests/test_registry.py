@@ -21,7 +21,8 @@ def test_a_model_folder_without_its_simulation_package_is_named(monkeypatch):
     monkeypatch.setattr(models, "MECHANISMS", (*models.MECHANISMS, "crane"))
     scenarios.mechanisms.cache_clear()
     try:
-        with pytest.raises(ImportError, match=r"models/crane/scene.xml has no simulation package sims/crane/"):
+        name = "crane"
+        with pytest.raises(ImportError, match=f"models/{name}/scene.xml has no simulation package sims/{name}/"):
             scenarios.mechanisms()
     finally:
         monkeypatch.undo()
