@@ -28,9 +28,9 @@ class ServoFeedforwardController:
     With an integral time T_i, ``z <- z + dt / T_i (q_ref - q)`` each tick, limited so
     ``kp z`` stays inside the force limit.
 
-    It drives the actuators its trajectory's channels name, which must be the first ``nu``
-    of its command (``ControlContext.actuators``; ``nu`` = the channels; checked in
-    ``reset``), and reads the task's observation (``sims.task``): ``joint_positions`` (the encoders, for
+    It drives the first ``nu`` actuators of its command (``ControlContext.actuators``, found
+    in the model by name; ``nu`` = the reference's channels), which must be the ones its
+    trajectory's channels name (checked in ``reset``), and reads the task's observation (``sims.task``): ``joint_positions`` (the encoders, for
     the integral action) and ``setpoints`` (the drives' set-points), in that order.
 
     Args:
@@ -52,14 +52,15 @@ class ServoFeedforwardController:
         self.setpoints = None
         self.reference = None
         self.tau_ff = None
+        self.actuator_ids = None
         self.z = None
         self._inv_dt = None
         self._gain = 0.0
 
     @staticmethod
-    def joint_addresses(model, nu: int) -> tuple[np.ndarray, np.ndarray]:
-        """(qpos addresses, dof addresses) of the joints the first ``nu`` actuators drive."""
-        joints = model.actuator_trnid[:nu, 0]
+    def joint_addresses(model, actuators: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(qpos addresses, dof addresses) of the joints the actuators (indices) drive."""
+        joints = model.actuator_trnid[actuators, 0]
         return model.jnt_qposadr[joints].copy(), model.jnt_dofadr[joints].copy()
 
     def feedforward_forces(self, context) -> np.ndarray:
@@ -68,7 +69,7 @@ class ServoFeedforwardController:
         reference = context.reference
         nu = reference.position.shape[1]
         nominal = context.nominal_physics()
-        qpos_adr, dofs = self.joint_addresses(nominal.model.ptr, nu)
+        qpos_adr, dofs = self.joint_addresses(nominal.model.ptr, self.actuator_ids)
         n = reference.t.size
         tau = np.zeros((n, nu))
         # A copy of the model (MjModel's copy is a full mj_copyModel) with contacts
@@ -95,12 +96,13 @@ class ServoFeedforwardController:
         if labels is not None and tuple(labels) != tuple(context.actuators[:nu]):
             raise ValueError(f"the trajectory's channels {tuple(labels)} are not the first {nu} actuators "
                              f"{tuple(context.actuators[:nu])}")
+        self.actuator_ids = ids = np.array([model.actuator(name).id for name in context.actuators[:nu]])
         if self.kp is None:
-            self.kp = model.actuator_gainprm[:nu, 0].copy()
+            self.kp = model.actuator_gainprm[ids, 0].copy()
         if self.kv is None:
-            self.kv = -model.actuator_biasprm[:nu, 2].copy()
+            self.kv = -model.actuator_biasprm[ids, 2].copy()
         if self.force_limit is None and self.integral_time is not None:
-            self.force_limit = model.actuator_forcerange[:nu, 1].copy()
+            self.force_limit = model.actuator_forcerange[ids, 1].copy()
         n = reference.t.size
         self.tau_ff = (self.feedforward_forces(context) if self.feedforward else np.zeros((n, nu)))
         self.reference = reference.position

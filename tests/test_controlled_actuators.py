@@ -79,3 +79,25 @@ def test_other_controllers_drive_every_actuator(name):
     setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=0.1))
     model = setup.physics.model.ptr
     assert runner.controlled_names(setup) == tuple(model.actuator(j).name for j in range(model.nu))
+
+
+def test_the_servo_controller_finds_its_drives_by_name():
+    """ServoFeedforwardController on a command that is not the model's first actuators (the
+    antenna's four joints, actuators 4 ... 7) reads those drives' gains, not the deck's."""
+    from planners.trajectory import TrajectorySample
+    from sims.controllers import ServoFeedforwardController
+    from sims.task import ControlContext
+
+    setup = build("antenna-paper-motion", None)
+    model = setup.physics.model.ptr
+    n = 3
+    reference = TrajectorySample(np.arange(n) * 0.005, np.zeros((n, 4)), np.zeros((n, 4)), np.zeros((n, 4)))
+    context = ControlContext(model=model, nominal_physics=lambda: setup.physics, problem=None, trajectory=None,
+                             reference=reference, control_dt=0.005, command=np.zeros(4), setpoint=np.zeros(4),
+                             actuators=tuple(JOINT_LABELS), observation={})
+    servo = ServoFeedforwardController(feedforward=False, integral_time=0.1)
+    servo.reset(context)
+    ids = [model.actuator(name).id for name in JOINT_LABELS]
+    assert min(ids) == 4
+    np.testing.assert_array_equal(servo.kp, model.actuator_gainprm[ids, 0])
+    np.testing.assert_array_equal(servo.force_limit, model.actuator_forcerange[ids, 1])

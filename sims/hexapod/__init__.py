@@ -600,11 +600,12 @@ class HexapodEvaluation:
         # Against this move's own target (the window's last tick is the next move's first).
         wanted = hexapod_planner.pivot_positions(np.asarray(self.moves[i].target_pose))
         pivots = 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(poses[settled]) - wanted, axis=-1).max(axis=-1)
-        # The measured struts: from the arrival on, when every encoder stays within ENCODER_SETTLE_M.
+        # The measured struts: from the arrival on, when every encoder (what the drives read,
+        # with the plant's bias) stays within ENCODER_SETTLE_M of its target.
         encoder_settle = None
         if arrived:
             after = np.arange(lo + arrival_tick, last + 1)
-            off = (np.abs(q[after] - target) > ENCODER_SETTLE_M).any(axis=1)
+            off = (np.abs(self.physics.drive_positions(q[after]) - target) > ENCODER_SETTLE_M).any(axis=1)
             if not off[-1]:
                 encoder_settle = float((np.flatnonzero(off)[-1] + 1 if off.any() else 0) * CONTROL_DT)
         return {
