@@ -9,6 +9,7 @@ number; tests compare the planners' kinematics with MuJoCo's at random poses.
 from __future__ import annotations
 
 import functools
+import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,15 +17,40 @@ from pathlib import Path
 import numpy as np
 
 MODELS_DIR = Path(__file__).resolve().parent
+
+#: Environment variable naming more mechanism roots (separated by os.pathsep): each holds
+#: ``models/<name>/scene.xml`` and ``sims/<name>/`` (and, if it has one, ``planners/<name>/``)
+#: of a mechanism of its own, found as the project's own are.
+ROOTS_VARIABLE = "PLANBENCH_MECHANISMS"
+
+
+def _model_folders() -> dict[str, Path]:
+    folders = {path.parent.name: path.parent for path in MODELS_DIR.glob("*/scene.xml")}
+    for root in filter(None, os.environ.get(ROOTS_VARIABLE, "").split(os.pathsep)):
+        for path in sorted(Path(root).resolve().glob("models/*/scene.xml")):
+            name = path.parent.name
+            if name in folders:
+                raise ValueError(f"{ROOTS_VARIABLE}: {path} names the mechanism {name!r}, already at {folders[name]}")
+            folders[name] = path.parent
+    return dict(sorted(folders.items()))
+
+
+_FOLDERS = _model_folders()
 #: Every mechanism: each folder of models/ with a scene.xml, in name order (found as MuJoCo
-#: Menagerie finds its model folders, no hand list). Its simulation is the package sims/<name>/.
-MECHANISMS = tuple(sorted(path.parent.name for path in MODELS_DIR.glob("*/scene.xml")))
+#: Menagerie finds its model folders, no hand list), and those of the roots that
+#: PLANBENCH_MECHANISMS names. Its simulation is the package sims/<name>/.
+MECHANISMS = tuple(_FOLDERS)
+
+
+def extra_roots() -> tuple[Path, ...]:
+    """The mechanism roots PLANBENCH_MECHANISMS names (their folders hold models/, sims/ ...)."""
+    return tuple(sorted({folder.parent.parent for folder in _FOLDERS.values()} - {MODELS_DIR.parent}))
 
 
 def model_dir(name: str) -> Path:
     if name not in MECHANISMS:
         raise ValueError(f"unknown model {name!r}; known models: {', '.join(MECHANISMS)}")
-    return MODELS_DIR / name
+    return _FOLDERS[name]
 
 
 def scene_path(name: str) -> Path:

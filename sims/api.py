@@ -14,7 +14,7 @@ the command line (``sims.plugins``).
 
 from __future__ import annotations
 
-from sims import outputs, runner, scenarios
+from sims import outputs, pipeline, runner, scenarios
 from sims.task import check_controller, check_planner
 
 
@@ -57,28 +57,15 @@ def run(scenario: str, *, planner=None, controller=None, params=None, plant=None
         raise ValueError("a video needs an output directory: give out= too")
     target = None if out is None else outputs.OutputDir(out)
     video_file = None if video is None else outputs.VideoFile(video, target)
+
+    def execute():
+        return pipeline.execute(spec, params, plant, planner=planner, controller=controller, out=target,
+                                video=video_file, quiet=quiet)[1]
+
     if target is None:
-        return _run(spec, params, plant, planner, controller, quiet)[1]
+        return execute()
     with target.reserved():
         if video_file is None:
-            return _run_and_write(spec, params, plant, planner, controller, target, None, quiet)
+            return execute()
         with video_file.reserved():
-            return _run_and_write(spec, params, plant, planner, controller, target, video_file, quiet)
-
-
-def build(spec, params, plant=None, planner=None, controller=None):
-    """``spec.build`` with the plant passed only when it is perturbed (a mechanism without
-    plant uncertainty takes no ``plant``)."""
-    extra = {} if plant is None or plant.is_nominal else {"plant": plant}
-    return spec.build(params, planner=planner, controller=controller, **extra)
-
-
-def _run(spec, params, plant, planner, controller, quiet):
-    setup = build(spec, params, plant, planner, controller)
-    return setup, runner.run(spec.name, setup, quiet=quiet)
-
-
-def _run_and_write(spec, params, plant, planner, controller, target, video, quiet):
-    setup, result = _run(spec, params, plant, planner, controller, quiet)
-    outputs.write_run(result, setup, target, video=video, camera=spec.camera, quiet=quiet)
-    return result
+            return execute()

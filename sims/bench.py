@@ -10,7 +10,7 @@ For each benchmarked scenario (no video) it reports:
                    the share of MuJoCo's steps, of the code under test (the controller's calls
                    and the online planner inside them) and of the testbed's own cost (sensors,
                    disturbance, logging, divergence scans).
-The best of several runs is taken for both (REPEATS, or the mechanism's BENCHMARK count), so
+The best of several runs is taken for both (REPEATS, or the mechanism's ``benchmark_runs``), so
 a busy machine affects both sides alike.
 """
 
@@ -22,7 +22,7 @@ import timeit
 import mujoco
 import numpy as np
 
-from sims import runner, scenarios
+from sims import pipeline, scenarios
 
 REPEATS = 5
 
@@ -38,8 +38,10 @@ def best_time(function, repeats: int = REPEATS):
 
 
 def benchmarks() -> list[tuple[str, int]]:
-    """(scenario, runs) of every mechanism: its package's BENCHMARK (sims.scenarios)."""
-    return [package.BENCHMARK for package in scenarios.mechanisms()]
+    """(scenario, runs) of every scenario tagged "benchmark" (sims.scenarios), with its
+    mechanism's ``benchmark_runs``."""
+    return [(s.name, record.benchmark_runs) for record in scenarios.mechanisms()
+            for s in record.tagged(scenarios.BENCHMARK)]
 
 
 def bare_steps_per_second(setup, n_steps: int) -> float:
@@ -63,16 +65,14 @@ def bench_scenario(name: str, repeats: int = REPEATS) -> dict:
     scenario = scenarios.get(name)
     best_run, best_loop = None, None
     for _ in range(repeats):
-        setup = scenario.build(scenario.params)
-        result = runner.run(name, setup)
+        setup, result = pipeline.execute(scenario, scenario.params)
         if best_run is None or result.wall_time_s < best_run.wall_time_s:
             best_run = result
         loop_rate = result.log.physics_steps / result.log.loop_wall_s
         best_loop = loop_rate if best_loop is None else max(best_loop, loop_rate)
     # One more run with the loop's clocks on: physics, code under test, the testbed's own cost.
-    profiled = runner.simulate(scenario.build(scenario.params), profile=True)
-    setup = scenario.build(scenario.params)
-    bare = bare_steps_per_second(setup, best_run.log.physics_steps)
+    profiled = pipeline.execute(scenario, scenario.params, profile=True)[1].log
+    bare = bare_steps_per_second(pipeline.build(scenario, scenario.params), best_run.log.physics_steps)
     return {
         "scenario": name,
         "sim_time_s": best_run.sim_time_s,
@@ -199,8 +199,8 @@ def planner_benchmarks() -> list[str]:
     import importlib.util
 
     texts = []
-    for package in scenarios.mechanisms():
-        name = f"{package.__name__}.bench"
+    for record in scenarios.mechanisms():
+        name = f"sims.{record.name}.bench"
         if importlib.util.find_spec(name) is not None:
             texts.append(importlib.import_module(name).planner_benchmark())
     return texts

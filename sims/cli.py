@@ -247,7 +247,7 @@ def _write_unfinished(out, scenario, params, plugins: dict, check) -> None:
 
 
 def cmd_run(argv: list[str]) -> int:
-    from sims import api, outputs, runner, supervise
+    from sims import outputs, pipeline, supervise
     from sims import plugins as plugins_module
     from sims.checks import Check
 
@@ -275,14 +275,8 @@ def cmd_run(argv: list[str]) -> int:
 
     def work():
         # In the supervised child: the plug-ins' code runs here only.
-        made = {role: plugins_module.make(plugin_spec, role, online_planner=scenario.online_planner)
-                for role, plugin_spec in plugins.items()}
-        setup = api.build(scenario, params, plant, **made)
-        supervise.report_duration(setup.duration)
-        result = runner.run(scenario.name, setup, quiet=args.quiet)
-        result.plugins = plugins
-        supervise.phase("writing the outputs (planbench's own code)")
-        outputs.write_run(result, setup, out, video=video, camera=camera, quiet=args.quiet)
+        _, result = pipeline.execute(scenario, params, plant, plugins=plugins, out=out, video=video, camera=camera,
+                                     quiet=args.quiet, on_built=lambda setup: supervise.report_duration(setup.task.duration))
         return ([(scenario.name, c) for c in result.checks], result.passed, result.sim_time_s, result.wall_time_s)
 
     with contextlib.ExitStack() as reserved:  # lock before simulating: a second run is refused
@@ -370,26 +364,25 @@ def _demo_root(raw: str) -> Path:
     inside it are)."""
     from sims import outputs, scenarios
 
-    return outputs.OutputRoot(raw, "demo --out", inner=tuple(scenarios.SCENARIOS)).path
+    return outputs.OutputRoot(raw, "demo --out", inner=tuple(s.name for s in scenarios.tagged(scenarios.DEMO))).path
 
 
 def cmd_demo(args) -> int:
-    from sims import outputs, runner, scenarios
+    from sims import outputs, pipeline, scenarios
 
     root = _demo_root(args.out)
-    targets = {name: outputs.OutputDir(root / name, option="demo --out")
-               for name in scenarios.SCENARIOS}  # every one validated before the first run
+    demo = scenarios.tagged(scenarios.DEMO)
+    targets = {s.name: outputs.OutputDir(root / s.name, option="demo --out")
+               for s in demo}  # every one validated before the first run
     rows, unexpected = [], []
     with contextlib.ExitStack() as reserved:
         for target in targets.values():
             reserved.enter_context(target.reserved())
-        for scenario in scenarios.SCENARIOS.values():
+        for scenario in demo:
             out = targets[scenario.name]
-            setup = scenario.build(scenario.params)
-            result = runner.run(scenario.name, setup, quiet=args.quiet)
-            outputs.write_run(result, setup, out, video=outputs.VideoFile(out.path / f"{scenario.name}.mp4", out),
-                              camera=scenario.camera, quiet=args.quiet,
-                              more_videos=[(f"{scenario.name}-{c}.mp4", c) for c in scenario.demo_cameras])
+            _, result = pipeline.execute(
+                scenario, scenario.params, out=out, video=outputs.VideoFile(out.path / f"{scenario.name}.mp4", out),
+                quiet=args.quiet, more_videos=tuple((f"{scenario.name}-{c}.mp4", c) for c in scenario.demo_cameras))
             rows += [(scenario.name, c) for c in result.checks]
             verdict = "passed" if result.passed else "failed"
             expected = "as expected" if result.passed == scenario.expect_pass else "UNEXPECTEDLY"
@@ -402,7 +395,7 @@ def cmd_demo(args) -> int:
     if unexpected:
         print(f"\nunexpected outcome: {', '.join(unexpected)}")
         return EXIT_CHECK_FAILED
-    print(f"\nall {len(scenarios.SCENARIOS)} scenarios behaved as expected "
+    print(f"\nall {len(demo)} scenarios behaved as expected "
           "(loader-direct is meant to fail its obstacle check)")
     return EXIT_OK
 

@@ -1,15 +1,18 @@
 """Each mechanism as a ``dm_control.rl.control.Environment``: a thin adapter over its Task.
 
-The adapter (``TaskAdapter``) runs a scenario's ``runner.Setup`` the way the runner does
-(``runner.start_episode``): the same initial state, the same sensors and disturbances seeded
-the same way, ``steps_per_tick`` physics steps per action. The agent plays the controller:
-its action is the commands of the actuators a controller drives (``Setup.controlled``), its
-observation what the task's sensors report (``sims.task``) plus the reference at the current
-tick (not the antenna's: its joint path is the true sea's), never the physics state. An
-episode starts as the reference controller's run starts (the machine at rest, its drives
-holding the start), and lasts the scenario's duration. The reward is exp(-error / scale) of
-the task's goal: the joint tracking error (loader, hexapod), the pointing error (antenna),
-the feed's distance from its goal path (FAST).
+The adapter (``TaskAdapter``) is the runner's loop with the agent in the controller's place:
+each episode starts from the task's initial state (``sims.task.Task``: its
+``initialize_episode``, the sensors and the disturbance seeded from a fresh seed drawn from the
+adapter's ``random``, as dm_control's suite tasks draw theirs), and each action is one control
+tick as the runner takes it: the task's disturbance (``Task.before_step``), ``steps_per_tick``
+physics steps with ``mj_step`` (MuJoCo's own step, not dm_control's legacy one, as in the
+runner), then the sensors (``Task.observe``). The action is the commands of the actuators a
+controller drives (``Task.controlled``), the observation what the task's sensors report plus
+the reference at the current tick (not the antenna's: its joint path is the true sea's), never
+the physics state. An episode starts with the machine at rest, its drives holding the start,
+and lasts the scenario's duration. The reward is exp(-error / scale) of the task's goal: the
+joint tracking error (loader, hexapod), the pointing error (antenna), the feed's distance from
+its goal path (FAST).
 """
 
 from __future__ import annotations
@@ -19,31 +22,41 @@ import collections
 import mujoco
 import numpy as np
 from dm_control.rl import control
+from dm_control.suite import base
 from dm_env import specs
 
 from sims import runner
+from sims.task import sample_checked
+
+#: Episode seeds are drawn from [0, this).
+SEED_RANGE = 2**31 - 1
 
 
-class TaskAdapter(control.Task):
+class TaskAdapter(base.Task):
     """A planbench Setup as a dm_control Task.
 
     Args:
-      setup: a scenario's ``runner.Setup`` (its physics at the initial state).
+      setup: a scenario's ``runner.Setup`` (its physics at the task's initial state).
       reward: (physics, tick, adapter) -> reward in (0, 1].
+      random: the episodes' random state (an int seed or a ``numpy.random.RandomState``);
+        None: seeded from the setup's seed, so that an environment is reproducible.
     """
 
-    def __init__(self, setup: runner.Setup, reward):
+    def __init__(self, setup: runner.Setup, reward, random=None):
+        super().__init__(random=setup.provenance.seed if random is None else random)
         self._setup = setup
         self._reward = reward
-        episode = runner.start_episode(setup)  # the reference controller's start of the run
-        self._times = episode.times
-        self._reference = episode.reference
-        physics = setup.physics
-        model = physics.model.ptr
-        self._state_spec = mujoco.mjtState.mjSTATE_INTEGRATION
-        self._initial = np.empty(mujoco.mj_stateSize(model, self._state_spec))
-        mujoco.mj_getState(model, physics.data.ptr, self._initial, self._state_spec)
+        self._times = setup.task.times()
+        self._reference = sample_checked(setup.components.trajectory, self._times)
         self._controlled = runner.controlled_actuators(setup)
+        # The reference controller's start chooses the drives' initial set-points (their
+        # activations: the hexapod's struts hold the start under gravity); each episode starts
+        # with them, as a run does.
+        start = runner.start_episode(setup)
+        self._act_adr = runner.controlled_views(setup)[1]
+        self._setpoint = start.context.setpoint.copy()
+        self._last = self._times.size - 1
+        self.episode_seed: int | None = None
         self.tick = 0
 
     @property
@@ -56,24 +69,23 @@ class TaskAdapter(control.Task):
         return self._reference
 
     def initialize_episode(self, physics):
-        setup = self._setup
-        model, data = physics.model.ptr, physics.data.ptr
-        mujoco.mj_setState(model, data, self._initial, self._state_spec)
-        mujoco.mj_forward(model, data)  # the sensors read sensordata and positions of this state
-        self._observation = setup.sensors.reset(physics, self._times, setup.seed)
-        if setup.disturbance is not None:
-            setup.disturbance.reset(physics, self._times, np.random.default_rng(setup.seed))
-        mujoco.mj_forward(model, data)
+        task = self._setup.task
+        task.restore_initial_state(physics)
+        self.episode_seed = int(self.random.randint(SEED_RANGE))
+        self._observation = task.initialize_episode(physics, self._times, self.episode_seed)
+        physics.data.act[self._act_adr] = self._setpoint
+        mujoco.mj_forward(physics.model.ptr, physics.data.ptr)
         self.tick = 0
+        task.observe(0, physics)  # the runner's first tick reads the sensors before the controller
 
     def before_step(self, action, physics):
         physics.data.ctrl[self._controlled] = action
-        if self._setup.disturbance is not None:
-            self._setup.disturbance(min(self.tick, self._times.size - 1), physics)
+        self._setup.task.before_step(min(self.tick, self._last), physics)
 
     def after_step(self, physics):
         self.tick += 1
-        self._setup.sensors(min(self.tick, self._times.size - 1), physics)
+        if self.tick <= self._last:
+            self._setup.task.observe(self.tick, physics)
 
     def action_spec(self, physics):
         model = physics.model.ptr
@@ -83,23 +95,26 @@ class TaskAdapter(control.Task):
                                   np.where(limited, hi, np.inf), name="ctrl")
 
     def get_observation(self, physics):
-        k = min(self.tick, self._times.size - 1)
+        k = min(self.tick, self._last)
         obs = collections.OrderedDict((name, np.array(value, dtype=float)) for name, value in self._observation.items())
-        if self._setup.reference_visible:
+        if self._setup.task.reference_visible:
             obs["reference_positions"] = self._reference.position[k].copy()
             obs["reference_velocities"] = self._reference.velocity[k].copy()
         return obs
 
     def get_reward(self, physics):
-        return self._reward(physics, min(self.tick, self._times.size - 1), self)
+        return self._reward(physics, min(self.tick, self._last), self)
 
 
-def environment(setup: runner.Setup, reward) -> control.Environment:
+def environment(setup: runner.Setup, reward, random=None) -> control.Environment:
     """The dm_control Environment of ``setup``: one action per control tick, ``steps_per_tick``
-    physics steps each, for the scenario's duration."""
-    task = TaskAdapter(setup, reward)
-    n_sub = runner.steps_per_tick(setup.physics.model.ptr, setup.control_dt)
-    return control.Environment(setup.physics, task, time_limit=setup.duration, n_sub_steps=n_sub)
+    physics steps each (``mj_step``, as the runner), for the scenario's duration. ``random``:
+    see ``TaskAdapter``."""
+    task = TaskAdapter(setup, reward, random)
+    physics = setup.physics
+    physics.legacy_step = False  # mj_step(nstep), the runner's step, not mj_step2 + mj_step1
+    n_sub = runner.steps_per_tick(physics.model.ptr, setup.task.control_dt)
+    return control.Environment(physics, task, time_limit=setup.task.duration, n_sub_steps=n_sub)
 
 
 def joint_tracking_reward(qpos_index, scale: float):
@@ -113,16 +128,16 @@ def joint_tracking_reward(qpos_index, scale: float):
     return reward
 
 
-def make(scenario: str, **params) -> control.Environment:
+def make(scenario: str, random=None, **params) -> control.Environment:
     """The dm_control Environment of the scenario ``scenario`` (any of ``planbench list``):
     its Setup built with its parameters overridden by ``params`` (e.g. ``duration``, ``seed``,
-    ``wind``: ``planbench run NAME --help``), the reward its mechanism declares
-    (``environment_reward`` in sims/<mechanism>/)."""
+    ``wind``: ``planbench run NAME --help``), the reward its mechanism declares. ``random``:
+    the episodes' random state (None: from the ``seed`` parameter)."""
     from sims import scenarios
 
     spec = scenarios.get(scenario)
     setup = spec.build(spec.resolve(params))
-    return environment(setup, scenarios.mechanism_of(scenario).environment_reward(setup))
+    return environment(setup, scenarios.mechanism_of(scenario).reward(setup), random)
 
 
 def loader_environment(plan: str = "supply") -> control.Environment:
@@ -159,4 +174,4 @@ def fast_environment(duration: float = 60.0, wind: float | None = None, seed: in
 
     params = fast.FastParams(**_given(wind=wind, seed=seed, cable_segments=cable_segments))
     setup = fast.build(fast.observation_plan(duration), params)
-    return environment(setup, fast.environment_reward(setup))
+    return environment(setup, fast.MECHANISM.reward(setup))

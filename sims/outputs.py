@@ -775,15 +775,15 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                 arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl,
                           "act": log.act, "actuator_force": log.actuator_force,
                           "sensordata": log.sensordata}
-                arrays.update(setup.timeseries(log))
-                if setup.output_stride > 1:  # every stride-th tick of the per-tick arrays
+                arrays.update(setup.task.evaluation.timeseries(log))
+                stride = setup.output.output_stride
+                if stride > 1:  # every stride-th tick of the per-tick arrays
                     n = log.t.size
-                    arrays = {k: v[::setup.output_stride] if np.ndim(v) and np.shape(v)[0] == n else v
-                              for k, v in arrays.items()}
-                    summary["timeseries_every_s"] = float(log.t[setup.output_stride] - log.t[0]) if n > setup.output_stride else None
+                    arrays = {k: v[::stride] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in arrays.items()}
+                    summary["timeseries_every_s"] = float(log.t[stride] - log.t[0]) if n > stride else None
                 np.savez_compressed(tmp / "timeseries.npz", **arrays)
-                setup.report(log, result.checks, tmp / "report.png")
-                render = dict(speed=setup.video_speed, quiet=quiet, frame_qpos=setup.video_qpos)
+                setup.task.evaluation.report(log, result.checks, tmp / "report.png")
+                render = dict(speed=setup.output.video_speed, quiet=quiet, frame_qpos=setup.output.video_qpos)
                 if video is not None:
                     if video.relative is not None:
                         path = tmp / video.relative
@@ -793,8 +793,8 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                         with video.staging() as path:
                             frames = render_video(setup.physics.model.ptr, log, path, camera=camera, **render)
                     summary["video"] = {"path": str(video.path), "frames": frames, "camera": camera}
-                    if setup.video_note:
-                        summary["video"]["shows"] = setup.video_note
+                    if setup.output.video_note:
+                        summary["video"]["shows"] = setup.output.video_note
                 for name, extra_camera in more_videos:
                     frames = render_video(setup.physics.model.ptr, log, tmp / name, camera=extra_camera, **render)
                     summary.setdefault("more_videos", []).append(

@@ -20,7 +20,6 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 from math import isfinite
-from typing import Callable, Protocol
 
 import mujoco
 import numpy as np
@@ -29,8 +28,8 @@ from tqdm import tqdm
 from planners.trajectory import Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, controller_check, divergence_check
 from sims import supervise
-from sims.task import (ControlContext, Controller, PluginError, Sensors, check_controller,
-                       check_first_command, fault_text, nominal_copy, sample_checked)
+from sims.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
+                       check_controller, check_first_command, fault_text, sample_checked)
 
 #: How often (in control ticks) the loop scans for divergence: NaN or inf in the logged
 #: state since the last scan, and MuJoCo's warning counters (its bad-qacc detection resets the
@@ -38,81 +37,29 @@ from sims.task import (ControlContext, Controller, PluginError, Sensors, check_c
 SCAN_TICKS = 10
 
 
-class Disturbance(Protocol):
-    """Wind, ship motion, payload forces...: applied once per control tick. Part of the
-    plant, so it may read and write the physics."""
-
-    def reset(self, physics, times: np.ndarray, rng: np.random.Generator) -> None: ...
-
-    def __call__(self, tick: int, physics) -> None: ...
-
-
 @dataclass
 class Setup:
-    """Everything one run needs; built by a scenario.
+    """Everything one run needs, built by a scenario, as dm_control's ``Environment`` holds a
+    physics and a task.
 
     Attributes:
-      physics: a ``dm_control.mujoco.Physics`` of the scene, at its initial state.
-      trajectory: the planned motion (what the planner returned; for the antenna, the ideal
-        joint path for the true sea, a reference for plots).
-      controller: see ``sims.task.Controller``.
-      sensors: the task's ``sims.task.Sensors`` (the controller's observation).
-      problem: the task's planning problem (typed, per mechanism).
-      planner: the planner that ran (its class is recorded in summary.json); for the
-        antenna the task's ``RecordingPlanner`` around the online planner.
-      control_dt: control period, s; a multiple of the model timestep.
-      duration: simulated time, s.
-      evaluate: (RunLog) -> (checks, metrics) for this mechanism.
-      timeseries: (RunLog) -> {name: array} written to timeseries.npz besides the log.
-      report: (RunLog, checks, path) -> None, draws report.png.
-      disturbance: optional, see ``Disturbance``.
-      video_speed: video clock / simulated clock (1 real time, 0.5 slow motion, 20 time-lapse).
-      video_qpos: optional (log, ticks) -> qpos rows to render at those ticks, for a video
-        that shows something other than the logged state (the hexapod's magnified motion).
-      video_note: what the video shows, written to summary.json (e.g. the magnification).
-      output_stride: timeseries.npz keeps every this-many-th tick (the checks use them all):
-        long runs at a high control rate would otherwise write hundreds of MB.
-      nominal_physics: () -> the controller's nominal model at the initial state
-        (``ControlContext.nominal_physics``); default: a copy of ``physics`` as it is now.
-      params: the scenario's parameters (sims.params) the run was built from, None for a
-        setup built by hand; the result records them resolved (``RunResult.parameters``).
-      plant: the plant's uncertainty (sims.params.PlantParams) the physics was built with,
-        None for the nominal plant of a mechanism without one; recorded in ``RunResult.plant``.
-        ``nominal_physics`` must then be the unperturbed model.
-      controlled: indices of the actuators a controller drives (the dm_control action), None
-        for all (the antenna's deck drives are the sea's).
-      reference_visible: False when ``trajectory`` is not a plan but the truth (the antenna's
-        joint path for the true ship motion): the controller then gets no trajectory and no
-        reference (``ControlContext``), nor the environment's agent; the log keeps it for
-        the plots.
+      physics: a ``dm_control.mujoco.Physics`` of the scene, at the task's initial state.
+      task: the ``sims.task.Task`` (problem, sensors, disturbance, evaluation, timing),
+        attached to ``physics`` (its initial state recorded).
+      components: the planner, the trajectory and the controller (``sims.task.Components``).
+      output: how the files are written (``sims.task.Output``).
+      provenance: seed, parameters, plant and plug-ins (``sims.task.Provenance``).
     """
 
     physics: object
-    trajectory: Trajectory
-    controller: Controller
-    sensors: Sensors
-    problem: object
-    planner: object
-    control_dt: float
-    duration: float
-    evaluate: Callable
-    timeseries: Callable
-    report: Callable
-    disturbance: Disturbance | None = None
-    video_speed: float = 1.0
-    seed: int = 0
-    video_qpos: Callable | None = None
-    video_note: str = ""
-    output_stride: int = 1
-    nominal_physics: Callable | None = None
-    params: object = None
-    plant: object = None
-    controlled: np.ndarray | None = None
-    reference_visible: bool = True
+    task: Task
+    components: Components
+    output: Output = field(default_factory=Output)
+    provenance: Provenance = field(default_factory=Provenance)
 
     def __post_init__(self):
-        if self.nominal_physics is None:
-            self.nominal_physics = nominal_copy(self.physics)
+        if self.task._initial_state is None:
+            self.task.attach(self.physics)
 
 
 @dataclass
@@ -254,9 +201,10 @@ class Episode:
 
 
 def controlled_actuators(setup: Setup) -> np.ndarray:
-    """Indices of the actuators the controller drives (``Setup.controlled``; None: all)."""
+    """Indices of the actuators the controller drives (``Task.controlled``; None: all)."""
     nu = setup.physics.model.ptr.nu
-    return np.arange(nu) if setup.controlled is None else np.asarray(setup.controlled, dtype=int)
+    controlled = setup.task.controlled
+    return np.arange(nu) if controlled is None else np.asarray(controlled, dtype=int)
 
 
 def controlled_names(setup: Setup) -> tuple:
@@ -280,35 +228,35 @@ def controlled_views(setup: Setup):
     return data.ctrl[ids[0]:ids[-1] + 1], adr[adr >= 0]
 
 
-def start_episode(setup: Setup) -> Episode:
-    """Put ``setup`` at the start of its run: reset the sensors (seeded from ``setup.seed``),
-    the online planner, ``setup.controller`` (its ``reset`` with the ControlContext, the
-    drives' initial set-points it chose) and the disturbance (seeded
-    from ``setup.seed``), and evaluate the physics."""
-    physics = setup.physics
+def start_episode(setup: Setup, seed: int | None = None) -> Episode:
+    """Put ``setup`` at the start of its run: the task's episode (``Task.initialize_episode``:
+    its sensors and disturbance seeded from ``seed``, default ``setup.provenance.seed``), then
+    the online planner and the controller (its ``reset`` with the ControlContext, the drives'
+    initial set-points it chose), and evaluate the physics."""
+    physics, task, components = setup.physics, setup.task, setup.components
     model, data = physics.model.ptr, physics.data.ptr
-    k = steps_per_tick(model, setup.control_dt)
-    times = control_ticks(setup.duration, setup.control_dt)
-    reference = sample_checked(setup.trajectory, times)
-    controller = setup.controller
+    k = steps_per_tick(model, task.control_dt)
+    times = task.times()
+    reference = sample_checked(components.trajectory, times)
+    controller = components.controller
     check_controller(controller)
-    observation = setup.sensors.reset(physics, times, setup.seed)
+    observation = task.initialize_episode(physics, times, setup.provenance.seed if seed is None else seed)
     command, act_adr = controlled_views(setup)
+    visible = task.reference_visible
+    planner = components.planner
     context = ControlContext(
-        model=setup.nominal_physics().model.ptr, nominal_physics=setup.nominal_physics,
-        problem=setup.problem, trajectory=setup.trajectory if setup.reference_visible else None,
-        reference=reference if setup.reference_visible else None,
-        control_dt=setup.control_dt, command=command, setpoint=data.act[act_adr].copy(),
+        model=task.nominal_physics().model.ptr, nominal_physics=task.nominal_physics,
+        problem=task.problem, trajectory=components.trajectory if visible else None,
+        reference=reference if visible else None,
+        control_dt=task.control_dt, command=command, setpoint=data.act[act_adr].copy(),
         actuators=controlled_names(setup), observation=observation,
-        sensors=tuple(setup.sensors.specs),
-        planner=setup.planner if hasattr(setup.planner, "step") else None)
+        sensors=tuple(task.sensors.specs),
+        planner=planner if hasattr(planner, "step") else None)
     # Before the first tick a plug-in that cannot start is bad input, not a failed run.
     if context.planner is not None:  # an online planner starts from the problem
-        _start("planner", context.planner.reset, setup.problem)
+        _start("planner", context.planner.reset, task.problem)
     _start("controller", controller.reset, context)
     data.act[act_adr] = context.setpoint
-    if setup.disturbance is not None:
-        setup.disturbance.reset(physics, times, np.random.default_rng(setup.seed))
     mujoco.mj_forward(model, data)
     return Episode(times, reference, observation, context, k)
 
@@ -325,7 +273,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     episode = start_episode(setup)
     times, reference, observation, context = episode.times, episode.reference, episode.observation, episode.context
     k, n = episode.steps_per_tick, episode.times.size
-    controller = setup.controller
+    controller = setup.components.controller
 
     log = RunLog(
         t=times,
@@ -355,7 +303,8 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
 
     record(0)
     initial_ctrl = data.ctrl.copy()
-    sensors, disturbance = setup.sensors, setup.disturbance
+    task = setup.task
+    observe, before_step = task.observe, task.before_step  # the same tick as sims.envs'
     ctrl_now = context.command
     contacts = log.contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
@@ -367,7 +316,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     supervise.phase("the control loop (the controller's __call__, or an online planner's step in it)")
     start = clock()
     for i in range(n - 1):
-        sensors(i, physics)
+        observe(i, physics)
         if profile:
             t0 = clock()
         try:
@@ -390,8 +339,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             log.controller_error = (float(times[i]), _bad_command(model, data.ctrl, times[i]))
             last = i
             break
-        if disturbance is not None:
-            disturbance(i, physics)
+        before_step(i, physics)
         ctrl[i] = data.ctrl
         if profile:
             t1 = clock()
@@ -434,11 +382,12 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     return log
 
 
-def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
-    """Simulate ``setup`` and evaluate its checks."""
+def run(name: str, setup: Setup, quiet: bool = True, profile: bool = False) -> RunResult:
+    """Simulate ``setup`` (``profile``: see ``simulate``) and evaluate its checks."""
     start = time.perf_counter()
-    log = simulate(setup, quiet=quiet)
-    checks, metrics = setup.evaluate(log)
+    log = simulate(setup, quiet=quiet, profile=profile)
+    task, components, provenance = setup.task, setup.components, setup.provenance
+    checks, metrics = task.evaluation.evaluate(log)
     checks = list(checks) + [
         divergence_check(log.warnings, log.diverged_at, log.divergence_message),
         controller_check(log.controller_error),
@@ -448,20 +397,22 @@ def run(name: str, setup: Setup, quiet: bool = True) -> RunResult:
     metrics = dict(metrics)
     metrics["physics_steps"] = log.physics_steps
     metrics["loop_wall_s"] = log.loop_wall_s
-    planner = getattr(setup.planner, "planner", setup.planner)  # the one a RecordingPlanner holds
-    components = {role: None if obj is None else f"{type(obj).__module__}.{type(obj).__qualname__}"
-                  for role, obj in (("planner", planner), ("trajectory", setup.trajectory),
-                                    ("controller", setup.controller), ("sensors", setup.sensors),
-                                    ("disturbance", setup.disturbance))}
-    return RunResult(name, setup.seed, log, checks, metrics, sim_time, wall, components,
-                     sensors=setup.sensors.describe(), parameters=_resolved(setup),
-                     plant=None if setup.plant is None else setup.plant.to_dict())
+    planner = getattr(components.planner, "planner", components.planner)  # the one a RecordingPlanner holds
+    roles = (("planner", planner), ("trajectory", components.trajectory), ("controller", components.controller),
+             ("sensors", task.sensors), ("disturbance", task.disturbance))
+    described = {role: None if obj is None else f"{type(obj).__module__}.{type(obj).__qualname__}"
+                 for role, obj in roles}
+    plant = provenance.plant
+    return RunResult(name, provenance.seed, log, checks, metrics, sim_time, wall, described,
+                     plugins=dict(provenance.plugins), sensors=task.sensors.describe(),
+                     parameters=_resolved(setup), plant=None if plant is None else plant.to_dict())
 
 
 def _resolved(setup: Setup) -> dict | None:
-    if setup.params is None:
+    params = setup.provenance.params
+    if params is None:
         return None
-    values = setup.params.to_dict()
+    values = params.to_dict()
     if "duration" in values and values["duration"] is None:
-        values["duration"] = float(setup.duration)
+        values["duration"] = float(setup.task.duration)
     return values

@@ -1,14 +1,15 @@
 """The scenario registry: every runnable scenario of every mechanism, by name.
 
-Each mechanism's package ``sims/<mechanism>/`` declares its own scenarios (``SCENARIOS``, a
-tuple of ``Scenario``), plan-only entries (``PLANS``, optional), the scenario that ``planbench
-bench`` times (``BENCHMARK``: name and number of runs) and the reward of its dm_control
-environment (``environment_reward``). The registry imports the packages of the mechanisms
-that ``models.MECHANISMS`` lists (one folder per model, as in MuJoCo Menagerie) the first
-time it is asked, as dm_control's suite builds its registry from its domain modules; the
-tuple is the folders of models/ that hold a scene.xml, so a fifth mechanism is its own
-folders (models/<name>/ and sims/<name>/) and nothing else. ``planbench list``, ``run``,
-``plan``, ``demo``, ``bench`` and the environments (``sims.envs``) all come from here.
+Each mechanism's package ``sims/<mechanism>/`` declares one record, ``MECHANISM``
+(``Mechanism``): its scenarios, each tagged as dm_control's suite tags its tasks ("demo": run by
+``planbench demo``; "benchmark": timed by ``planbench bench``), its plan-only entries, how many
+runs the bench takes the best of, and the reward of its dm_control environment. The registry
+imports the packages of the mechanisms that ``models.MECHANISMS`` lists (one folder per model,
+as in MuJoCo Menagerie) the first time it is asked, as dm_control's suite builds its registry
+from its domain modules; the tuple is the folders of models/ that hold a scene.xml (and those
+of the roots that ``PLANBENCH_MECHANISMS`` names), so a fifth mechanism is its own folders
+(models/<name>/ and sims/<name>/) and nothing else. ``planbench list``, ``run``, ``plan``,
+``demo``, ``bench`` and the environments (``sims.envs``) all come from here.
 """
 
 from __future__ import annotations
@@ -18,7 +19,14 @@ import importlib
 from dataclasses import dataclass
 from typing import Callable
 
+from dm_control.utils import containers
+
 import models
+
+#: The tags of a scenario: ``planbench demo`` runs those tagged DEMO, ``planbench bench`` times
+#: those tagged BENCHMARK.
+DEMO = "demo"
+BENCHMARK = "benchmark"
 
 
 @dataclass(frozen=True)
@@ -49,6 +57,7 @@ class Scenario:
       plant: the nominal plant (an instance of the mechanism's ``sims.params.PlantParams``:
         its plant-uncertainty fields at their nominal values); ``build(..., plant=...)`` takes
         a perturbed one. None: the mechanism declares no plant uncertainty.
+      tags: DEMO, BENCHMARK or neither (a plan-only entry has none).
     """
 
     name: str
@@ -65,6 +74,16 @@ class Scenario:
     online_planner: bool = False
     plant: object = None
     judge_plans: Callable | None = None
+    tags: tuple = (DEMO,)
+
+    @property
+    def __name__(self) -> str:  # a named factory, as the tasks of dm_control's TaggedTasks
+        return self.name
+
+    def __call__(self, params=None, **components):
+        """The Setup of a run with ``params`` (None: the scenario's defaults) and
+        ``components`` (planner, controller, plant) as ``build`` takes them."""
+        return self.build(self.params if params is None else params, **components)
 
     def resolve(self, overrides: dict | None = None, **changes):
         """The scenario's parameters with ``overrides`` (a mapping, as a scenario file's
@@ -84,39 +103,95 @@ class Scenario:
         return type(self.plant).from_mapping(dict(overrides or {}), base=self.plant, prefix="plant.")
 
 
+@dataclass(frozen=True)
+class Mechanism:
+    """One mechanism's record, declared by its package (``sims.<name>.MECHANISM``).
+
+    Attributes:
+      name: its folders' name (models/<name>/, sims/<name>/).
+      scenarios: its runnable scenarios, each with its tags.
+      reward: (setup) -> (physics, tick, adapter) -> reward in (0, 1], of its dm_control
+        environment (``sims.envs``).
+      plans: plan-only entries (``planbench plan``), no physics.
+      benchmark_runs: how many runs ``planbench bench`` takes the best of.
+    """
+
+    name: str
+    scenarios: tuple
+    reward: Callable
+    plans: tuple = ()
+    benchmark_runs: int = 5
+
+    @functools.cached_property
+    def tasks(self) -> containers.TaggedTasks:
+        """Its scenarios by name and tag (dm_control's ``TaggedTasks``)."""
+        tasks = containers.TaggedTasks()
+        for scenario in self.scenarios:
+            tasks.add(*scenario.tags)(scenario)
+        return tasks
+
+    def tagged(self, tag: str) -> tuple:
+        """Its scenarios tagged ``tag``, in declaration order."""
+        names = self.tasks.tagged(tag)
+        return tuple(s for s in self.scenarios if s.name in names)
+
+
+def _import_mechanism(name: str):
+    import planners
+    import sims
+
+    # A mechanism of a root PLANBENCH_MECHANISMS names: its sims/ and planners/ folders
+    # are searched after the project's own (as a namespace package's portions).
+    for root in models.extra_roots():
+        for package, folder in ((sims, root / "sims"), (planners, root / "planners")):
+            if folder.is_dir() and str(folder) not in package.__path__:
+                package.__path__.append(str(folder))
+    try:
+        return importlib.import_module(f"sims.{name}")
+    except ModuleNotFoundError as e:
+        if e.name != f"sims.{name}":
+            raise
+        raise ImportError(f"models/{name}/scene.xml has no simulation package sims/{name}/") from None
+
+
 @functools.lru_cache(maxsize=1)
 def mechanisms() -> tuple:
-    """The mechanisms' simulation packages (``sims.<name>`` for each of models.MECHANISMS), in
-    that order; a model folder without its package is an error naming both."""
-    packages = []
+    """The mechanisms' records (``sims.<name>.MECHANISM`` for each of models.MECHANISMS), in
+    that order; a model folder without its package, or a package without its record, is an
+    error naming it."""
+    records = []
     for name in models.MECHANISMS:
-        try:
-            packages.append(importlib.import_module(f"sims.{name}"))
-        except ModuleNotFoundError as e:
-            if e.name != f"sims.{name}":
-                raise
-            raise ImportError(f"models/{name}/scene.xml has no simulation package sims/{name}/") from None
-    return tuple(packages)
+        package = _import_mechanism(name)
+        record = getattr(package, "MECHANISM", None)
+        if not isinstance(record, Mechanism) or record.name != name:
+            raise ImportError(f"sims/{name}/ declares no MECHANISM = Mechanism({name!r}, ...)")
+        records.append(record)
+    return tuple(records)
 
 
 @functools.lru_cache(maxsize=1)
 def _registry() -> tuple[dict, dict]:
     scenarios, plans = {}, {}
-    for package in mechanisms():
-        for table, entries in ((scenarios, getattr(package, "SCENARIOS", ())), (plans, getattr(package, "PLANS", ()))):
+    for record in mechanisms():
+        for table, entries in ((scenarios, record.scenarios), (plans, record.plans)):
             for entry in entries:
                 if entry.name in scenarios or entry.name in plans:
-                    raise ValueError(f"scenario name {entry.name!r} of {package.__name__} is taken")
+                    raise ValueError(f"scenario name {entry.name!r} of sims.{record.name} is taken")
                 table[entry.name] = entry
     return scenarios, plans
 
 
-def mechanism_of(name: str):
-    """The package (``sims.<mechanism>``) that declares the scenario ``name``."""
-    for package in mechanisms():
-        if any(s.name == name for s in (*getattr(package, "SCENARIOS", ()), *getattr(package, "PLANS", ()))):
-            return package
+def mechanism_of(name: str) -> Mechanism:
+    """The record of the mechanism that declares the scenario (or plan) ``name``."""
+    for record in mechanisms():
+        if any(s.name == name for s in (*record.scenarios, *record.plans)):
+            return record
     raise ValueError(f"unknown scenario {name!r}")
+
+
+def tagged(tag: str) -> tuple:
+    """Every mechanism's scenarios tagged ``tag`` (DEMO, BENCHMARK), in registry order."""
+    return tuple(s for record in mechanisms() for s in record.tagged(tag))
 
 
 def __getattr__(attribute: str):

@@ -26,7 +26,7 @@ import copy
 import inspect
 import math
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any, Callable, Protocol, runtime_checkable
 
 import mujoco
@@ -179,6 +179,162 @@ class JointEncoders(Sensors):
             np.take(getter(data), index, out=out)
         if not self._ideal:
             self._positions += self.bias + self.noise * self._rng.standard_normal(self.noise.size)
+
+
+# ----------------------------------------------------------------------------- the task
+
+
+@runtime_checkable
+class Disturbance(Protocol):
+    """Wind, ship motion, payload forces...: applied once per control tick. Part of the
+    plant, so it may read and write the physics."""
+
+    def reset(self, physics, times: np.ndarray, rng: np.random.Generator) -> None: ...
+
+    def __call__(self, tick: int, physics) -> None: ...
+
+
+@runtime_checkable
+class Evaluation(Protocol):
+    """How a task judges a run, from its log (``sims.runner.RunLog``) and the task's own
+    records: never from a planner's or controller's internals."""
+
+    def evaluate(self, log) -> tuple[list, dict]:
+        """(checks, metrics): the task's checks (``sims.checks.Check``) and its figures."""
+
+    def timeseries(self, log) -> dict:
+        """{name: array}: what timeseries.npz keeps besides the log."""
+
+    def report(self, log, checks, path) -> None:
+        """Draws report.png at ``path``."""
+
+
+@dataclass
+class Task:
+    """What one run asks of the components, modelled on ``dm_control.rl.control.Task``.
+
+    The physics is not part of it (as in dm_control, the environment holds the physics and
+    hands it to the task). The task owns the initial state the physics was built at, the
+    disturbance, the sensors (the controller's observation), the planning problem and the
+    evaluation.
+
+    Attributes:
+      problem: the planning problem (typed, per mechanism).
+      sensors: the controller's observation (``Sensors``).
+      evaluation: the checks, timeseries and report (``Evaluation``).
+      control_dt: the control period, s; a whole multiple of the model's timestep.
+      duration: simulated time, s.
+      disturbance: optional (``Disturbance``).
+      controlled: indices of the actuators a controller drives (the dm_control action), None
+        for all (the antenna's deck drives are the sea's).
+      reference_visible: False when the trajectory is not a plan but the truth (the antenna's
+        joint path for the true ship motion): the controller then gets no trajectory and no
+        reference (``ControlContext``), nor the environment's agent.
+      nominal_physics: () -> the controller's nominal model at the initial state
+        (``ControlContext.nominal_physics``); None: a copy of the physics as the task found it.
+    """
+
+    problem: Any
+    sensors: Sensors
+    evaluation: Evaluation
+    control_dt: float
+    duration: float
+    disturbance: Disturbance | None = None
+    controlled: np.ndarray | None = None
+    reference_visible: bool = True
+    nominal_physics: Callable | None = None
+    _initial_state: np.ndarray | None = field(default=None, init=False, repr=False)
+
+    _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+
+    def attach(self, physics) -> "Task":
+        """Record ``physics``'s present state as the task's initial state (and, without a
+        nominal model, a copy of it as the controller's); returns the task."""
+        model, data = physics.model.ptr, physics.data.ptr
+        self._initial_state = np.empty(mujoco.mj_stateSize(model, self._STATE))
+        mujoco.mj_getState(model, data, self._initial_state, self._STATE)
+        if self.nominal_physics is None:
+            self.nominal_physics = nominal_copy(physics)
+        return self
+
+    def restore_initial_state(self, physics) -> None:
+        """Put ``physics`` back at the state it had when the task was attached, evaluated."""
+        model, data = physics.model.ptr, physics.data.ptr
+        mujoco.mj_setState(model, data, self._initial_state, self._STATE)
+        mujoco.mj_forward(model, data)
+
+    def times(self) -> np.ndarray:
+        """The control ticks' times, s (``planners.trajectory.control_ticks``)."""
+        from planners.trajectory import control_ticks
+
+        return control_ticks(self.duration, self.control_dt)
+
+    def initialize_episode(self, physics, times: np.ndarray, seed: int) -> dict:
+        """Start an episode from the physics' present state: the sensors and the disturbance
+        reset, seeded from ``seed``; returns the observation at t = 0."""
+        observation = self.sensors.reset(physics, times, seed)
+        if self.disturbance is not None:
+            self.disturbance.reset(physics, times, np.random.default_rng(seed))
+        return observation
+
+    def before_step(self, tick: int, physics) -> None:
+        """The disturbance of control tick ``tick``, applied before the physics steps."""
+        if self.disturbance is not None:
+            self.disturbance(tick, physics)
+
+    def observe(self, tick: int, physics) -> None:
+        """The sensors' readings for the start of control tick ``tick``."""
+        self.sensors(tick, physics)
+
+
+@dataclass
+class Components:
+    """What a run judges: the planner that ran (for the antenna, the task's
+    ``RecordingPlanner`` around the online planner), the trajectory it returned (for the
+    antenna, the ideal joint path for the true sea, a reference for plots) and the
+    controller (``Controller``)."""
+
+    planner: Any
+    trajectory: Trajectory
+    controller: Any
+
+
+@dataclass
+class Output:
+    """How a run's files are written.
+
+    Attributes:
+      video_speed: video clock / simulated clock (1 real time, 0.5 slow motion, 20 time-lapse).
+      video_qpos: optional (log, ticks) -> qpos rows to render at those ticks, for a video
+        that shows something other than the logged state (the hexapod's magnified motion).
+      video_note: what the video shows, written to summary.json (e.g. the magnification).
+      output_stride: timeseries.npz keeps every this-many-th tick (the checks use them all):
+        long runs at a high control rate would otherwise write hundreds of MB.
+    """
+
+    video_speed: float = 1.0
+    video_qpos: Callable | None = None
+    video_note: str = ""
+    output_stride: int = 1
+
+
+@dataclass
+class Provenance:
+    """Where a run came from, recorded in summary.json.
+
+    Attributes:
+      seed: the episode's seed (sensors, disturbance).
+      params: the scenario's parameters (sims.params) the run was built from, None for a task
+        built by hand; the result records them resolved.
+      plant: the plant's uncertainty (sims.params.PlantParams) the physics was built with,
+        None for a mechanism without one.
+      plugins: the ``MODULE:FACTORY`` of a user's planner or controller, by role.
+    """
+
+    seed: int = 0
+    params: Any = None
+    plant: Any = None
+    plugins: dict = field(default_factory=dict)
 
 
 # ----------------------------------------------------------------------------- the contract

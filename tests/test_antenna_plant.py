@@ -110,13 +110,13 @@ def test_the_imu_bias_is_the_sensor_s_and_leaves_the_model():
     mujoco.mju_axisAngle2Quat(expected, np.array([0.3, 0.0, -0.2]) / np.hypot(0.3, 0.2), np.radians(np.hypot(0.3, 0.2)))
     matrix = np.empty(9)
     mujoco.mju_quat2Mat(matrix, expected)
-    np.testing.assert_allclose(setup.sensors.bias_rotation, matrix.reshape(3, 3), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(setup.task.sensors.bias_rotation, matrix.reshape(3, 3), rtol=0, atol=1e-15)
     # The datasheet the controller reads keeps the nominal IMU; it only says there is an error.
-    nominal = build(0.1).sensors
+    nominal = build(0.1).task.sensors
     assert nominal.bias_rotation is None
-    assert setup.sensors.specs[1:] == nominal.specs[1:]
-    assert setup.sensors.specs[0] == dataclasses.replace(nominal.specs[0], bias=setup.sensors.specs[0].bias)
-    assert nominal.specs[0].bias == "none" and "unknown" in setup.sensors.specs[0].bias
+    assert setup.task.sensors.specs[1:] == nominal.specs[1:]
+    assert setup.task.sensors.specs[0] == dataclasses.replace(nominal.specs[0], bias=setup.task.sensors.specs[0].bias)
+    assert nominal.specs[0].bias == "none" and "unknown" in setup.task.sensors.specs[0].bias
 
 
 # ------------------------------------------------------------------ the controller keeps the nominal model
@@ -126,7 +126,7 @@ def test_the_controller_gets_the_nominal_model_at_the_plant_s_start():
     setup = build(0.1, EVERYTHING)
     nominal = models.load("antenna")
     assert changed_fields(nominal, setup.physics.model.ptr)  # the plant is perturbed
-    given = setup.nominal_physics()
+    given = setup.task.nominal_physics()
     assert changed_fields(nominal, given.model.ptr) == {}
     for name in ("qpos", "qvel", "act", "ctrl"):
         np.testing.assert_array_equal(getattr(given.data, name), getattr(setup.physics.data, name))
@@ -134,11 +134,11 @@ def test_the_controller_gets_the_nominal_model_at_the_plant_s_start():
     assert changed_fields(nominal, context.model) == {}
     assert changed_fields(nominal, context.nominal_physics().model.ptr) == {}
     # The controller's constants come from the nominal model and the IMU's datasheet.
-    controller = setup.controller
+    controller = setup.components.controller
     kp, kv = antenna.AntennaPhysics.load().drive_gains()
     np.testing.assert_array_equal(controller.lead, kv / kp)
     assert (controller.period, controller.latency) == (4, 4)  # 50 Hz and 20 ms at 200 Hz
-    assert setup.plant == antenna.AntennaPlant(**EVERYTHING)
+    assert setup.provenance.plant == antenna.AntennaPlant(**EVERYTHING)
 
 
 def test_without_an_imu_bias_the_plant_starts_where_the_nominal_one_does():
@@ -146,9 +146,9 @@ def test_without_an_imu_bias_the_plant_starts_where_the_nominal_one_does():
     perturbed, reference = build(0.1, fields), build(0.1)
     for name in ("qpos", "qvel", "act"):
         np.testing.assert_array_equal(getattr(perturbed.physics.data, name), getattr(reference.physics.data, name))
-        np.testing.assert_array_equal(getattr(perturbed.nominal_physics().data, name),
+        np.testing.assert_array_equal(getattr(perturbed.task.nominal_physics().data, name),
                                       getattr(reference.physics.data, name))
-    np.testing.assert_array_equal(perturbed.problem.theta0, reference.problem.theta0)
+    np.testing.assert_array_equal(perturbed.task.problem.theta0, reference.task.problem.theta0)
 
 
 # ------------------------------------------------------------------ each perturbation acts as computed by hand
@@ -169,15 +169,15 @@ def test_an_imu_bias_shifts_the_pointing_by_the_bias(nominal_run):
     log = result.log
     deck = log.qpos[:, setup.physics.deck_qpos]
     rotated = world_from_ship(deck[:, 1], deck[:, 2], deck[:, 3]) @ np.radians(bias)
-    by_hand = np.degrees(np.linalg.norm(np.cross(rotated, setup.problem.satellite[:, 2]), axis=1))
-    pointing, _ = setup.evaluate.errors_deg(log)
-    nominal_pointing, _ = nominal_run[1].evaluate.errors_deg(nominal_run[0].log)
+    by_hand = np.degrees(np.linalg.norm(np.cross(rotated, setup.task.problem.satellite[:, 2]), axis=1))
+    pointing, _ = setup.task.evaluation.errors_deg(log)
+    nominal_pointing, _ = nominal_run[1].task.evaluation.errors_deg(nominal_run[0].log)
     floor = nominal_pointing.max()  # the servo's own error, without the IMU's noise
     assert floor < 0.003 and by_hand.min() > 0.1
     np.testing.assert_allclose(pointing, by_hand, rtol=0, atol=floor + 0.002)
     # The run starts tracking what the biased IMU says (the planner's start is the plant's
     # angles): no start transient in the drives.
-    np.testing.assert_array_equal(setup.problem.theta0, log.qpos[0, setup.physics.antenna_qpos])
+    np.testing.assert_array_equal(setup.task.problem.theta0, log.qpos[0, setup.physics.antenna_qpos])
     checks = {c.name: c.value for c in result.checks}
     nominal = {c.name: c.value for c in nominal_run[0].checks}
     assert checks["joint_torque"] == pytest.approx(nominal["joint_torque"], rel=0.1)

@@ -58,6 +58,6 @@ def test_our_controller_steps_at_increasing_times_after_the_start():
 
     setup = scenario.build(params)
     result = runner.run(scenario.name, setup)
-    t = setup.planner.records()["t"]
+    t = setup.components.planner.records()["t"]
     assert t.size > 10 and t[0] > 0.0 and (np.diff(t) > 0).all()
     assert all(c.passed for c in result.checks if c.name == "controller_errors")

@@ -155,8 +155,8 @@ def scenario_run(tmp_path_factory, name: str) -> Written:
     # FAST's cable actuators are re-linearized (or, with the chains, re-sprung) in the run's
     # model every tick: read FAST runs with the compiled model of their cables (the same
     # sensors, sites and leg drives).
-    model = fast_physics._compiled(setup.params.cable_segments) if name.startswith("fast") else None
-    return write(tmp_path_factory, name, setup, setup.duration, lambda: scenario.plan(scenario.params), model)
+    model = fast_physics._compiled(setup.provenance.params.cable_segments) if name.startswith("fast") else None
+    return write(tmp_path_factory, name, setup, setup.task.duration, lambda: scenario.plan(scenario.params), model)
 
 
 def scenario_fixture(name: str):
@@ -348,9 +348,9 @@ def hexapod_sync_driven_async(tmp_path_factory):
     setup = scenarios.get("hexapod-sync-move").build(scenarios.get("hexapod-sync-move").resolve(duration=1.0))
     [problem] = sim_hexapod.problems(scenarios.get("hexapod-sync-move").params)
     plan = hexapod_planner.PaperMovePlanner().plan(dataclasses.replace(problem, synchronous=False))
-    setup.trajectory = plan
-    setup.duration = plan.duration + 1.0
-    return write(tmp_path_factory, "hexapod-sync-driven-async", setup, setup.duration, plan)
+    setup.components.trajectory = plan
+    setup.task.duration = plan.duration + 1.0
+    return write(tmp_path_factory, "hexapod-sync-driven-async", setup, setup.task.duration, plan)
 
 
 @pytest.fixture(params=["hexapod-sync-move", "hexapod-async-move"])
@@ -601,8 +601,8 @@ def fast_observation(tmp_path_factory):
     termination, 4 m/s wind, Stewart on; its observing window is the middle 10 s."""
     plan = fast_sim.observation_plan(10.0)
     setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0))
-    return write(tmp_path_factory, "fast-observation", setup, setup.duration, plan,
-                 fast_physics._compiled(setup.params.cable_segments))
+    return write(tmp_path_factory, "fast-observation", setup, setup.task.duration, plan,
+                 fast_physics._compiled(setup.provenance.params.cable_segments))
 
 
 @pytest.fixture(scope="module")
@@ -610,8 +610,8 @@ def fast_scan(tmp_path_factory):
     """A short motion scan: its observing window is the legs and the transition between."""
     plan = _short_scan_plan()
     setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0, seed=1))
-    return write(tmp_path_factory, "fast-scan", setup, setup.duration, plan,
-                 fast_physics._compiled(setup.params.cable_segments))
+    return write(tmp_path_factory, "fast-scan", setup, setup.task.duration, plan,
+                 fast_physics._compiled(setup.provenance.params.cable_segments))
 
 
 FAST_RUNS = ["fast-tracking", "fast-ra-scan", "fast-source-switch", "fast-observation", "fast-scan"]
@@ -763,7 +763,7 @@ def diverging_loader(tmp_path_factory):
     ``faulty_loader``.)"""
     setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").resolve(duration=0.5))
     setup.physics.model.ptr.opt.gravity[:] = [0.0, 0.0, -1e12]
-    return write(tmp_path_factory, "loader-diverging", setup, setup.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
+    return write(tmp_path_factory, "loader-diverging", setup, setup.task.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
 
 
 FAULT_TICK = 40
@@ -773,7 +773,7 @@ FAULT_TICK = 40
 def faulty_loader(tmp_path_factory):
     """loader-supply with a user's controller that raises at tick FAULT_TICK."""
     setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").resolve(duration=0.5))
-    inner = setup.controller
+    inner = setup.components.controller
 
     class RaisingController:
         def reset(self, context):
@@ -784,8 +784,8 @@ def faulty_loader(tmp_path_factory):
                 raise ZeroDivisionError("gain schedule hit 0")
             inner(tick, observation)
 
-    setup.controller = RaisingController()
-    return write(tmp_path_factory, "loader-faulty", setup, setup.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
+    setup.components.controller = RaisingController()
+    return write(tmp_path_factory, "loader-faulty", setup, setup.task.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
 
 
 def _replayed_warnings(w: Written) -> int:
@@ -898,7 +898,7 @@ def test_planner_and_controller_solve_with_the_paper_weights():
     permuted = _least_norm_rates(ant.jacobian(theta0), omega, np.array([10.0, 5.0, 1.0, 2.0]))
     assert np.abs(permuted - hand).max() > 0.05 * np.abs(hand).max()  # the test can tell
     np.testing.assert_allclose(ant.joint_rates(theta0, omega)[0], hand, rtol=1e-10, atol=1e-14)
-    problem = scenarios.get("antenna-paper-motion").build(scenarios.get("antenna-paper-motion").resolve(duration=0.1)).problem  # what the controller gets
+    problem = scenarios.get("antenna-paper-motion").build(scenarios.get("antenna-paper-motion").resolve(duration=0.1)).task.problem  # what the controller gets
     np.testing.assert_allclose(ant.joint_rates(theta0, omega, problem.weights)[0], hand,
                                rtol=1e-10, atol=1e-14)
 

@@ -115,7 +115,7 @@ def _fake_demo(monkeypatch):
     class Result:
         checks, passed, sim_time_s, wall_time_s = [], True, 0.0, 0.0
 
-    def run(name, setup, quiet):
+    def run(name, setup, quiet, profile=False):
         calls.append(name)
         result = Result()
         result.passed = scenarios.SCENARIOS[name].expect_pass

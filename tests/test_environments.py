@@ -65,10 +65,12 @@ def _conformance_case(name: str):
         for attribute in vars(built.physics):
             if not attribute.startswith("_") and attribute not in vars(fresh.physics):
                 setattr(fresh.physics, attribute, getattr(built.physics, attribute))
-        fresh.sensors, fresh.disturbance, fresh.controller = (copy.deepcopy(built.sensors),
-                                                              copy.deepcopy(built.disturbance),
-                                                              copy.deepcopy(built.controller))
-        return envs.environment(fresh, scenarios.mechanism_of(name).environment_reward(fresh))
+        fresh.task = copy.copy(built.task)  # its initial state and nominal model are shared
+        fresh.task.sensors = copy.deepcopy(built.task.sensors)
+        fresh.task.disturbance = copy.deepcopy(built.task.disturbance)
+        fresh.components = copy.copy(built.components)
+        fresh.components.controller = copy.deepcopy(built.components.controller)
+        return envs.environment(fresh, scenarios.mechanism_of(name).reward(fresh))
 
     attributes = {"make": staticmethod(make)}
     if scenarios.get(name).online_planner:  # the antenna: its four drives' set-point rates
@@ -78,18 +80,37 @@ def _conformance_case(name: str):
 
 @pytest.mark.parametrize("name", list(scenarios.SCENARIOS))
 def test_an_episode_starts_as_a_run_starts(name):
-    """The same sensors and seeding as the runner: the first observation of an episode, and
-    of the next one, equal the observation a run's controller gets at its reset, bit for bit."""
+    """The same reset and seeding as the runner: the first observation of each episode equals
+    the observation a run's controller gets at its reset with that episode's seed, bit for
+    bit, and each episode draws a new seed (dm_control's ``random``)."""
     spec = scenarios.get(name)
-    run_start = runner.start_episode(spec.build(spec.resolve(duration=EPISODE_S, seed=3))).observation
+    setup = spec.build(spec.resolve(duration=EPISODE_S, seed=3))
     env = envs.make(name, duration=EPISODE_S, seed=3)
-    for _ in range(2):
+    seeds = []
+    for _ in range(3):
         observation = env.reset().observation
+        seeds.append(env.task.episode_seed)
+        setup.task.restore_initial_state(setup.physics)
+        run_start = runner.start_episode(setup, seed=seeds[-1]).observation
         for key, value in run_start.items():
             assert np.asarray(value, dtype=float).tobytes() == observation[key].tobytes(), key
         for _ in range(3):
             env.step(np.clip(np.zeros(env.action_spec().shape), env.action_spec().minimum,
                              env.action_spec().maximum))
+    assert len(set(seeds)) == len(seeds), seeds
+
+
+def test_episodes_are_reproducible_from_the_random_state():
+    """Two environments with the same ``random`` draw the same episode seeds; another draws others."""
+    def seeds(random):
+        env = envs.make("loader-supply", random=random, duration=EPISODE_S)
+        out = []
+        for _ in range(2):
+            env.reset()
+            out.append(env.task.episode_seed)
+        return out
+
+    assert seeds(7) == seeds(7) != seeds(8)
 
 
 for _name in scenarios.SCENARIOS:  # every registered scenario, no new test code for a new one

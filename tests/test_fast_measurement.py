@@ -44,12 +44,12 @@ def estimate_errors(result, setup, skip_s: float = 2.0):
     log, physics = result.log, setup.physics
     model = physics.model.ptr
     n = log.t.size - 1  # the last logged state has no sensor call
-    start = int(round(skip_s / setup.control_dt))
+    start = int(round(skip_s / setup.task.control_dt))
     out = {}
     for k, (body, name) in enumerate((("cabin", "cabin"), ("platform", "feed_platform"))):
         adr = model.jnt_qposadr[model.body_jntadr[model.body(name).id]]
         position, quat = log.qpos[start:n, adr:adr + 3], log.qpos[start:n, adr + 3:adr + 7]
-        estimate = setup.sensors.estimate_log[start:n, k]
+        estimate = setup.task.sensors.estimate_log[start:n, k]
         position_error = np.linalg.norm(estimate[:, :3] - position, axis=1)
         attitude_error = (Rotation.from_matrix(estimate[:, 3:].reshape(-1, 3, 3))
                           * Rotation.from_quat(quat[:, [1, 2, 3, 0]]).inv()).magnitude()
@@ -166,23 +166,23 @@ def test_sensor_options_reach_the_run_from_the_scenario_parameters():
     is what the run's sensors use; the ideal system has the earlier observation keys."""
     params = FastTrackingParams(duration=0.5, sensors=SensorOptions(ts_latency_s=0.16))
     setup = build_scenario(params)
-    assert setup.sensors.fix_lag["platform"] == 8  # 20 ms ticks
-    spec = {s.name: s for s in setup.sensors.specs}
+    assert setup.task.sensors.fix_lag["platform"] == 8  # 20 ms ticks
+    spec = {s.name: s for s in setup.task.sensors.specs}
     assert spec["platform_ts"].latency_s == pytest.approx(0.16) and spec["platform_ts"].rate_hz == pytest.approx(50 / 6)
     # The specs give what is simulated: whole ticks (8 Hz is every 6 ticks at 50 Hz, 150 ms is 8).
     at_150 = build_scenario(FastTrackingParams(duration=0.5, sensors=SensorOptions(ts_latency_s=0.15)))
-    assert {s.name: s for s in at_150.sensors.specs}["platform_ts"].latency_s == pytest.approx(0.16)
+    assert {s.name: s for s in at_150.task.sensors.specs}["platform_ts"].latency_s == pytest.approx(0.16)
     at_100_hz = build_scenario(FastTrackingParams(duration=0.5, control_rate_hz=100.0))
-    assert {s.name: s for s in at_100_hz.sensors.specs}["platform_ts"].rate_hz == pytest.approx(100 / 12)
+    assert {s.name: s for s in at_100_hz.task.sensors.specs}["platform_ts"].rate_hz == pytest.approx(100 / 12)
     ideal = build_scenario(FastTrackingParams(duration=0.5, sensors=SensorOptions(system="ideal")))
-    assert {s.name for s in ideal.sensors.specs} >= {"cabin_pose_ts", "cabin_pose"}
+    assert {s.name for s in ideal.task.sensors.specs} >= {"cabin_pose_ts", "cabin_pose"}
     # The ideal system's specs too: its 10 ms stabilizer latency rounds up to one 20 ms tick at
     # 50 Hz (never sooner than the datasheet), one 10 ms tick at 100; GPS/RTK's 50 ms to 60 ms.
-    assert {s.name: s for s in ideal.sensors.specs}["cabin_pose"].latency_s == pytest.approx(0.02)
+    assert {s.name: s for s in ideal.task.sensors.specs}["cabin_pose"].latency_s == pytest.approx(0.02)
     assert spec["cabin_rtk"].latency_s == pytest.approx(0.06)
     ideal_100 = build_scenario(FastTrackingParams(duration=0.5, sensors=SensorOptions(system="ideal"),
                                                   control_rate_hz=100.0))
-    specs = {s.name: s for s in ideal_100.sensors.specs}
+    specs = {s.name: s for s in ideal_100.task.sensors.specs}
     assert specs["cabin_pose"].latency_s == pytest.approx(0.01) and specs["cabin_pose_ts"].latency_s == pytest.approx(0.15)
     assert specs["cabin_pose_ts"].rate_hz == pytest.approx(10.0)
 

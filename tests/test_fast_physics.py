@@ -51,12 +51,12 @@ def test_static_tensions_equal_the_planner(elevation_deg):
     setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0, cable_segments=0, sensors=IDEAL,
                                                      control_rate_hz=100.0))
     result = runner.run("hold", setup)
-    planned = setup.controller.state.tension[-1]
+    planned = setup.components.controller.state.tension[-1]
     measured = -result.log.actuator_force[-1, setup.physics.cable_ids]
     np.testing.assert_allclose(measured, planned, rtol=0.01)
     assert np.abs(measured / planned - 1).max() < 0.002  # in fact within 0.2 %
     if elevation_deg == 50.0:  # the tilt split's point: tensions far from uniform
-        assert np.degrees(setup.controller.state.cabin_tilt[-1]) > 10
+        assert np.degrees(setup.components.controller.state.cabin_tilt[-1]) > 10
         assert planned.max() / planned.min() > 1.5
     assert check(result, "feed_error_max").value < 2.0  # mm: the feed holds still
 
@@ -132,7 +132,7 @@ def test_stabilizer_holds_10_mm_rms_at_4_m_s():
 
 def test_wind_load_matches_the_drag_formula():
     result, setup = observation_run(8.0, False)
-    loads = setup.disturbance
+    loads = setup.task.disturbance
     n = result.log.t.size - 1
     force = np.linalg.norm(loads.force[:n], axis=1)
     # Cabin alone: 1/2 rho Cd D H u^2 at the mean; cables add their normal drag.
@@ -221,7 +221,7 @@ def test_dm_control_environment_with_the_winch_feedforward():
         return np.array(rewards)
 
     held = run(0.0)
-    assert abs(held.size - env.task.setup.trajectory.duration / env.task.setup.control_dt) <= 1  # a step a tick
+    assert abs(held.size - env.task.setup.components.trajectory.duration / env.task.setup.task.control_dt) <= 1  # a step a tick
     assert held.min() > math.exp(-1.0)  # feed error below 10 mm throughout
     assert run(1.0).min() < 0.05  # 1 m of cable paid out: the feed drops by metres
 
@@ -296,12 +296,12 @@ def test_long_runs_write_every_tenth_tick(tmp_path):
     from sims import outputs
 
     plan = fast_sim.observation_plan(200.0)
-    stride = fast_sim.build(plan, fast_sim.FastParams()).output_stride  # 204 s > 120 s: 10 Hz
+    stride = fast_sim.build(plan, fast_sim.FastParams()).output.output_stride  # 204 s > 120 s: 10 Hz
     assert stride == 5 and stride == fast_sim.output_stride(fast_sim.FastParams().control_dt)
-    assert fast_sim.build(plan, fast_sim.FastParams(control_rate_hz=100.0)).output_stride == 10
+    assert fast_sim.build(plan, fast_sim.FastParams(control_rate_hz=100.0)).output.output_stride == 10
     setup = fast_sim.build(plan, fast_sim.FastParams(duration=3.0, control_rate_hz=100.0))
-    assert setup.output_stride == 1
-    setup.output_stride = 10
+    assert setup.output.output_stride == 1
+    setup.output.output_stride = 10
     result = runner.run("stride", setup)
     outputs.write_run(result, setup, tmp_path / "out")
     ts = np.load(tmp_path / "out" / "timeseries.npz")
@@ -330,19 +330,19 @@ def settled_chain(elevation_deg: float, segments: int = SEGMENTS, start_rope: fl
     if start_rope != 1.0:
         planned = data.ctrl[physics.cable_ids].copy()
         data.ctrl[physics.cable_ids] = start_rope * planned
-        setup.disturbance.reset(physics, episode.times, np.random.default_rng(0))
+        setup.task.disturbance.reset(physics, episode.times, np.random.default_rng(0))
         data.ctrl[physics.cable_ids] = planned
     data.ctrl[physics.leg_ids] = 0.0
     damping = model.dof_damping.copy()
     model.dof_damping[:] = np.maximum(damping, 2e3)
     model.dof_damping[:6] = 2e5
     for _ in range(600):
-        setup.disturbance.apply(physics)
+        setup.task.disturbance.apply(physics)
         mujoco.mj_step(model, data, nstep=5)
     model.dof_damping[:] = damping
     data.qvel[:] = 0.0
     mujoco.mj_forward(model, data)
-    setup.disturbance.apply(physics)
+    setup.task.disturbance.apply(physics)
     return setup
 
 
@@ -357,8 +357,8 @@ def test_discretized_cables_confirm_the_lumped_statics(elevation_deg, segments):
     node weights (W / n each) leave it short by the factor 1 - 1 / n^2 of the sag term,
     0.19 m a cable with two segments (240 mm of cabin offset, tried)."""
     setup = settled_chain(elevation_deg, segments)
-    physics, state = setup.physics, setup.controller.state
-    rest = setup.disturbance._rest
+    physics, state = setup.physics, setup.components.controller.state
+    rest = setup.task.disturbance._rest
     weight = fast.FAST.cable_mass_per_length * fast.GRAVITY
     chain = physics.anchor_forces()
     chain[:, 2] -= fast_physics.end_fraction(segments, load=True) * weight * rest * segments
@@ -380,8 +380,8 @@ def test_chains_carry_the_rope_the_winches_pay_out():
     fast-tracking's first observation (the feed-forward-only example, tried)."""
     segments = 2
     setup = settled_chain(90.0, segments, start_rope=0.97)
-    physics, state, model = setup.physics, setup.controller.state, setup.physics.model.ptr
-    rest = setup.disturbance._rest
+    physics, state, model = setup.physics, setup.components.controller.state, setup.physics.model.ptr
+    rest = setup.task.disturbance._rest
     np.testing.assert_allclose(rest * segments, setup.physics.data.ptr.ctrl[physics.cable_ids])
     nodes = model.body_mass[physics.node_bodies]
     np.testing.assert_allclose(nodes, np.broadcast_to((fast_physics.node_mass_factor(segments) *
@@ -462,9 +462,9 @@ def test_the_chains_slow_refresh_changes_nothing_that_is_judged():
     values = []
     for seconds in (fast_physics.ChainCableLoads.GEOMETRY_S, 0.0):
         setup = build_scenario(FastTrackingParams(duration=20.0, wind=8.0, sensors=IDEAL))
-        setup.disturbance.GEOMETRY_S = seconds
+        setup.task.disturbance.GEOMETRY_S = seconds
         values.append({c.name: c.value for c in runner.run("refresh", setup).checks})
-        assert setup.disturbance.geometry_ticks == (5 if seconds else 1)
+        assert setup.task.disturbance.geometry_ticks == (5 if seconds else 1)
     assert values[0].keys() == values[1].keys()
     for name, value in values[1].items():
         assert values[0][name] == pytest.approx(value, rel=1e-3, abs=1e-6), name

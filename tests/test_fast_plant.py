@@ -155,12 +155,12 @@ def test_the_cable_constants_are_the_plant_s_and_the_model_keeps_them_out():
     applied half weights), not in the compiled model."""
     assert changed_fields(fast_physics._compiled(0), plant_model(cable_ea_error=-0.1)) == {}
     _, setup = hold(FastPlant(cable_ea_error=-0.1, cable_mass_error=0.1))
-    loads = setup.disturbance
+    loads = setup.task.disturbance
     assert loads.ea == pytest.approx(1.35e8, rel=1e-15)
     assert loads.mass_per_length == pytest.approx(11.0, rel=1e-15)
     assert loads.weight == pytest.approx(11.0 * GRAVITY, rel=1e-15)
     _, nominal = hold()
-    assert (nominal.disturbance.ea, nominal.disturbance.weight) == (CABLE_EA, CABLE_WEIGHT)
+    assert (nominal.task.disturbance.ea, nominal.task.disturbance.weight) == (CABLE_EA, CABLE_WEIGHT)
 
 
 def test_the_discretized_cables_take_the_plant_s_ea_and_mass():
@@ -174,7 +174,7 @@ def test_the_discretized_cables_take_the_plant_s_ea_and_mass():
                                (fast_physics.node_mass_factor(3) * 11.0 * rest)[:, None] * np.ones((6, 2)), rtol=1e-15)
     np.testing.assert_allclose(model.tendon_stiffness[physics.segment_tendons[:, 1:]],
                                (1.35e8 / rest)[:, None] * np.ones((6, 2)), rtol=1e-15)
-    nominal = setup.nominal_physics().model.ptr
+    nominal = setup.task.nominal_physics().model.ptr
     assert changed_fields(fast_physics._compiled(3), nominal) == {}
 
 
@@ -187,7 +187,7 @@ def test_the_controller_gets_the_nominal_model_and_its_feedforward_stays_nominal
     reference = SPEC.build(params)
     nominal = fast_physics._compiled(params.cable_segments)
     assert changed_fields(nominal, setup.physics.model.ptr)  # the plant is perturbed
-    given = setup.nominal_physics()
+    given = setup.task.nominal_physics()
     assert changed_fields(nominal, given.model.ptr) == {}
     for name in ("qpos", "qvel", "act", "ctrl"):
         np.testing.assert_array_equal(getattr(given.data, name), getattr(reference.physics.data, name))
@@ -201,9 +201,9 @@ def test_the_controller_gets_the_nominal_model_and_its_feedforward_stays_nominal
     # Feed-forward: the winches' stretch and sag at the nominal EA and weight, the nominal
     # tower tops; the A-B rotator's gravity torque of the nominal masses.
     for name in ("l0_ff", "ab_setpoint", "p_platform", "r_platform"):
-        np.testing.assert_array_equal(getattr(setup.controller, name), getattr(reference.controller, name), name)
-    np.testing.assert_array_equal(setup.evaluate.planned_tower_tops, reference.physics.tower_tops)
-    assert setup.plant == FastPlant(**EVERYTHING) and reference.plant == FastPlant()
+        np.testing.assert_array_equal(getattr(setup.components.controller, name), getattr(reference.components.controller, name), name)
+    np.testing.assert_array_equal(setup.task.evaluation.planned_tower_tops, reference.physics.tower_tops)
+    assert setup.provenance.plant == FastPlant(**EVERYTHING) and reference.provenance.plant == FastPlant()
 
 
 # ------------------------------------------------------------------ each perturbation acts as computed by hand

@@ -20,7 +20,7 @@ def short_run():
 
 
 def stroke_check(log, setup):
-    checks, _ = setup.evaluate(log)
+    checks, _ = setup.task.evaluation.evaluate(log)
     return next(c for c in checks if c.name == "stewart_stroke")
 
 

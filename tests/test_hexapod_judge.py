@@ -330,7 +330,7 @@ def test_following_error_leaves_out_the_settling_after_the_last_arrival():
     arrival = calm.metrics["move_duration_s"]
     at = int(round((arrival + 0.3) / DT))
     kicked, setup, _ = run("hexapod-sync-move", controller=KickedAfterArrival(at, 100e-6))
-    ts = setup.timeseries(kicked.log)
+    ts = setup.task.evaluation.timeseries(kicked.log)
     after = kicked.log.t > arrival + 1e-9
     deviation = 1e6 * np.abs(ts["strut_position_actual"] - ts["strut_position_planned"])[after].max()
     assert deviation > 2 * sh.FOLLOWING_LIMIT_UM  # the disturbance is there, after the arrival
@@ -364,8 +364,8 @@ def _wind_run(wind: float, steady: bool):
     setup, _ = build("hexapod-sync-move", controller=sh.HexapodController(integral_time=None),
                      wind=wind, duration=1.5, elevation=45.0)
     recording = None
-    if setup.disturbance is not None:
-        recording = setup.disturbance = _Recording(setup.disturbance, steady)
+    if setup.task.disturbance is not None:
+        recording = setup.task.disturbance = _Recording(setup.task.disturbance, steady)
     result = runner.run("hexapod-sync-move", setup)
     return result, setup, recording
 
@@ -373,7 +373,7 @@ def _wind_run(wind: float, steady: bool):
 def test_the_applied_wind_force_is_the_logged_one_every_tick():
     result, setup, recording = _wind_run(10.0, steady=False)
     applied = np.array(recording.applied)
-    logged = setup.timeseries(result.log)["wind_force"]
+    logged = setup.task.evaluation.timeseries(result.log)["wind_force"]
     assert applied.shape[0] == logged.shape[0] - 1  # no physics after the last tick
     np.testing.assert_array_equal(applied[:, :3], logged[:-1])
     np.testing.assert_array_equal(applied[:, 3:], 0.0)

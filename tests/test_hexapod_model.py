@@ -90,11 +90,13 @@ def _hold(physics, seconds):
     """HexapodController holding the start for ``seconds``, run by the runner."""
     from sims import hexapod as hexapod_sim
     from sims import runner
+    from sims.task import Components, Task
 
     controller = HexapodController()
-    setup = runner.Setup(physics=physics, trajectory=_Still(physics.strut_positions(), seconds),
-                         controller=controller, sensors=hexapod_sim.sensors(physics), problem=None, planner=None,
-                         control_dt=0.005, duration=seconds, evaluate=None, timeseries=None, report=None)
+    task = Task(problem=None, sensors=hexapod_sim.sensors(physics), evaluation=None, control_dt=0.005,
+                duration=seconds)
+    setup = runner.Setup(physics, task, Components(planner=None, trajectory=_Still(physics.strut_positions(), seconds),
+                                                   controller=controller))
     runner.simulate(setup)
     return controller
 

@@ -17,9 +17,9 @@ def run(name, controller=None, trajectory=None, **options):
     scenario = scenarios.get(name)
     setup = scenario.build(scenario.resolve(**options))
     if controller is not None:
-        setup.controller = controller
+        setup.components.controller = controller
     if trajectory is not None:
-        setup.trajectory = trajectory
+        setup.components.trajectory = trajectory
     return runner.run(name, setup), setup
 
 
@@ -41,13 +41,13 @@ def test_checks_hold(name, elevation, wind):
     else:
         assert result.metrics["arrival_spread_s"] > 0.5  # async struts really end apart
     # The run covered the move and the settling time.
-    assert result.sim_time_s >= setup.trajectory.duration + sim_hexapod.SETTLE_S - 1e-9
+    assert result.sim_time_s >= setup.components.trajectory.duration + sim_hexapod.SETTLE_S - 1e-9
     assert result.metrics["loop_closure_um"] < 0.3
 
 
 def test_wind_loads_the_camera_with_its_drag():
     result, setup = run("hexapod-sync-move", elevation=45.0, wind=WIND_M_S)
-    wind = setup.disturbance
+    wind = setup.task.disturbance
     # Wind along world x, camera axis in the y-z plane: the camera shows D x L = 4.95 m^2
     # (to 0.5 %: the move tilts it by ~0.1 deg, showing a sliver of its end).
     area = 1.65 * 3.0

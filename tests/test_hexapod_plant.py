@@ -160,7 +160,7 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start():
     reference = SPEC.build(params)
     nominal = hexapod._compiled(ELEVATION)
     assert changed_fields(nominal, setup.physics.model.ptr)  # the plant is perturbed
-    given_model = setup.nominal_physics()
+    given_model = setup.task.nominal_physics()
     assert changed_fields(nominal, given_model.model.ptr) == {}
     assert given_model.geometry is RUBIN_CAMERA and given_model.encoder_bias is None
     for name in ("qpos", "qvel", "act"):
@@ -175,7 +175,7 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start():
                                rtol=0, atol=1e-12)
     assert setup.physics.loop_closure_error() < 1e-9 and not setup.physics.data.qvel.any()
     assert "unknown" in context.sensors[0].bias
-    assert setup.plant == hexapod.HexapodPlant(**EVERYTHING)
+    assert setup.provenance.plant == hexapod.HexapodPlant(**EVERYTHING)
 
 
 # ------------------------------------------------------------------ the perturbations act
@@ -277,7 +277,7 @@ def test_a_pivot_radius_error_puts_the_platform_where_its_geometry_does(nominal_
     np.testing.assert_allclose(start, by_hand, rtol=2e-3, atol=1e-12)
     # At the end the encoders are at the target's (nominal) strut positions: the plant's pivots
     # put the platform at its forward kinematics of them, and the check judges that true pose.
-    target = setup.problem.target_pose
+    target = setup.task.problem.target_pose
     lengths = hexapod_planner.strut_positions(target) + RUBIN_CAMERA.nominal_lengths
     true_pose, _ = hexapod_planner.forward_kinematics(lengths, geometry, initial=target)
     miss = 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(true_pose) - hexapod_planner.pivot_positions(target),

@@ -83,8 +83,8 @@ def test_same_seed_same_log():
 def test_without_feedforward_tracking_fails():
     """The tracking checks can fail: PD drives alone lag the spline by more than 0.25 deg."""
     setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").params)
-    c = setup.controller
-    setup.controller = ServoFeedforwardController(c.kp, c.kv, feedforward=False)
+    c = setup.components.controller
+    setup.components.controller = ServoFeedforwardController(c.kp, c.kv, feedforward=False)
     result = runner.run("loader-supply", setup)
     assert not checks(result)["tracking_error"].passed
 
@@ -111,12 +111,12 @@ class NaNForce:
 
 def test_divergence_ends_the_run_as_a_failed_check():
     setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").params)
-    setup.disturbance = NaNForce(tick=100)
+    setup.task.disturbance = NaNForce(tick=100)
     result = runner.run("loader-supply", setup)
     c = checks(result)["simulation_warnings"]
     assert not c.passed and not result.passed
     assert "t = 0.5" in c.note or "by t = 0.5" in c.note
-    assert result.log.t[-1] <= 0.5 + runner.SCAN_TICKS * setup.control_dt + 1e-9
+    assert result.log.t[-1] <= 0.5 + runner.SCAN_TICKS * setup.task.control_dt + 1e-9
     assert np.isfinite(result.log.qpos).all() or "non-finite" in c.note
 
 
@@ -163,6 +163,6 @@ def test_shell_tip_sensor_matches_planner_kinematics(supply):
     expected = forward_kinematics(result.log.qpos, ["shell_tip"])["shell_tip"]
     np.testing.assert_allclose(tip[-1], expected[-1], atol=1e-7)
     step = setup.physics.model.opt.timestep
-    tip_speed = np.linalg.norm(np.diff(expected, axis=0), axis=1) / setup.control_dt
+    tip_speed = np.linalg.norm(np.diff(expected, axis=0), axis=1) / setup.task.control_dt
     lag = np.linalg.norm(tip - expected, axis=1)
     assert np.all(lag[1:] <= 1.5 * tip_speed.max() * step + 1e-9)

@@ -136,7 +136,7 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start():
     reference = SPEC.build(params)
     nominal = models.load("loader")
     assert changed_fields(nominal, setup.physics.model.ptr)  # the plant is perturbed
-    given_model = setup.nominal_physics()
+    given_model = setup.task.nominal_physics()
     assert changed_fields(nominal, given_model.model.ptr) == {}
     for name in ("qpos", "qvel", "act"):
         np.testing.assert_array_equal(getattr(given_model.data, name), getattr(reference.physics.data, name))
@@ -145,12 +145,12 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start():
     assert changed_fields(nominal, context.nominal_physics().model.ptr) == {}
     # The plant starts where its encoders read the first key point.
     bias = table1_to_si(np.array(EVERYTHING["encoder_bias"]))
-    q0 = setup.problem.key_points[0]
+    q0 = setup.task.problem.key_points[0]
     np.testing.assert_allclose(setup.physics.joint_positions(), q0 - bias, rtol=0, atol=1e-15)
     np.testing.assert_allclose(context.observation["joint_positions"], q0, rtol=0, atol=1e-15)
     # Its datasheet does not reveal the bias; the record of the run does.
     assert str(EVERYTHING["encoder_bias"][1]) not in context.sensors[0].bias
-    assert setup.plant == loader.LoaderPlant(**EVERYTHING)
+    assert setup.provenance.plant == loader.LoaderPlant(**EVERYTHING)
 
 
 # ------------------------------------------------------------------ the perturbations act
@@ -200,7 +200,7 @@ def test_a_weaker_drive_saturates_at_its_own_limit(nominal_run):
     assert np.abs(nominal.log.actuator_force[:, shoulder]).max() > limit[shoulder]
     checks = {c.name: c for c in weak.checks}
     assert checks["joint_torque"].value > 1.0 and not checks["joint_torque"].passed
-    ratio = np.abs(setup.timeseries(weak.log)["drive_force_demanded"]) / limit
+    ratio = np.abs(setup.task.evaluation.timeseries(weak.log)["drive_force_demanded"]) / limit
     assert checks["joint_torque"].value == pytest.approx(ratio.max(), rel=1e-12)
 
 
@@ -219,7 +219,7 @@ def test_an_encoder_bias_offsets_the_true_joints_by_minus_the_bias(nominal_run):
 
 def test_a_longer_upper_arm_moves_the_shell_tip_the_evaluation_reports():
     result, setup = run(dict(upper_arm_length_error=0.002))
-    q = setup.timeseries(result.log)["q_actual"][-1]
+    q = setup.task.evaluation.timeseries(result.log)["q_actual"][-1]
     theta2 = q[CHAIN.names.index("shoulder")]
     nominal_tip = forward_kinematics(q, ["shell_tip"])["shell_tip"].reshape(3)
     # The same joints put the tip 2 mm further along the upper arm (at theta2 above horizontal).

@@ -12,9 +12,9 @@ from sims import scenarios
 def test_the_mechanisms_are_the_model_folders():
     folders = sorted(p.parent.name for p in models.MODELS_DIR.glob("*/scene.xml"))
     assert list(models.MECHANISMS) == folders == ["antenna", "fast", "hexapod", "loader"]
-    assert [p.__name__ for p in scenarios.mechanisms()] == [f"sims.{n}" for n in folders]
+    assert [m.name for m in scenarios.mechanisms()] == folders
     # every scenario comes from one of them
-    assert {scenarios.mechanism_of(n).__name__ for n in scenarios.SCENARIOS} == {f"sims.{n}" for n in folders}
+    assert {scenarios.mechanism_of(n).name for n in scenarios.SCENARIOS} == set(folders)
 
 
 def test_a_model_folder_without_its_simulation_package_is_named(monkeypatch):

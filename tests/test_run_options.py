@@ -240,8 +240,8 @@ def test_log_estimate_matches_the_arrays_a_run_holds(name, estimate):
     for ticks in (20, 120):
         setup = scenario.build(scenario.resolve(duration=ticks * scenario.control_dt, **extra))
         log = runner.simulate(setup)
-        held.append((log.t.size, _held_bytes(log, setup.controller, setup.sensors, setup.planner, setup.disturbance,
-                                             setup.trajectory)))
+        held.append((log.t.size, _held_bytes(log, setup.components.controller, setup.task.sensors, setup.components.planner, setup.task.disturbance,
+                                             setup.components.trajectory)))
     (n1, b1), (n2, b2) = held
     measured = (b2 - b1) / (n2 - n1)
     assert measured <= estimate(None) <= 1.1 * measured, (measured, estimate(None))

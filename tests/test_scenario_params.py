@@ -123,7 +123,7 @@ def test_any_valid_loader_parameters_build_and_plan(p):
     scenario = scenarios.get("loader-supply")
     assert scenario.plan(p).duration == pytest.approx((len(p.key_points) - 1) * p.key_interval)
     setup = scenario.build(p)
-    np.testing.assert_allclose(setup.physics.joint_positions(), setup.problem.key_points[0], atol=1e-12)
+    np.testing.assert_allclose(setup.physics.joint_positions(), setup.task.problem.key_points[0], atol=1e-12)
     model = setup.physics.model.ptr
     assert model.body_mass[model.body("shell").id] == pytest.approx(p.payload_mass, abs=1e-9)
 
@@ -134,7 +134,7 @@ def test_any_valid_hexapod_parameters_build_and_plan(p):
     scenario = scenarios.get("hexapod-sync-move")
     trajectory = scenario.plan(p)
     setup = scenario.build(p)
-    assert setup.duration == pytest.approx(trajectory.duration + hexapod.SETTLE_S)
+    assert setup.task.duration == pytest.approx(trajectory.duration + hexapod.SETTLE_S)
     np.testing.assert_allclose(setup.physics.poses_from_qpos(setup.physics.data.qpos)[0],
                                hexapod.pose_si(p.start_pose), atol=1e-9)
 
@@ -172,7 +172,7 @@ def test_fast_scans_and_switches_of_other_sizes_plan():
     assert [s.name for s in plan.segments if s.name.startswith("observation")] == [
         "observation (3C 286)", "observation (3C 295)", "observation (3C 286)"]
     setup = scenarios.get("fast-source-switch").build(switch.replace(duration=0.5))
-    assert setup.trajectory.duration == pytest.approx(plan.duration)
+    assert setup.components.trajectory.duration == pytest.approx(plan.duration)
 
 
 # ------------------------------------------------------------------ one bad field: refused by name

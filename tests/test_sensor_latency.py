@@ -56,8 +56,8 @@ class Recording:
 def recorded(name: str) -> Recording:
     spec = scenarios.get(name)
     setup = spec.build(spec.resolve({"duration": RUNS[name]}))
-    recording = Recording(setup.controller, setup.physics)
-    runner.simulate(dataclasses.replace(setup, controller=recording))
+    recording = Recording(setup.components.controller, setup.physics)
+    runner.simulate(dataclasses.replace(setup, components=dataclasses.replace(setup.components, controller=recording)))
     return recording
 
 

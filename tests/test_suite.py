@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from sims import outputs, runner, scenarios
+from sims import outputs, pipeline, runner, scenarios
 from sims.checks import NOT_EVALUATED
 from sims.task import PluginError
 
@@ -121,7 +121,7 @@ class FaultyController:
 @pytest.mark.parametrize("name", NAMES)
 def test_a_controller_fault_ends_the_run_as_a_failed_check(name, fault, fault_tick, tmp_path):
     setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=SHORT_S, seed=1))
-    setup.controller = FaultyController(setup.controller, fault_tick, fault)
+    setup.components.controller = FaultyController(setup.components.controller, fault_tick, fault)
     result = runner.run(name, setup)
     checks = {c.name: c for c in result.checks}
     error = checks["controller_errors"]
@@ -142,7 +142,7 @@ def test_a_nan_first_command_is_bad_input_before_any_step(name):
     """A non-finite command at the first tick is a broken contract, found before MuJoCo
     steps: a PluginError (the CLI's exit 2) naming the actuator, not a run."""
     setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=SHORT_S, seed=1))
-    setup.controller = FaultyController(setup.controller, 0, "nan")
+    setup.components.controller = FaultyController(setup.components.controller, 0, "nan")
     last = setup.physics.model.actuator(setup.physics.model.nu - 1).name
     with pytest.raises(PluginError, match=rf"\({last}\) = nan at t = 0.0000 s, its first command"):
         runner.run(name, setup)
@@ -187,11 +187,11 @@ def test_the_nominal_plant_runs_bit_for_bit_as_without_one(name):
     setup, result = short_run(name, 1)
     params = scenario.resolve(duration=SHORT_S, seed=1)
     for other_setup in (scenario.build(params, plant=type(scenario.plant)()),
-                        api.build(scenario, params, scenario.resolve_plant({}))):
+                        pipeline.build(scenario, params, scenario.resolve_plant({}))):
         other = runner.run(name, other_setup)
         for key in LOGGED:
             np.testing.assert_array_equal(getattr(other.log, key), getattr(result.log, key), err_msg=key)
-        ours, theirs = setup.timeseries(result.log), other_setup.timeseries(other.log)
+        ours, theirs = setup.task.evaluation.timeseries(result.log), other_setup.task.evaluation.timeseries(other.log)
         assert ours.keys() == theirs.keys()
         for key in ours:
             np.testing.assert_array_equal(theirs[key], ours[key], err_msg=key)

@@ -40,7 +40,8 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
-from sims.task import ControlContext, JointEncoders, nominal_copy, RecordingPlanner, Sensors, SensorSpec, check_planner
+from sims.task import (Components, ControlContext, JointEncoders, Output, Provenance, RecordingPlanner, Sensors,
+                       SensorSpec, Task, check_planner, nominal_copy)
 from sims.antenna.ship_motion import (SEA_HS_MAX_M, SEA_TP_RANGE_S, PaperShipMotion, SeaStateMotion, check_sea_state,
                                      world_from_ship)
 from sims.params import ParamError, Params, PlantParams, ScenarioParams, override, param
@@ -553,7 +554,7 @@ class AntennaEvaluation:
         pointing, twist = pointing_errors(self.physics.dish_rotation(log.qpos), self.satellite)
         return np.degrees(pointing), np.degrees(twist)
 
-    def __call__(self, log: RunLog):
+    def evaluate(self, log: RunLog):
         p = self.physics
         pointing, polarization = self.errors_deg(log)
         q, qd = self._joint_log(log)
@@ -767,27 +768,16 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
         description.update({"planner": planner.method, "planner_angular_velocity": planner.omega_method})
     evaluation = AntennaEvaluation(physics, satellite, recorder, drive, pointing_max_deg,
                                    rms_limit_deg, description)
+    task = Task(problem=problem, sensors=AntennaImu(physics, imu, CONTROL_DT, plant if perturbed else None),
+                evaluation=evaluation, control_dt=CONTROL_DT, duration=duration, disturbance=drive,
+                controlled=physics.antenna_actuators,
+                reference_visible=False,  # the ideal path knows the true sea: plots only
+                nominal_physics=nominal_copy(nominal) if perturbed else None)  # None: a copy of physics
     return Setup(
-        physics=physics,
-        trajectory=reference,
-        controller=controller,
-        sensors=AntennaImu(physics, imu, CONTROL_DT, plant if perturbed else None),
-        problem=problem,
-        planner=recorder,
-        controlled=physics.antenna_actuators,
-        reference_visible=False,  # the ideal path knows the true sea: plots only
-        control_dt=CONTROL_DT,
-        duration=duration,
-        evaluate=evaluation,
-        timeseries=evaluation.timeseries,
-        report=evaluation.report,
-        disturbance=drive,
+        physics, task, Components(planner=recorder, trajectory=reference, controller=controller),
         # Time-lapse so the video lasts at most video_length_s.
-        video_speed=max(1.0, duration / video_length_s),
-        seed=seed,
-        params=params,
-        nominal_physics=nominal_copy(nominal) if perturbed else None,  # None: a copy of physics
-        plant=plant if plant is not None else AntennaPlant(),
+        Output(video_speed=max(1.0, duration / video_length_s)),
+        Provenance(seed=seed, params=params, plant=plant if plant is not None else AntennaPlant()),
     )
 
 
@@ -898,7 +888,7 @@ def joint_kinds() -> list[str]:
 
 # ----------------------------------------------------------------------------- registry
 
-from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario  # noqa: E402  (the registry imports this package lazily)
 
 #: Elevation of the satellite above the horizon, deg, below which no run is set up: a
 #: ship's dish does not track lower (the sea, the superstructure and the atmosphere; an
@@ -1098,18 +1088,20 @@ SCENARIOS = (
         control_dt=CONTROL_DT,
         online_planner=True,
         plant=AntennaPlant(),
+        tags=(DEMO, BENCHMARK),
     ),
 )
-#: The scenario ``planbench bench`` times, and how many runs it takes the best of.
-BENCHMARK = ("antenna-sea-state", 5)
 
 
 def environment_reward(setup: Setup):
     """The dm_control reward: exp(-pointing error / 0.1 deg)."""
-    satellite, scale = setup.problem.satellite, np.deg2rad(0.1)
+    satellite, scale = setup.task.problem.satellite, np.deg2rad(0.1)
 
     def reward(physics, tick, adapter):
         pointing, _ = pointing_errors(physics.dish_rotation(physics.data.qpos), satellite)
         return float(np.exp(-pointing[0] / scale))
 
     return reward
+
+
+MECHANISM = Mechanism("antenna", SCENARIOS, environment_reward, benchmark_runs=5)

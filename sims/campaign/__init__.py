@@ -138,9 +138,7 @@ def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
     the rerun's check values must equal the table's (the same parameters and seed)."""
     import numpy as np
 
-    from sims import outputs, runner
-    from sims import plugins as plugin_module
-    from sims.api import build
+    from sims import outputs, pipeline
 
     picked = report.worst_runs(table, k, target.checks())
     rows = {r["run"]: r for r in table.to_pylist() if r["run"] in set(picked)}
@@ -149,15 +147,10 @@ def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
     out = []
     for rank, index in enumerate(picked, start=1):
         params, plant = spec.resolve(by_index[index])
-        made = {role: plugin_module.make(s, role, online_planner=spec.scenario.online_planner)
-                for role, s in spec.plugins.items()}
-        setup = build(spec.scenario, params, plant, **made)
-        result = runner.run(spec.scenario.name, setup, quiet=quiet)
-        result.plugins = dict(spec.plugins)
         folder = target.path / "worst" / f"{rank:02d}-run-{index:06d}"
         directory = outputs.OutputDir(folder, option="--rerun-worst")
-        outputs.write_run(result, setup, directory, video=folder / f"{spec.scenario.name}.mp4",
-                          camera=spec.scenario.camera, quiet=quiet)
+        _, result = pipeline.execute(spec.scenario, params, plant, plugins=spec.plugins, out=directory,
+                                     video=folder / f"{spec.scenario.name}.mp4", quiet=quiet)
         row = rows[index]
         differ = [c.name for c in result.checks
                   if not np.array_equal(np.float64(c.value), np.float64(row.get(f"check.{c.name}", np.nan)),

@@ -111,7 +111,7 @@ def run_chunk(context: Context, tasks: list[RunTask]) -> dict:
         _judge(scenario, resolved, plugin_specs, plugins, meta)
     else:
         for task, row, params, plant in resolved:
-            files[task.index] = _simulate(scenario, context, params, plant, plugin_specs, plugins, row, meta)
+            files[task.index] = _simulate(scenario, context, params, plant, plugin_specs, row, meta)
     return {"rows": rows, "checks": meta, "files": files}
 
 
@@ -162,32 +162,35 @@ def _watchdog(limit_s: float):
         signal.signal(signal.SIGALRM, old)
 
 
-def _simulate(scenario, context, params, plant, plugin_specs, plugins, row, meta) -> dict:
-    """One run in MuJoCo; its row filled in, its files returned."""
-    from sims import api, outputs, runner, supervise
+def _simulate(scenario, context, params, plant, plugin_specs, row, meta) -> dict:
+    """One run in MuJoCo (``sims.pipeline.execute``); its row filled in, its files returned."""
+    from sims import outputs, pipeline, supervise
 
     start = time.perf_counter()
     board = supervise.in_worker()
     limit = context.timeout if context.timeout is not None else supervise.DEFAULT_TIMEOUT_BASE_S
+
+    def follow_duration(setup):
+        if context.timeout is None:  # the default limit follows the simulated duration
+            nonlocal limit
+            limit += setup.task.duration
+            signal.setitimer(signal.ITIMER_REAL, max(1e-3, limit - (time.perf_counter() - start)))
+
     try:
-        with _watchdog(limit):
-            made = {role: plugins.make(spec, role, online_planner=scenario.online_planner)
-                    for role, spec in plugin_specs.items()}
-            setup = api.build(scenario, params, plant, **made)
-            if context.timeout is None:  # the default limit follows the simulated duration
-                limit += setup.duration
-                signal.setitimer(signal.ITIMER_REAL, max(1e-3, limit - (time.perf_counter() - start)))
-            result = runner.run(scenario.name, setup)
-        result.plugins = dict(plugin_specs)
-        if context.save:
-            with tempfile.TemporaryDirectory(prefix="planbench-run-") as tmp:
-                out = Path(tmp) / "run"
+        with contextlib.ExitStack() as stack:
+            out = video = None
+            if context.save:
+                out = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="planbench-run-"))) / "run"
                 video = out / f"{scenario.name}.mp4" if "video" in context.save else None
-                outputs.write_run(result, setup, out, video=video, camera=scenario.camera)
-                files = {p.name: p.read_bytes() for p in out.iterdir()
-                         if p.is_file() and p.name != outputs.MANIFEST}
-        else:
-            files = {"summary.json": (json.dumps(outputs.summary_dict(result), indent=2) + "\n").encode()}
+            with _watchdog(limit):
+                # The run's own time is limited; writing its files (planbench's) is not.
+                _, result = pipeline.execute(scenario, params, plant, plugins=plugin_specs, out=out, video=video,
+                                             on_built=follow_duration,
+                                             on_judged=lambda _: signal.setitimer(signal.ITIMER_REAL, 0))
+            if out is not None:
+                files = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file() and p.name != outputs.MANIFEST}
+            else:
+                files = {"summary.json": (json.dumps(outputs.summary_dict(result), indent=2) + "\n").encode()}
     except RunTimeout:
         row.update(status="error", passed=None, error=f"timed out: the run passed its wall-time limit of "
                    f"{limit:g} s in {board.read_phase()}", wall_s=time.perf_counter() - start, sim_s=None)

@@ -45,7 +45,7 @@ from sims.fast.physics import (CONTROL_DT, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, C
 from sims.fast.measurement import FusedSensors, SensorOptions, estimate_errors, floats_per_tick, make_sensors
 from sims.runner import RunLog, Setup
 from sims.params import ParamError, ScenarioParams, param
-from sims.task import nominal_copy, plan_checked
+from sims.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
 from sims.wind import MEAN_SPEED, SPECTRA, MeasuredWind, WindFileError
 
 #: The built-in catalogue: ICRS (J2000) RA and Dec, rad, of calibrators and pulsars FAST
@@ -364,7 +364,7 @@ class FastEvaluation:
             "observing": observing_mask(self.goal, segment),
         }
 
-    def __call__(self, log: RunLog):
+    def evaluate(self, log: RunLog):
         p = self.physics
         s = self.series(log)
         n = log.t.size
@@ -546,13 +546,11 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     sensors = make_sensors(physics, params.sensors if sensor_options is None else sensor_options, control_dt)
     evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops,
                                 sensors=sensors)
-    return Setup(physics=physics, trajectory=trajectory, controller=controller,
-                 sensors=sensors, problem=session, planner=planner,
-                 control_dt=control_dt, duration=duration, evaluate=evaluation, timeseries=evaluation.timeseries,
-                 report=evaluation.report, disturbance=loads, video_speed=1.0, seed=params.seed, params=params,
-                 output_stride=output_stride(control_dt) if duration > LONG_RUN_S else 1,
-                 nominal_physics=nominal_copy(nominal) if perturbed else None,  # None: a copy of physics
-                 plant=plant if plant is not None else FastPlant())
+    task = Task(problem=session, sensors=sensors, evaluation=evaluation, control_dt=control_dt, duration=duration,
+                disturbance=loads, nominal_physics=nominal_copy(nominal) if perturbed else None)  # None: a copy
+    return Setup(physics, task, Components(planner=planner, trajectory=trajectory, controller=controller),
+                 Output(output_stride=output_stride(control_dt) if duration > LONG_RUN_S else 1),
+                 Provenance(seed=params.seed, params=params, plant=plant if plant is not None else FastPlant()))
 
 
 def goal_plan(params: "FastParams") -> fp.FastPlan:
@@ -585,7 +583,7 @@ def build_scenario(params: "FastParams", planner=None, controller=None, plant: F
 
 # ----------------------------------------------------------------------------- parameters
 
-from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario  # noqa: E402  (the registry imports this package lazily)
 
 _ANGLE = run_limits.ANGLE
 _UTC = dict(unit="UTC", reason="ISO 8601, e.g. 2026-03-01T14:30:00; years 1972-2099, where UTC has its leap seconds")
@@ -748,6 +746,7 @@ SCENARIOS = (
         FastTrackingParams(),
         **_RUN,
         demo_cameras=("closeup",),
+        tags=(DEMO, BENCHMARK),
     ),
     Scenario(
         "fast-ra-scan",
@@ -775,17 +774,17 @@ PLANS = (
         plan_extras=write_figures,
     ),
 )
-#: The scenario ``planbench bench`` times, and how many runs it takes the best of (it
-#: simulates 1330 s in ~40-90 s a run).
-BENCHMARK = ("fast-tracking", 2)
 
 
 def environment_reward(setup: Setup):
     """The dm_control reward: exp(-|feed - its goal path| / 10 mm)."""
-    goal = setup.problem.goal
+    goal = setup.task.problem.goal
 
     def reward(physics, tick, adapter, scale=0.01):
         _, feed, _, _ = goal.feed(np.array([adapter.reference.t[tick]]))
         return float(np.exp(-np.linalg.norm(physics.feed_position() - feed[0]) / scale))
 
     return reward
+
+
+MECHANISM = Mechanism("fast", SCENARIOS, environment_reward, plans=PLANS, benchmark_runs=2)

@@ -39,7 +39,7 @@ from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
 from sims.params import Params, ParamError, PlantParams, ScenarioParams, param
 from sims.plant import set_inertial
-from sims.task import JointEncoders, nominal_copy, plan_checked
+from sims.task import Components, JointEncoders, Output, Provenance, Task, nominal_copy, plan_checked
 from sims.wind import MEAN_SPEED, BodyWindDrag, horizontal_direction
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
@@ -623,7 +623,7 @@ class HexapodEvaluation:
             "reason": None if arrived else self._not_arrived_reason(log, i, arrivals, end),
         }
 
-    def __call__(self, log: RunLog):
+    def evaluate(self, log: RunLog):
         p = self.physics
         ref = log.reference
         q, qd = self._strut_log(log)
@@ -880,7 +880,7 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
     planner returned.
 
     ``plant`` (None: the nominal plant) perturbs the simulated machine only: the planner and
-    the controller keep the nominal model (``Setup.nominal_physics``, at the start pose). The
+    the controller keep the nominal model (``Task.nominal_physics``, at the start pose). The
     plant starts at rest where its encoders read the start pose's strut positions (the
     nominal kinematics'), as a previous move commanded by the same controller would have left
     it: its struts at those minus the encoder bias, its platform wherever its own pivots put
@@ -907,25 +907,14 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
                             WIND_AZIMUTH_DEG)
     evaluation = HexapodEvaluation(physics, moves, starts, durations, wind)
     return Setup(
-        physics=physics,
-        trajectory=trajectory,
-        controller=controller if controller is not None else HexapodController(),
-        sensors=sensors(physics),
-        problem=moves[0] if len(moves) == 1 else tuple(moves),
-        planner=planner if planner is not None else hexapod_planner.PaperMovePlanner(),
-        control_dt=CONTROL_DT,
-        duration=duration,
-        evaluate=evaluation,
-        timeseries=evaluation.timeseries,
-        report=evaluation.report,
-        disturbance=wind,
-        video_speed=1.0,
-        seed=params.seed,
-        nominal_physics=nominal_physics,
-        params=params,
-        plant=plant,
-        video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
-        video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)",
+        physics,
+        Task(problem=moves[0] if len(moves) == 1 else tuple(moves), sensors=sensors(physics), evaluation=evaluation,
+             control_dt=CONTROL_DT, duration=duration, disturbance=wind, nominal_physics=nominal_physics),
+        Components(planner=planner if planner is not None else hexapod_planner.PaperMovePlanner(),
+                   trajectory=trajectory, controller=controller if controller is not None else HexapodController()),
+        Output(video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
+               video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)"),
+        Provenance(seed=params.seed, params=params, plant=plant),
     )
 
 
@@ -935,7 +924,7 @@ def strut_kinds() -> list[str]:
 
 # ----------------------------------------------------------------------------- registry
 
-from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario  # noqa: E402  (the registry imports this package lazily)
 
 _POSE_UNITS = ("mm", "mm", "mm", "deg", "deg", "deg")
 _POSE_LOW = pose_mm_deg(RUBIN_LIMITS.pose_lower)
@@ -1074,6 +1063,7 @@ SCENARIOS = (
         "Rubin camera hexapod, 3 t camera: synchronous move of ~2 mm and 0.1 deg, all six struts arrive on one tick",
         HexapodParams(moves=(HexapodMove(SYNC_TARGET_MM_DEG, True),)),
         **_RUN,
+        tags=(DEMO, BENCHMARK),
     ),
     Scenario(
         "hexapod-async-move",
@@ -1082,12 +1072,13 @@ SCENARIOS = (
         **_RUN,
     ),
 )
-#: The scenario ``planbench bench`` times, and how many runs it takes the best of.
-BENCHMARK = ("hexapod-sync-move", 5)
 
 
 def environment_reward(setup: Setup):
     """The dm_control reward: exp(-max strut tracking error / 10 um)."""
     from sims.envs import joint_tracking_reward
 
-    return joint_tracking_reward(setup.sensors.qpos, 10e-6)
+    return joint_tracking_reward(setup.task.sensors.qpos, 10e-6)
+
+
+MECHANISM = Mechanism("hexapod", SCENARIOS, environment_reward, benchmark_runs=5)

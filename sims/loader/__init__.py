@@ -30,7 +30,7 @@ from sims.controllers import ServoFeedforwardController, demanded_force
 from sims.runner import RunLog, Setup
 from sims.params import PlantParams, ScenarioParams, param
 from sims.plant import set_inertial
-from sims.task import JointEncoders, nominal_copy, plan_checked
+from sims.task import Components, JointEncoders, Provenance, Task, nominal_copy, plan_checked
 
 #: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
 ROBOT_CONTYPE = 1
@@ -234,7 +234,7 @@ class LoaderEvaluation:
         dofs = _joint_dofs(self.physics)
         return log.qpos[:, dofs], log.qvel[:, dofs]
 
-    def __call__(self, log: RunLog):
+    def evaluate(self, log: RunLog):
         model = self.physics.model.ptr
         q, qd = self._joint_log(log)
         ref = log.reference.position
@@ -362,7 +362,7 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
     rest; the checks judge the key points, the obstacles and the drive limits.
 
     ``plant`` (None: the nominal plant) perturbs the simulated machine only: the planner and
-    the controller keep the nominal model (``Setup.nominal_physics``). The plant starts at
+    the controller keep the nominal model (``Task.nominal_physics``). The plant starts at
     rest where its encoders read the first key point, i.e. at key_points[0] - encoder bias
     (the controller sees only the encoders); the checks judge its true joints.
     """
@@ -382,22 +382,12 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
         nominal_physics = nominal_copy(nominal)
     evaluation = LoaderEvaluation(physics, task.key_times, task.key_points, plant)
     return Setup(
-        physics=physics,
-        trajectory=trajectory,
-        controller=reference_controller() if controller is None else controller,
-        sensors=sensors(physics, bias),
-        problem=task,
-        planner=planner,
-        control_dt=CONTROL_DT,
-        duration=duration,
-        evaluate=evaluation,
-        timeseries=evaluation.timeseries,
-        report=evaluation.report,
-        video_speed=1.0,
-        seed=params.seed,
-        nominal_physics=nominal_physics,
-        params=params,
-        plant=plant,
+        physics,
+        Task(problem=task, sensors=sensors(physics, bias), evaluation=evaluation, control_dt=CONTROL_DT,
+             duration=duration, nominal_physics=nominal_physics),
+        Components(planner=planner, trajectory=trajectory,
+                   controller=reference_controller() if controller is None else controller),
+        provenance=Provenance(seed=params.seed, params=params, plant=plant),
     )
 
 
@@ -490,7 +480,7 @@ class LoaderPlant(PlantParams):
 
 # ----------------------------------------------------------------------------- registry
 
-from sims.scenarios import Scenario  # noqa: E402  (the registry imports this package lazily)
+from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario  # noqa: E402  (the registry imports this package lazily)
 
 def judge_plans(params_list, planner=None):
     """The planner checks of each run, no physics (planner-only campaigns; sims/loader/plan_checks.py)."""
@@ -507,6 +497,7 @@ SCENARIOS = (
         "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the breechblock and seat ring",
         LoaderParams(),
         **_RUN,
+        tags=(DEMO, BENCHMARK),
     ),
     Scenario(
         "loader-direct",
@@ -517,12 +508,13 @@ SCENARIOS = (
         **_RUN,
     ),
 )
-#: The scenario ``planbench bench`` times, and how many runs it takes the best of.
-BENCHMARK = ("loader-supply", 5)
 
 
 def environment_reward(setup: Setup):
     """The dm_control reward: exp(-max joint tracking error / 0.1 deg)."""
     from sims.envs import joint_tracking_reward
 
-    return joint_tracking_reward(setup.sensors.qpos, np.deg2rad(0.1))
+    return joint_tracking_reward(setup.task.sensors.qpos, np.deg2rad(0.1))
+
+
+MECHANISM = Mechanism("loader", SCENARIOS, environment_reward, benchmark_runs=5)
