@@ -4,7 +4,8 @@ Code, READMEs, models and examples cite files: documents by name (``REFERENCE.md
 ``README.md``), files by their path from the repository's root (``models/hexapod/README.md``,
 ``sims/hexapod/plan_checks.py``), and sections by a quoted title after the document
 (``REFERENCE.md, "Rubin hexapod"``). Each must exist: a name in the citing file's folder or
-at the root, a path from the root (a ``*`` matches as in a glob), a section as a heading or
+at the root, a path from the root or from the mechanism root holding the citing file
+(tests/mechanisms/*/; a ``*`` matches as in a glob), a section as a heading or
 quoted text of that document. Files of other projects (``constants.py`` of ts_mthexapod)
 are named without a path of this repository and are not checked.
 """
@@ -42,11 +43,16 @@ def _resolve(name: str, citing: Path) -> Path | None:
             if (folder / name).is_file():
                 return folder / name
         return None
-    if "*" in name:
-        matches = sorted(ROOT.glob(name))
-        return matches[0] if matches else None
-    path = ROOT / name.rstrip("/")
-    return path if path.exists() else None
+    # A path from the root, or from the mechanism root that holds the citing file (a root
+    # PLANBENCH_MECHANISMS names has models/, planners/, sims/ of its own: tests/mechanisms/*/).
+    for base in [ROOT, *(p for p in citing.parents if p != ROOT and ROOT in p.parents and (p / "models").is_dir())]:
+        if "*" in name:
+            matches = sorted(base.glob(name))
+            if matches:
+                return matches[0]
+        elif (base / name.rstrip("/")).exists():
+            return base / name.rstrip("/")
+    return None
 
 
 def bad_citations(text: str, citing: Path) -> list[str]:

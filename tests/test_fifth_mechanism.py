@@ -1,8 +1,10 @@
 """A mechanism is its own folders and nothing else.
 
-tests/mechanisms/pendulum/ holds a one-joint pendulum as a user would add a fifth mechanism:
-models/pendulum/ (MJCF and README), planners/pendulum/ (a quintic planner) and sims/pendulum/
-(physics, task, evaluation, scenario, reward, its MECHANISM record). Named by
+tests/mechanisms/pendulum/ holds a one-joint pendulum as a user would add a fifth mechanism,
+three folders under one root: tests/mechanisms/pendulum/models/pendulum/ (MJCF and README),
+tests/mechanisms/pendulum/planners/pendulum/ (a quintic planner) and
+tests/mechanisms/pendulum/sims/pendulum/ (physics, task, evaluation, scenario, reward, its
+MECHANISM record). Named by
 PLANBENCH_MECHANISMS, it is found by its folders alone: ``planbench list``, ``run``, ``plan``,
 ``sweep`` and the dm_control environment reach it, in fresh processes (the registry is read
 once per process). Nothing of it is named anywhere else in the project.
@@ -23,7 +25,7 @@ import models
 
 ROOT = Path(__file__).resolve().parents[1]
 PENDULUM = ROOT / "tests" / "mechanisms" / "pendulum"
-#: m g L of the pendulum's bob (models/pendulum/README.md), N m.
+#: m g L of the pendulum's bob (tests/mechanisms/pendulum/models/pendulum/README.md), N m.
 GRAVITY_TORQUE = 2.0 * 9.81 * 0.5
 
 
