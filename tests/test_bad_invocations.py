@@ -96,7 +96,7 @@ CASES = [
     (["run", "fast-tracking", "--out", "{tmp}/r", "--cable-segments", "x"], ["cable_segments = 'x'", "not an integer"]),
     (["run", "hexapod-sync-move", "--out", "{tmp}/r", "--stewart", "on"], ["unrecognized arguments", "--stewart"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--cable-segments", "4"], ["unrecognized arguments", "--cable-segments"]),
-    # valid numbers that are not a run (issue 12, part 5)
+    # valid numbers that are not a run
     (["run", "fast-tracking", "--out", "{tmp}/r", "--duration", "1e-6"], ["duration = 1e-06 s", "one control tick (20 ms)"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--duration", "0.004"], ["duration = 0.004 s", "one control tick (5 ms)"]),
     (["run", "fast-tracking", "--out", "{tmp}/r", "--duration", "1e12"], ["duration 1e+12 s", "PiB of log", "limit of"]),

@@ -1,6 +1,6 @@
 """Every check value of every scenario, recomputed independently from the written outputs.
 
-A check is only as good as the code computing its value (issue 12, point 7). For each
+A check is only as good as the code computing its value. For each
 registered scenario these tests produce the outputs the public way (the scenario's
 ``build(scenario.resolve(...))``, ``sims.runner.run``, ``sims.outputs.write_run`` into a fresh
 directory), then read back ONLY ``summary.json``, ``timeseries.npz`` and the compiled MuJoCo
@@ -25,7 +25,7 @@ Tolerances (relative unless said otherwise; each assertion states its own):
     < 1e-8 of the tension).
 Every tolerance is at least 1e5 times tighter than the 0.5x / 1.2x mis-scalings these tests
 must catch; each test was shown to fail when its check's value is scaled so in the evaluation
-code (mutation runs on a copy of the tree, issue 12).
+code (mutation runs on a copy of the tree).
 
 Check names per scenario are pinned from actual runs (``CHECKS``): a check added or dropped
 without a recomputation here fails ``test_check_names``.

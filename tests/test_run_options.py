@@ -1,4 +1,4 @@
-"""Run options that are valid numbers but not a run (issue 12, section 5).
+"""Run options that are valid numbers but not a run.
 
 Refused up front, before anything is built or written: a duration under one control tick or
 whose log would not fit in memory (sims.run_limits), sea states outside the range of the
@@ -125,7 +125,7 @@ def test_bad_run_options_exit_2_with_one_line(tmp_path, capsys, args, words):
 
 
 def test_the_cable_segment_limit_is_the_models():
-    """14 at the model's 2 ms timestep (the issue's number), from the one function the run
+    """14 at the model's 2 ms timestep, from the one function the run
     checks its cables with; at half the timestep twice as many."""
     assert max_cable_segments() == 14
     assert max_cable_segments(timestep=0.001) in (28, 29)

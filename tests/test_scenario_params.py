@@ -1,4 +1,4 @@
-"""Scenarios as data (issue 14): typed parameters declared once, scenario files, reruns.
+"""Scenarios as data: typed parameters declared once, scenario files, reruns.
 
 Every scenario's parameters are one sims.params class; these tests hold the declarations to
 what they promise: valid values build and plan, a value outside its range is refused with its
