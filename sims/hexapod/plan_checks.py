@@ -105,8 +105,9 @@ from planners.errors import PlanningError
 from planners.hexapod import POSE_LABELS, RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS, StrutMove
 from planners.trajectory import PiecewiseTrajectory, control_ticks
 from sims.checks import Check
-from sims.hexapod import (ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM, HexapodParams,
-                          arrival_times, hexapod_speed_check, plan_moves, problems, strut_tolerances)
+from sims.hexapod.params import HexapodParams
+from sims.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM, arrival_times,
+                               hexapod_speed_check, plan_moves, problems, strut_tolerances)
 #: Forward kinematics stops for a pose once its largest strut-length residual is below this,
 #: m (0.1 nm: 1e-8 of the smallest pose limit, 1e-4 of the 1 um end-pose limit).
 FK_TOLERANCE_M = 1e-10

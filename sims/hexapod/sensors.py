@@ -1,0 +1,26 @@
+"""The hexapod's sensors: the six strut encoders (``sensors``)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from sims.hexapod.params import CONTROL_DT
+from sims.hexapod.physics import HexapodPhysics
+from sims.task import JointEncoders
+
+
+def sensors(physics: HexapodPhysics) -> JointEncoders:
+    """The hexapod's sensors: the six strut encoders (length change from the zero pose),
+    exact, every tick (Rubin's encoders resolve far below the 1 um check; README.md), with the
+    plant's encoder bias (``physics.encoder_bias``) if it has one."""
+    model = physics.model.ptr
+    acts = [model.actuator(j).actadr[0] for j in range(6)]
+    bias = physics.encoder_bias
+    encoders = JointEncoders(physics.strut_qpos, physics.strut_dofs, acts,
+                             "strut encoders (length change from the zero pose)", "m", CONTROL_DT,
+                             bias=0.0 if bias is None else bias)
+    if bias is not None and bias.any():
+        # The datasheet a controller is given (ControlContext.sensors) cannot state the true
+        # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").
+        encoders.specs[0] = dataclasses.replace(encoders.specs[0], bias="unknown zero offset (plant uncertainty)")
+    return encoders
