@@ -10,9 +10,8 @@ Duration:
   * its log must fit in memory. The runner preallocates the log (``sims.runner.RunLog``:
     t, qpos, qvel, act, ctrl, actuator_force, sensordata, mocap, the reference sampled at
     every tick) and the controllers and disturbances preallocate their own per-tick arrays;
-    each mechanism states those per tick (``log_bytes_per_tick`` in sims/loader/__init__.py,
-    sims/hexapod/__init__.py, sims/antenna/__init__.py, sims/fast/__init__.py;
-    tests/test_run_options.py measures them). A run whose
+    each mechanism states those per tick (its package's ``log_bytes_per_tick``, e.g.
+    ``sims.loader.log_bytes_per_tick``; tests/test_run_options.py measures them). A run whose
     estimate exceeds ``log_memory_limit()``, a quarter of the machine's physical memory, is
     refused: evaluating the checks and writing the outputs needs about as much again as the
     log (measured peaks of 1.2-2.5 times the log), so a quarter leaves the rest of the machine
