@@ -12,182 +12,29 @@ models/loader/README.md "Plant uncertainty").
 
 from __future__ import annotations
 
-import dataclasses
-import functools
-from dataclasses import dataclass
-
-import mujoco
 import numpy as np
-from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import loader as loader_planner
 from planners.loader import forward_kinematics
 from sims import run_limits
 from sims.checks import Check
-from sims.loader.collision import clearance, geoms_by_contype, obstacle_contact_pairs
-from sims.controllers import ServoFeedforwardController, demanded_force
+from sims.controllers import demanded_force
+from sims.loader.collision import clearance, obstacle_contact_pairs
+from sims.loader.controller import reference_controller
+from sims.loader.params import (_BIAS_LIMIT, _BIAS_UNITS, _KEY_HIGH, _KEY_LOW, CONTROL_DT, SETTLE_S, LoaderParams,
+                                LoaderPlant, log_bytes_per_tick)
+from sims.loader.physics import (ARM_BODIES, OBSTACLE_CONTYPE, ROBOT_CONTYPE, LoaderPhysics, _joint_dofs, apply_plant,
+                                 joint_kinds, plant_chain, shell_mass)
+from sims.loader.sensors import sensors
 from sims.runner import RunLog, Setup
-from sims.params import PlantParams, ScenarioParams, param
-from sims.plant import set_inertial
-from sims.task import Components, JointEncoders, Provenance, Task, nominal_copy, plan_checked
-
-#: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
-ROBOT_CONTYPE = 1
-OBSTACLE_CONTYPE = 2
-
-CONTROL_DT = 0.005  # s: 200 Hz motion controller; the drives run at the 0.5 ms physics step
-SETTLE_S = 0.5  # s simulated after the plan ends, so the arrival is seen at rest
+from sims.task import Components, Provenance, Task, nominal_copy, plan_checked
 
 #: Check limits. 0.1 deg at the key points is 3.8 mm at the 2.2 m reach of the shell tip, a
 #: small fraction of the 6 cm by which the planned path clears the obstacles; the run-wide
 #: tracking limit allows 0.25 deg (9.6 mm at the tip) while the arm accelerates.
 KEYPOINT_LIMIT_DEG = 0.1
 TRACKING_LIMIT_DEG = 0.25
-
-
-class LoaderPhysics(dm_mujoco.Physics):
-    """dm_control Physics of models/loader/scene.xml with readable accessors."""
-
-    @classmethod
-    def load(cls, payload_mass: float = None, plant: "LoaderPlant | None" = None) -> "LoaderPhysics":
-        """The scene at its home keyframe; ``payload_mass`` (kg, None: the model's 45 kg) scales
-        the shell's geoms' masses, so its inertia scales with them (same shape and density
-        distribution), edited with MjSpec before compiling. ``plant`` (None: the nominal
-        plant): the true machine, perturbed as ``LoaderPlant`` says (``apply_plant``); its
-        ``payload_mass_error`` makes the shell's true mass payload_mass (1 + error)."""
-        nominal = plant is None or plant.is_nominal
-        if nominal and (payload_mass is None or payload_mass == shell_mass()):
-            physics = cls.from_xml_path(str(models.scene_path("loader")))
-        else:
-            spec = mujoco.MjSpec.from_file(str(models.scene_path("loader")))
-            mass = shell_mass() if payload_mass is None else payload_mass
-            if not nominal:
-                mass = mass * (1.0 + plant.payload_mass_error)
-            factor = mass / shell_mass()
-            if factor != 1.0:
-                for geom in spec.body("shell").find_all(mujoco.mjtObj.mjOBJ_GEOM):
-                    geom.mass = geom.mass * factor
-            if not nominal:
-                apply_plant(spec, plant)
-            physics = cls.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
-        physics.reset(keyframe_id=0)
-        return physics
-
-    def set_start(self, q: np.ndarray) -> None:
-        """Joints and the drives' set-points at ``q`` (theta1 m, theta2 ... theta6 rad), at rest."""
-        self.named.data.qpos[self.joint_names] = q
-        self.named.data.qvel[self.joint_names] = 0.0
-        self.data.act[:] = q
-        self.forward()
-
-    @property
-    def joint_names(self) -> list[str]:
-        return models.loader_spec().names
-
-    def joint_positions(self) -> np.ndarray:
-        """theta1 ... theta6: slide (m) and five angles (rad)."""
-        return self.named.data.qpos[self.joint_names].copy()
-
-    def joint_velocities(self) -> np.ndarray:
-        return self.named.data.qvel[self.joint_names].copy()
-
-    def setpoints(self) -> np.ndarray:
-        """The drives' position set-points (their activations), m and rad."""
-        return self.data.act.copy()
-
-    def actuator_forces(self) -> np.ndarray:
-        """Drive force (N) and torques (N m) after the force-range clamp."""
-        return self.named.data.actuator_force[self.joint_names].copy()
-
-    def shell_tip(self) -> np.ndarray:
-        """World position of the shell's nose, m."""
-        return self.named.data.site_xpos["shell_tip"].copy()
-
-    def shell_tip_log(self, sensordata: np.ndarray) -> np.ndarray:
-        """The ``shell_tip_pos`` sensor's columns of a logged sensordata array, m.
-
-        MuJoCo evaluates sensors before integrating, so after ``mj_step`` they describe the
-        state one physics step (0.5 ms) before the logged qpos.
-        """
-        sensor = self.model.ptr.sensor("shell_tip_pos")
-        return sensordata[:, sensor.adr[0] : sensor.adr[0] + sensor.dim[0]]
-
-    def robot_geoms(self) -> np.ndarray:
-        return geoms_by_contype(self.model.ptr, ROBOT_CONTYPE)
-
-    def obstacle_geoms(self) -> np.ndarray:
-        return geoms_by_contype(self.model.ptr, OBSTACLE_CONTYPE)
-
-
-def joint_kinds() -> list[str]:
-    return [j.kind for j in models.loader_spec().joints]
-
-
-@functools.lru_cache(maxsize=1)
-def shell_mass() -> float:
-    """The model's shell (the payload body ``shell``), kg."""
-    model = models.load("loader")
-    return float(model.body_mass[model.body("shell").id])
-
-
-def _joint_dofs(physics: LoaderPhysics) -> np.ndarray:
-    model = physics.model.ptr
-    return np.array([model.joint(n).dofadr[0] for n in physics.joint_names])
-
-
-#: The arm's links, carriage to gripper: the bodies whose geoms' masses ``arm_mass_error``
-#: scales (the shell is the payload, ``payload_mass_error``).
-ARM_BODIES = ("carriage", "upper_arm", "forearm", "wrist_pitch_link", "wrist_yaw_link", "gripper")
-
-
-def apply_plant(spec: mujoco.MjSpec, plant: "LoaderPlant") -> None:
-    """Edit the loader's MjSpec into the plant ``plant`` (all but the payload's mass, which
-    ``LoaderPhysics.load`` scales). Each edit touches only its own elements:
-
-    * arm_mass_error: the mass and inertia of every body of ``ARM_BODIES`` times (1 + error),
-      its centre of mass and principal axes kept (``sims.plant.set_inertial``);
-    * upper_arm_length_error: the elbow axis (body ``forearm``) moved along the upper arm, m
-      (the beam's geom and mass are left: a bore position error, not another beam);
-    * joint_viscous_friction: each joint's damping (N s/m, N m s/rad) = fraction x its drive's
-      rated force / rated speed, so the friction at rated speed is that fraction of the rating;
-    * drive_force_scale: every drive's force range times the scale;
-    * encoder_bias: the drives close their loop on the biased encoder, so the drive force is
-      kp (set-point - (q + b)) - kv qdot: affine bias term biasprm[0] = -kp b.
-    """
-    chain = models.loader_spec()
-    if plant.arm_mass_error:
-        nominal = models.load("loader")  # the links' inertials as MuJoCo computes them from their geoms
-        for name in ARM_BODIES:
-            set_inertial(spec, nominal, name, 1.0 + plant.arm_mass_error)
-    if plant.upper_arm_length_error:
-        forearm = spec.body("forearm")
-        forearm.pos = np.asarray(forearm.pos) + np.array([plant.upper_arm_length_error, 0.0, 0.0])
-    bias = plant.encoder_bias_si()
-    for j, name in enumerate(chain.names):
-        if plant.joint_viscous_friction:
-            joint = spec.joint(name)
-            damping = np.array(joint.damping)
-            damping[0] = plant.joint_viscous_friction * chain.force_limit[j] / chain.rate_limit[j]
-            joint.damping = damping
-        actuator = spec.actuator(name)
-        if plant.drive_force_scale != 1.0:
-            actuator.forcerange = plant.drive_force_scale * np.asarray(actuator.forcerange)
-        if bias[j]:
-            biasprm = np.array(actuator.biasprm)
-            biasprm[0] = -actuator.gainprm[0] * bias[j]
-            actuator.biasprm = biasprm
-
-
-def plant_chain(plant: "LoaderPlant | None" = None) -> models.SerialChainSpec:
-    """The plant's kinematic chain (``models.loader_spec()`` with its upper-arm length error),
-    for the evaluation's shell tip: the checks judge the true machine."""
-    chain = models.loader_spec()
-    if plant is None or not plant.upper_arm_length_error:
-        return chain
-    bodies = tuple(dataclasses.replace(b, pos=b.pos + np.array([plant.upper_arm_length_error, 0.0, 0.0]))
-                   if b.name == "forearm" else b for b in chain.bodies)
-    return dataclasses.replace(chain, bodies=bodies)
 
 
 class LoaderEvaluation:
@@ -308,40 +155,6 @@ class LoaderEvaluation:
         loader_report(self.timeseries(log), log.t, checks, path)
 
 
-@functools.lru_cache(maxsize=1)
-def log_bytes_per_tick() -> float:
-    """Bytes a loader run preallocates per control tick: the runner's log of the compiled
-    model (6 planned joints) and the servo controller's set-points and feed-forward torques
-    (6 + 6 doubles). The contact list of loader-direct (a few hundred ticks) is left out."""
-    model = models.load("loader")
-    return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6)
-
-
-def sensors(physics: LoaderPhysics, bias=None) -> JointEncoders:
-    """The loader's sensors: the drives' encoders on theta1 ... theta6, exact, every tick
-    (no encoder figures are published for it; an assumption, README.md). ``bias`` (6,) m and
-    rad: the plant's encoder zero offsets (``LoaderPlant.encoder_bias``), added to every
-    reading; None or zeros: none."""
-    model = physics.model.ptr
-    joints = [model.joint(n) for n in physics.joint_names]
-    encoders = JointEncoders([j.qposadr[0] for j in joints], [j.dofadr[0] for j in joints],
-                             [model.actuator(n).actadr[0] for n in physics.joint_names],
-                             "encoders of theta1 (m) ... theta6 (rad)", "m|rad", CONTROL_DT,
-                             bias=0.0 if bias is None else bias)
-    if bias is not None and np.any(bias):
-        # The datasheet a controller is given (ControlContext.sensors) cannot state the true
-        # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").
-        encoders.specs[0] = dataclasses.replace(encoders.specs[0], bias="unknown zero offset (plant uncertainty)")
-    return encoders
-
-
-def reference_controller() -> ServoFeedforwardController:
-    """Our controller: the drives' PD with the nominal model's inverse dynamics as
-    feed-forward (``ServoFeedforwardController``)."""
-    spec = models.loader_spec()
-    return ServoFeedforwardController(spec.kp, spec.kv)
-
-
 def problem(params: "LoaderParams") -> loader_planner.LoaderProblem:
     """The run's planning problem: the key points at uniform times, the model's limits."""
     points = loader_planner.table1_to_si(np.array(params.key_points))
@@ -389,93 +202,6 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
                    controller=reference_controller() if controller is None else controller),
         provenance=Provenance(seed=params.seed, params=params, plant=plant),
     )
-
-
-# ----------------------------------------------------------------------------- parameters
-
-_JOINTS = models.loader_spec()
-#: Each key point column's range in Table 1's units (mm, deg): the model's joint ranges.
-_KEY_LOW = tuple(float(v) for v in loader_planner.si_to_table1(_JOINTS.lower))
-_KEY_HIGH = tuple(float(v) for v in loader_planner.si_to_table1(_JOINTS.upper))
-
-
-@dataclass(frozen=True)
-class LoaderParams(ScenarioParams):
-    """A loader run: key points through the cubic B-spline, the payload, the run's length."""
-
-    key_points: tuple[tuple[float, ...], ...] = param(
-        tuple(tuple(float(v) for v in row) for row in loader_planner.TABLE1),
-        "key points, one row per point: theta1 (mm), theta2 ... theta6 (deg), as Table 1; the "
-        "first is the start pose", unit=("mm", "deg", "deg", "deg", "deg", "deg"), low=_KEY_LOW, high=_KEY_HIGH,
-        reason="the joint ranges of models/loader/loader.xml", length=6, min_items=2, max_items=200)
-    key_interval: float = param(0.5, "time from one key point to the next (uniform, as Table 1)", "s",
-                                low=CONTROL_DT, high=60.0,
-                                reason="at least one control tick; a minute is longer than any loading stroke")
-    settle: float = param(SETTLE_S, "time simulated after the last key point, so the arrival is seen at rest",
-                          "s", low=0.0, high=60.0, reason="the drives settle in well under a second")
-    payload_mass: float = param(45.0, "mass of the shell in the gripper (its inertia scales with it)", "kg",
-                                low=0.0, high=90.0,
-                                reason="none to twice the 45 kg 155 mm shell the drives are sized for "
-                                       "(models/loader/README.md)")
-    duration: float | None = param(None, "simulated time; none: the key points' span plus the settle time",
-                                   "s", low=CONTROL_DT, reason="at least one control tick (5 ms)")
-
-    def check(self) -> None:
-        duration = self.duration if self.duration is not None else \
-            (len(self.key_points) - 1) * self.key_interval + self.settle
-        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
-
-
-#: Each encoder's zero offset range, in Table 1's units (mm, deg).
-_BIAS_UNITS = ("mm", "deg", "deg", "deg", "deg", "deg")
-_BIAS_LIMIT = (1.0, 0.1, 0.1, 0.1, 0.1, 0.1)
-
-
-@dataclass(frozen=True)
-class LoaderPlant(PlantParams):
-    """The loader as built, against its model (plant uncertainty, for campaigns).
-
-    The paper gives no masses, dimensions or drive data: the nominal model's numbers are all
-    assumptions (models/loader/README.md), and so are these ranges; each states its reasoning.
-    The defaults are the nominal plant. The planner and the controller keep the nominal
-    model; ``apply_plant`` edits the plant's MjSpec, the encoders take the bias.
-    """
-
-    payload_mass_error: float = param(
-        0.0, "true shell mass relative to payload_mass (which the controller is told): m = payload_mass (1 + error); "
-        "its inertia scales with it", "fraction", low=-0.1, high=0.1,
-        reason="155 mm HE projectiles weigh 43-47 kg (+-4.4 % of 45 kg, models/loader/README.md); +-10 % "
-               "also covers a fuze or projectile lot the loader was not told of (assumption)")
-    arm_mass_error: float = param(
-        0.0, "mass (and inertia) of every arm link, carriage to gripper, relative to the model's", "fraction",
-        low=-0.05, high=0.05,
-        reason="welded beams and castings come within a few % of their drawing mass; +-5 % assumed (the "
-               "link masses are themselves assumptions, models/loader/README.md)")
-    upper_arm_length_error: float = param(
-        0.0, "error of the upper arm's shoulder-to-elbow axis distance (1.0 m in the model)", "m",
-        low=-0.002, high=0.002,
-        reason="a welded arm whose bores are machined after welding holds +-0.5 mm; +-2 mm allows an "
-               "unmachined weldment (assumption)")
-    joint_viscous_friction: float = param(
-        0.0, "viscous friction of every joint (reducer, bearings, seals): its force/torque at the drive's rated "
-        "speed as a fraction of the drive's rated force/torque; the model has none", "fraction", low=0.0, high=0.1,
-        reason="friction only takes energy (>= 0); servo gearboxes lose 5-10 % at rated speed (efficiency "
-               "90-95 %): up to 10 %, all of it taken as viscous (assumption: no drive data are published)")
-    drive_force_scale: float = param(
-        1.0, "every drive's force/torque limit relative to its rating (models/loader/README.md)", "fraction",
-        low=0.5, high=1.0,
-        reason="a drive delivers at most its rated force; down to half of it when derated (heat, a low DC bus, "
-               "an aged motor); assumption")
-    encoder_bias: tuple[float, ...] = param(
-        (0.0,) * 6, "zero offset of each drive's encoder, theta1 (mm), theta2 ... theta6 (deg): the drive and "
-        "the controller read q + bias", unit=_BIAS_UNITS, low=tuple(-b for b in _BIAS_LIMIT), high=_BIAS_LIMIT,
-        length=6,
-        reason="the joints' zero (mastering) offsets of a calibrated arm, assumed within the 0.1 deg key-point "
-               "limit and 1 mm of the slide's homing; no encoder data are published")
-
-    def encoder_bias_si(self) -> np.ndarray:
-        """(6,) the encoder biases in joint units, m and rad."""
-        return loader_planner.table1_to_si(np.array(self.encoder_bias))
 
 
 # ----------------------------------------------------------------------------- registry
