@@ -1,7 +1,7 @@
 """Planner-only checks of loader runs: the planned joint trajectory judged without physics.
 
 ``judge_plans(params_list)`` builds each run's planning problem as a run does
-(``sims.loader.problem``: the key points at uniform times, the model's joint limits) and
+(``sims.loader.task.problem``: the key points at uniform times, the model's joint limits) and
 returns, per run, the checks that judge the trajectory the paper's planner (the cubic
 B-spline, ``planners.loader.CubicBSplinePlanner``) returns for it. Where a run's check of the
 same name measures the machine (the encoders, the logged poses), the planned quantity's name
@@ -32,7 +32,7 @@ plan_min_clearance   m      > 0                   smallest signed distance betwe
                                                   of the logged poses)
 ===================  =====  ====================  ================================================
 
-Limits are the run's (``sims.loader``) and the model's (``models.loader_spec``), never
+Limits are the run's (``sims.loader.task``) and the model's (``models.loader_spec``), never
 loosened. ``joint_range`` judges as the planner does, with its numbers and its one tolerance,
 ``planners.loader.JOINT_LIMIT_TOLERANCE`` (1e-9 m on the slide, 1e-9 rad on the hinges):
 a key point beyond a limit by no more than it, or the spline between key points (at the
@@ -111,13 +111,15 @@ import numpy as np
 
 import models
 from planners.errors import PlanningError
-from planners.loader import JOINT_LIMIT_TOLERANCE, LoaderProblem
+from planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, LoaderProblem, si_to_table1
 from planners.loader.bspline import CubicBSplineTrajectory
 from planners.trajectory import control_ticks
 from sims.checks import Check
-from sims.loader import (CONTROL_DT, KEYPOINT_LIMIT_DEG, OBSTACLE_CONTYPE, ROBOT_CONTYPE, LoaderParams,
-                         problem)
 from sims.loader.collision import clearance, geoms_by_contype
+from sims.loader.params import CONTROL_DT, LoaderParams
+from sims.loader.physics import OBSTACLE_CONTYPE, ROBOT_CONTYPE
+from sims.loader.task import KEYPOINT_LIMIT_DEG, problem
+from sims.task import plan_checked
 
 #: ``sims.loader.collision.clearance``'s cap: distances beyond it are reported as it, m.
 DISTMAX_M = 0.5
@@ -185,7 +187,7 @@ def _segment_distance(p1, d1, p2, d2, e) -> np.ndarray:
 
 
 class _Collision:
-    """The loader scene's robot and obstacle collision geoms (``sims.loader``'s contypes), and
+    """The loader scene's robot and obstacle collision geoms (``sims.loader.physics``'s contypes), and
     ``clearance`` at many poses with what makes it cheap (module docstring)."""
 
     def __init__(self):
@@ -527,8 +529,6 @@ def range_ratio_of(values: np.ndarray, lower: np.ndarray, upper: np.ndarray, all
 
 def _refusal(task: LoaderProblem) -> str:
     """Why the paper's planner refuses ``task``, or "" (it accepts)."""
-    from planners.loader import CubicBSplinePlanner
-
     try:
         CubicBSplinePlanner().plan(task)
     except PlanningError as e:
@@ -581,8 +581,6 @@ def judge_plans(params_list: Sequence[LoaderParams], planner=None) -> list[list[
     params_list = list(params_list)
     tasks = [problem(p) for p in params_list]
     if planner is not None:
-        from sims.task import plan_checked
-
         return [judge_trajectory(task, plan_checked(planner, task, task.labels)) for task in tasks]
     groups: dict[tuple, list[int]] = {}
     for i, task in enumerate(tasks):
@@ -644,8 +642,6 @@ def random_key_points(n: int, rng: np.random.Generator, keys: int = 6, spread_de
     """``n`` key-point sets (Table 1's units: mm, deg), drawn for the tests: uniform in the
     joint ranges (``spread_deg`` None), or Table 1's points with each value moved by a uniform
     +/- spread_deg (deg; the slide by that many mm times 5), clipped to the ranges."""
-    from planners.loader import TABLE1, si_to_table1
-
     spec = models.loader_spec()
     low, high = si_to_table1(spec.lower), si_to_table1(spec.upper)
     if spread_deg is None:
