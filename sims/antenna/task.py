@@ -44,7 +44,7 @@ ATTITUDE_FRO_LIMIT = 1e-6
 
 
 class ShipMotionTrajectory:
-    """A ship motion (sims.ship_motion) as a Trajectory of the deck joints."""
+    """A ship motion (sims.antenna.ship_motion) as a Trajectory of the deck joints."""
 
     labels = DECK_JOINTS
 
