@@ -1,4 +1,4 @@
-"""The ship antenna in MuJoCo (sims/antenna/__init__.py): short runs of both scenarios, the IMU and
+"""The ship antenna in MuJoCo (sims/antenna/task.py): short runs of both scenarios, the IMU and
 deck against the ship motion, the planner's kinematics against MuJoCo's, the prediction,
 determinism and bad input. The full-length runs belong to ``make demo`` and the benchmark."""
 

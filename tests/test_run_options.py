@@ -263,8 +263,8 @@ def test_build_refuses_a_duration_under_one_tick(name):
 @pytest.mark.parametrize("name, heavy", [
     ("loader-supply", "sims.loader.LoaderPhysics.load"),
     ("hexapod-sync-move", "sims.hexapod.HexapodPhysics.load"),
-    ("antenna-paper-motion", "sims.antenna.ideal_path"),
-    ("antenna-sea-state", "sims.antenna.ideal_path"),
+    ("antenna-paper-motion", "sims.antenna.task.ideal_path"),
+    ("antenna-sea-state", "sims.antenna.task.ideal_path"),
     ("fast-tracking", "sims.fast.FastPhysics.load"),
 ])
 def test_build_checks_before_any_work(monkeypatch, name, heavy):
