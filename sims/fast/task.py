@@ -5,7 +5,9 @@ dm_control reward."""
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -112,10 +114,7 @@ def plan_kinds() -> list[str]:
 def write_figures(plan: fp.FastPlan, out_dir) -> None:
     """figures.png (the paper's Figures 16 and 17: the feed's and one cable's velocity and
     acceleration) and segments.json."""
-    import json
-    from pathlib import Path
-
-    from sims.fast.report import fast_plan_figure
+    from sims.fast.report import fast_plan_figure  # matplotlib: only when figures are written
 
     t = np.arange(0.0, plan.duration, 0.1)
     fast_plan_figure(plan, t, Path(out_dir) / "figures.png")
