@@ -13,8 +13,10 @@ from sims import fast as fast_sim
 from sims import runner
 from sims.fast import physics as fast_physics
 from sims.fast.measurement import SensorOptions
-from sims.fast.physics import (CableLoads, ControllerOptions, FastController, FastPhysics,
-                               tangent_stiffness, winch_feedforward)
+from sims.fast import loads as fast_loads
+from sims.fast.controller import ControllerOptions, FastController, winch_feedforward
+from sims.fast.loads import CableLoads
+from sims.fast.physics import FastPhysics, tangent_stiffness
 
 #: The idealized cabin-pose measurements (the earlier sensors: tests of the statics and of the
 #: chains that want the feed still to a millimetre).
@@ -460,7 +462,7 @@ def test_the_chains_slow_refresh_changes_nothing_that_is_judged():
     from sims.fast import FastTrackingParams, build_scenario
 
     values = []
-    for seconds in (fast_physics.ChainCableLoads.GEOMETRY_S, 0.0):
+    for seconds in (fast_loads.ChainCableLoads.GEOMETRY_S, 0.0):
         setup = build_scenario(FastTrackingParams(duration=20.0, wind=8.0, sensors=IDEAL))
         setup.task.disturbance.GEOMETRY_S = seconds
         values.append({c.name: c.value for c in runner.run("refresh", setup).checks})

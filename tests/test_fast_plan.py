@@ -1,4 +1,4 @@
-"""The FAST plan (planners/fast/plan.py, sims/fast/__init__.py): source switching (section 3.2, eq. 10),
+"""The FAST plan (planners/fast/plan.py, sims/fast/task.py): source switching (section 3.2, eq. 10),
 start and termination (section 3.1), tracking, and a whole plan sampled at 100 Hz."""
 
 import math

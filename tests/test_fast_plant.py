@@ -19,7 +19,8 @@ from plant_model import assert_edits_only
 from planners import fast
 from sims import api, fast as fast_sim, runner, scenarios
 from sims.fast import physics as fast_physics
-from sims.fast.physics import CABIN_BODIES, CABLE_EA, CABLE_WEIGHT, FastPhysics, FastPlant
+from sims.fast.params import CABIN_BODIES, FastPlant
+from sims.fast.physics import CABLE_EA, CABLE_WEIGHT, FastPhysics
 from sims.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -19,7 +19,8 @@ from sims import antenna, fast, hexapod, loader, run_limits, runner, scenarios, 
 from sims.antenna import ship_motion
 from sims.checks import NOT_EVALUATED, Check
 from sims.cli import BadInput, _resolve_source, format_checks, main
-from sims.fast.physics import CableLoads, max_cable_segments
+from sims.fast.loads import CableLoads
+from sims.fast.physics import max_cable_segments
 
 
 def _read(args):

@@ -15,7 +15,7 @@ import numpy as np
 
 from planners import fast
 from planners.fast import plan as fp
-from sims.fast.physics import winch_feedforward
+from sims.fast.controller import winch_feedforward
 
 
 class FeedforwardOnly:

@@ -1,0 +1,269 @@
+"""FAST's plant loads per control tick: the cables' catenary law, their weight and the wind.
+
+* ``CableLoads`` (the runner's disturbance; it is part of the plant, so a user's controller
+  gets it too): each cable's tension from the elastic catenary (parabolic sag) at the current
+  chord length and the winch's unstretched length, linearized into the cable actuator's gain
+  and bias for the tick; half of each cable's weight at its cabin anchor; wind drag on the
+  cabin and on the cables (half of each cable's drag at its anchor). ``ChainCableLoads`` does
+  the same for the discretized cables (``discretized_spec``), whose chains carry sag and
+  weight themselves.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from planners import fast
+from planners.errors import LimitError
+from sims.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICIENT, CABIN_HEIGHT, CABLE_DAMPING_S,
+                               CABLE_EA, NODE_DAMPING_RATIO, SEGMENT_OMEGA_DT_LIMIT, STRING_MODE_HZ, FastPhysics,
+                               cable_drag_force, catenary_tension, chord_factor, end_fraction, max_cable_segments,
+                               moment_sum, node_mass_factor, tangent_stiffness)
+from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
+
+
+class CableLoads:
+    """The cables' physics and the wind, per control tick (the runner's disturbance).
+
+    Per tick, with the winch's unstretched lengths L0 = ``ctrl`` of the cable actuators:
+    the tension T at the current chord (``catenary_tension``, from the last tick's value),
+    the tangent stiffness k and the chord factor g, written into the actuator's affine law so
+    that over the tick force = -(T + k (L' - L) - g k (L0' - L0)) - beta k L'_dot, i.e. the
+    catenary law linearized at the tick's start (the tension changes little in 20 ms); half
+    of each cable's weight at its anchor; with wind: drag on the cabin (its silhouette across
+    the wind at its tilt) and on each cable (the wind's component normal to the chord; half of
+    the cable's drag at its anchor). All as one force and torque on the cabin body
+    (``xfrc_applied``).
+
+    Args:
+      wind_speed: mean wind, m/s (0: none).
+      wind_azimuth_deg: the direction the wind blows toward, deg from +x (east) toward +y.
+      spectrum: "kaimal" or "davenport" (sims.wind).
+      turbulence_intensity: sigma_u / U; None: the spectrum's own (sims.wind.wind_speed_series).
+      measured: a sims.wind.MeasuredWind record instead of the model (its speed, and its
+        direction where it has one), resampled to the ticks.
+      ea, mass_per_length: the true cables' EA (N) and mass per length (kg/m) for the plant's
+        law and loads; default the nominal ones (a perturbed plant's: ``FastPlant``). The
+        controller's feed-forward keeps the nominal ones (``winch_feedforward``).
+    """
+
+    def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal",
+                 turbulence_intensity: float | None = None, measured=None, ea: float = CABLE_EA,
+                 mass_per_length: float = fast.FAST.cable_mass_per_length):
+        self.ea = float(ea)
+        self.mass_per_length = float(mass_per_length)
+        self.weight = self.mass_per_length * fast.GRAVITY  # N/m; CABLE_WEIGHT at the nominal mass
+        self.mean_speed = check_mean_speed(wind_speed) if measured is None else float(np.mean(measured.speed))
+        self.direction = horizontal_direction(wind_azimuth_deg)
+        self.spectrum = spectrum
+        self.turbulence_intensity = turbulence_intensity
+        self.measured = measured
+        self._directions = None
+        self.speed = None
+        self.force = None  # (n, 3) wind force on cabin and cables, N (logged)
+        self.tension = None  # (6,) the catenary tensions of the current tick, N
+        self.tension_log = None  # (n, 6) per tick, before the actuator's force clamp
+
+    def reset(self, physics: FastPhysics, times: np.ndarray, rng: np.random.Generator) -> None:
+        if self.measured is None:
+            self.speed = wind_speed_series(times, self.mean_speed, rng, self.spectrum,
+                                           turbulence_intensity=self.turbulence_intensity)
+        else:
+            self.speed, self._directions = self.measured.resample(times)
+            if self._directions is not None:
+                self.direction = self._directions[0]
+        self.still_air = not np.any(self.speed)  # the speeds are known for the whole run
+        self.force = np.zeros((times.size, 3))
+        self.tension_log = np.zeros((times.size, 6))
+        model, data = physics.model.ptr, physics.data.ptr
+        self._model, self._data = model, data
+        self._cables = physics.cable_ids
+        self._sites = physics.anchor_sites
+        self._towers = physics.tower_tops
+        self._cabin = physics.cabin_body
+        self._xfrc = data.xfrc_applied[self._cabin]
+        mujoco.mj_forward(model, data)
+        chord, span, _ = self._geometry()
+        self.tension = catenary_tension(chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60,
+                                        ea=self.ea, weight=self.weight)
+        self.apply(physics)
+
+    def _geometry(self):
+        data = self._data
+        vectors = data.site_xpos[self._sites] - self._towers
+        chord = np.sqrt(np.einsum("ij,ij->i", vectors, vectors))
+        span = np.hypot(vectors[:, 0], vectors[:, 1])
+        return chord, span, vectors
+
+    def apply(self, physics, tick: int | None = None) -> None:
+        """Update the cable laws and the loads for the coming tick (``tick`` None: no wind,
+        nothing logged)."""
+        model, data = self._model, self._data
+        chord, span, vectors = self._geometry()
+        l0 = data.ctrl[self._cables]
+        # One Newton step from the last tick's tension: it moves by a fraction of a percent in
+        # 10 ms, and Newton's error squares (the tests compare with the converged solution).
+        t = catenary_tension(chord, l0, span, self.tension, iterations=1, ea=self.ea, weight=self.weight)
+        self.tension = t
+        if tick is not None:
+            self.tension_log[tick] = t
+        k = tangent_stiffness(t, span, l0, self.ea, self.weight)
+        g = chord_factor(t, span, self.ea, self.weight)
+        ids = self._cables
+        model.actuator_gainprm[ids, 0] = g * k
+        model.actuator_biasprm[ids, 0] = -t + k * chord - g * k * l0
+        model.actuator_biasprm[ids, 1] = -k
+        model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
+        anchor_force = np.zeros((6, 3))
+        anchor_force[:, 2] = -0.5 * self.weight * chord
+        com = data.xipos[self._cabin]
+        arms = data.site_xpos[self._sites] - com
+        u = 0.0 if tick is None else float(self.speed[tick])
+        force, torque = np.zeros(3), np.zeros(3)
+        if u != 0.0:
+            # Cables: the normal component of the wind on each chord, half the drag at the anchor.
+            cable_drag = cable_drag_force(u * self.direction, vectors, 0.5 * chord)
+            force, torque = self._cabin_drag(u)
+            self.force[tick] = cable_drag.sum(axis=0) + force
+            anchor_force += cable_drag
+        self._xfrc[:3] = anchor_force.sum(axis=0) + force
+        self._xfrc[3:] = moment_sum(arms, anchor_force) + torque
+
+    def _cabin_drag(self, u: float):
+        """(force (3,), torque (3,) about the cabin body's centre of mass) of the wind speed
+        ``u`` on the cabin: a cylinder of its size along its z axis, drag at the shell's centre."""
+        data = self._data
+        rotation = data.xmat[self._cabin].reshape(3, 3)
+        cos_t = min(abs(float(rotation[:, 2] @ self.direction)), 1.0)
+        area = CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + \
+            math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
+        drag = 0.5 * AIR_DENSITY * CABIN_DRAG_COEFFICIENT * area * abs(u) * u * self.direction
+        centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE - data.xipos[self._cabin]
+        return drag, moment_sum(centre[None], drag[None])
+
+    def __call__(self, tick: int, physics) -> None:
+        if self._directions is not None:
+            self.direction = self._directions[tick]
+        self.apply(physics, tick)
+
+
+class ChainCableLoads(CableLoads):
+    """The plant's loads with the discretized cables (``FastPhysics.load(cable_segments=n)``).
+
+    The chain carries sag, cable weight and cable inertia itself; per tick this shares the
+    winch command L0 (``ctrl``) among the segments: rest length l = L0 / n, stiffness EA / l
+    and damping beta EA / l for the springs, and the winch segment's law force =
+    (EA / l) (L0 / n - L1) - beta (EA / l) L1'; gives the nodes and ends the mass of the rope
+    paid out (``_set_masses``); puts the half segment that ends at the cabin
+    anchor (its weight) on the cabin; and applies the wind: on the cabin, and on every node half
+    of each neighbouring segment's normal drag (half the last segment on the cabin).
+    """
+
+    def reset(self, physics: FastPhysics, times: np.ndarray, rng: np.random.Generator) -> None:
+        n = physics.cable_segments
+        self._n = n
+        self._nodes = physics.node_bodies
+        self._segments = physics.segment_tendons
+        self._node_ids = self._nodes.ravel()
+        self._first = self._segments[:, 0]
+        self._passive = self._segments[:, 1:].ravel()
+        self._passive_cable = np.repeat(np.arange(self._segments.shape[0]), n - 1)  # each passive segment's cable
+        model, data = physics.model.ptr, physics.data.ptr
+        rest = data.ctrl[physics.cable_ids] / n
+        # A segment's axial mode, 2 sqrt(EA / mu) / l rad/s, must stay slow for the timestep
+        # (the springs are explicit): ``max_cable_segments`` at this run's cables.
+        most = max_cable_segments(float(rest.min()) * n, float(model.opt.timestep), self.ea, self.mass_per_length)
+        if n > most:
+            omega = 2.0 * math.sqrt(self.ea / self.mass_per_length) / rest.min()
+            raise LimitError(f"cable segments {n}: the shortest segment ({rest.min():.1f} m) vibrates at "
+                             f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
+                             f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most "
+                             f"{most} segments")
+        self._anchor_masses = np.array([model.body(f"anchor_mass{i + 1}").id for i in range(3)])
+        self._node_dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)  # (6, n - 1, 3)
+        self.settling_damping = np.zeros(self._node_dofs.shape)  # N s/m on the nodes (static_equilibrium's)
+        tick = float(times[1] - times[0]) if times.size > 1 else self.GEOMETRY_S
+        self.geometry_ticks = max(1, int(round(self.GEOMETRY_S / tick)))
+        super().reset(physics, times, rng)
+
+    def _set_masses(self, rest: np.ndarray) -> None:
+        """The rope between tower and cabin is the winch's unstretched length L0 = n l (rest:
+        (6,) l): the nodes' masses (and so their weights, through their fixed gravcomp) and
+        their damping, and the ends' share at the anchors (two cables each, gravity-compensated),
+        follow it as the winches pay out (a few per cent of L0 over a switch; held at the
+        start's, they left the cabin 40 mm from where the catenary law puts it, tested). MuJoCo's dynamics
+        read body_mass every step (body_subtreemass stays the compiled one: it only moves the
+        reference point of the trees' spatial quantities, which the dynamics do not depend on)."""
+        model, n = self._model, self._n
+        mass = node_mass_factor(n) * self.mass_per_length * rest  # (6,)
+        model.body_mass[self._nodes] = mass[:, None]
+        model.dof_damping[self._node_dofs] = ((2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[:, None, None]
+                                              + self.settling_damping)
+        ends = end_fraction(n, load=False) * self.mass_per_length * rest * n
+        model.body_mass[self._anchor_masses] = ends[0::2] + ends[1::2]
+
+    #: Seconds between refreshes of what changes slowly: the springs' stiffness EA / l (l =
+    #: L0 / n moves by under 1.3e-4 of itself in 0.1 s at the winches' 0.4 m/s), the
+    #: directions of the segments and the cabin's tilt that shape the drag (under 1.2e-4 rad
+    #: in 0.1 s), the end weights' moment, and the rope's mass and weight on the nodes and
+    #: ends (``_set_masses``); a whole number of ticks, at least one. The
+    #: rest lengths (the rope paying through) and the wind's speed act every tick.
+    #: tests/test_fast_physics.py compares with refreshing every tick.
+    GEOMETRY_S = 0.1
+
+    def apply(self, physics, tick: int | None = None) -> None:
+        model, data = self._model, self._data
+        ids = self._cables
+        self._rest = rest = data.ctrl[ids] * (1.0 / self._n)  # (6,) every segment's unstretched length
+        refresh = tick is None or tick % self.geometry_ticks == 0 or self._directions is not None
+        if refresh:
+            self._refresh(rest)
+        # The winch's segment: force = (k / n) L0 - k L1 - beta k L1' (k frozen between
+        # refreshes, so L0 itself moves its rest length); the others: springs of rest l.
+        model.tendon_lengthspring[self._passive] = rest[self._passive_cable, None]
+        self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
+        if tick is not None:
+            self.tension_log[tick] = self.tension
+        u = 0.0 if tick is None else float(self.speed[tick])
+        scale = u * abs(u)  # drag goes with u |u|
+        if u != 0.0:
+            np.multiply(self._node_drag, scale, out=self._node_force)
+            data.xfrc_applied[self._node_ids, :3] = self._node_force
+            self.force[tick] = scale * self._total_drag
+        np.add(self._static_wrench, scale * self._drag_wrench, out=self._xfrc)
+
+    def _refresh(self, rest: np.ndarray) -> None:
+        """The slowly changing parts (GEOMETRY_S): the springs' stiffness and damping, the
+        end weights' force and moment on the cabin, and the drag per unit of u |u| on every
+        node, on the cabin and in all."""
+        model, data = self._model, self._data
+        ids, n = self._cables, self._n
+        self._k = k = self.ea / np.maximum(rest, 1e-3)
+        self._set_masses(rest)
+        model.actuator_gainprm[ids, 0] = k / n
+        model.actuator_biasprm[ids, 0] = 0.0
+        model.actuator_biasprm[ids, 1] = -k
+        model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
+        model.tendon_stiffness[self._passive] = k[self._passive_cable]
+        model.tendon_damping[self._passive] = CABLE_DAMPING_S * k[self._passive_cable]
+        anchors = data.site_xpos[self._sites]
+        arms = anchors - data.xipos[self._cabin]
+        weight = np.zeros((6, 3))
+        weight[:, 2] = -end_fraction(n, load=True) * self.weight * rest * n
+        self._static_wrench = np.concatenate([weight.sum(axis=0), moment_sum(arms, weight)])
+        if self.still_air:
+            self._drag_wrench = np.zeros(6)
+            return
+        nodes = data.xpos[self._nodes]  # (6, n - 1, 3)
+        points = np.concatenate([self._towers[:, None], nodes, anchors[:, None]], axis=1)
+        pieces = np.diff(points, axis=1)  # (6, n, 3) segment vectors
+        drag = cable_drag_force(self.direction, pieces.reshape(-1, 3), np.repeat(rest, n)).reshape(6, n, 3)
+        self._node_drag = (0.5 * (drag[:, :-1] + drag[:, 1:])).reshape(-1, 3)  # half of each neighbour
+        self._node_force = np.empty_like(self._node_drag)
+        anchor = 0.5 * drag[:, -1]
+        cabin_force, cabin_torque = self._cabin_drag(1.0)
+        self._drag_wrench = np.concatenate([anchor.sum(axis=0) + cabin_force, moment_sum(arms, anchor) + cabin_torque])
+        self._total_drag = drag.sum(axis=(0, 1)) - 0.5 * drag[:, 0].sum(axis=0) + cabin_force
