@@ -283,6 +283,11 @@ class FastPhysics(dm_mujoco.Physics):
         return self._ids("actuator", CABLE_ACTUATORS)
 
     @functools.cached_property
+    def chord_tendon_ids(self) -> np.ndarray:
+        """The six chord tendons, tower top to cabin anchor (named as their cables)."""
+        return self._ids("tendon", CABLE_ACTUATORS)
+
+    @functools.cached_property
     def ab_ids(self) -> np.ndarray:
         return self._ids("actuator", AB_ACTUATORS)
 
@@ -373,7 +378,7 @@ class FastPhysics(dm_mujoco.Physics):
 
     def cable_lengths(self) -> np.ndarray:
         """(6,) chord lengths tower top to cabin anchor, m (MuJoCo's spatial tendons)."""
-        return self.data.ptr.ten_length[:6].copy()
+        return self.data.ptr.ten_length[self.chord_tendon_ids]
 
     def cabin_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """(origin (3,), rotation (3, 3)) of the cabin frame in the world."""
