@@ -171,16 +171,17 @@ def test_dm_control_environment_with_an_imu_driven_controller():
         step = env.step(np.clip((target - observation["setpoints"]) / period, spec.minimum, spec.maximum))
         rewards.append(step.reward)
     assert len(rewards) == 400
-    # This controller lags one IMU period and takes the IMU's noise as it comes: over episodes
-    # of other noise draws its largest pointing error is 0.15-0.21 deg (the reward's scale is
-    # 0.1 deg); idle, the ship carries the dish past 0.46 deg.
-    assert min(rewards) > np.exp(-2.5)  # pointing error below 0.25 deg throughout
     step = env.reset()
     idle = []
     while not step.last():
         step = env.step(np.zeros(4))
         idle.append(step.reward)
-    assert min(idle) < 0.01
+    # The reward is exp(-pointing error / 0.1 deg). Idle, the ship carries the dish 3.9 deg off
+    # the satellite; this controller (one IMU period of lag, the IMU's noise as it comes) keeps
+    # it within 0.15-0.21 deg over episodes of other noise draws: it removes at least 90 % of
+    # the error the ship's motion causes.
+    held, drifted = (-0.1 * np.log(np.array(r)) for r in (rewards, idle))
+    assert drifted.max() > 2.0 and held.max() < 0.1 * drifted.max()
 
 
 def test_a_half_turn_to_the_start_attitude_plans():

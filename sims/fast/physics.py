@@ -20,6 +20,7 @@ from __future__ import annotations
 import copy
 import functools
 import math
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -29,6 +30,9 @@ import models
 from planners import fast
 from planners.rotations import wxyz
 from sims.wind import AIR_DENSITY
+
+if TYPE_CHECKING:  # annotations only: sims/fast/params.py imports this module
+    from sims.fast.params import FastPlant
 
 #: s: the default control period (50 Hz; FastParams.control_rate_hz). FAST's own rates are not
 #: public; 50 Hz samples the 0.17-0.6 Hz cabin modes and the stabilizer's 2 Hz loop 25-80

@@ -25,27 +25,33 @@ class SwingProblem:
 
 @dataclass(frozen=True)
 class QuinticSwing:
-    """The planned swing (a Trajectory): held at the goal after ``duration``."""
+    """The planned swing of ``problem`` (a Trajectory): held at the goal after ``duration``."""
 
-    start: float
-    goal: float
-    duration: float
-    labels: tuple = ("swing",)
+    problem: SwingProblem
+
+    @property
+    def duration(self) -> float:
+        return float(self.problem.move_time)
+
+    @property
+    def labels(self) -> tuple:
+        return tuple(self.problem.labels)
 
     def sample(self, t) -> TrajectorySample:
         t = sample_times(t)
-        tau = np.clip(t / self.duration, 0.0, 1.0)
-        inside = (t > 0.0) & (t < self.duration)
-        span, T = self.goal - self.start, self.duration
+        T, start = self.duration, float(self.problem.start)
+        span = float(self.problem.goal) - start
+        tau = np.clip(t / T, 0.0, 1.0)
+        inside = (t > 0.0) & (t < T)
         s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
         ds = np.where(inside, 30.0 * tau**2 * (1.0 - tau) ** 2 / T, 0.0)
         dds = np.where(inside, 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / T**2, 0.0)
         column = lambda x: np.asarray(x, dtype=float).reshape(-1, 1)
-        return TrajectorySample(t, column(self.start + span * s), column(span * ds), column(span * dds))
+        return TrajectorySample(t, column(start + span * s), column(span * ds), column(span * dds))
 
 
 class QuinticPlanner:
     """plan(problem) -> the quintic rest-to-rest swing of ``problem``."""
 
     def plan(self, problem: SwingProblem) -> QuinticSwing:
-        return QuinticSwing(float(problem.start), float(problem.goal), float(problem.move_time), tuple(problem.labels))
+        return QuinticSwing(problem)
