@@ -28,10 +28,11 @@ class ServoFeedforwardController:
     With an integral time T_i, ``z <- z + dt / T_i (q_ref - q)`` each tick, limited so
     ``kp z`` stays inside the force limit.
 
-    It drives the first ``nu`` actuators of its command (``ControlContext.actuators``, found
-    in the model by name; ``nu`` = the reference's channels), which must be the ones its
-    trajectory's channels name (checked in ``reset``), and reads the task's observation (``sims.task``): ``joint_positions`` (the encoders, for
-    the integral action) and ``setpoints`` (the drives' set-points), in that order.
+    It drives every actuator of its command (``ControlContext.actuators``, found in the model
+    by name), one per channel of its reference: the trajectory's channels must be those
+    actuators, in that order (checked in ``reset``). It reads the task's observation
+    (``sims.task``): ``joint_positions`` (the encoders, for the integral action) and
+    ``setpoints`` (the drives' set-points), in that order.
 
     Args:
       kp, kv: (nu,) drive gains as in the MJCF (N/m or N m/rad; N s/m or N m s/rad); None:
@@ -92,11 +93,12 @@ class ServoFeedforwardController:
         reference = context.reference
         model = context.model
         nu = reference.position.shape[1]
+        actuators = tuple(context.actuators)
         labels = getattr(context.trajectory, "labels", None)
-        if labels is not None and tuple(labels) != tuple(context.actuators[:nu]):
-            raise ValueError(f"the trajectory's channels {tuple(labels)} are not the first {nu} actuators "
-                             f"{tuple(context.actuators[:nu])}")
-        self.actuator_ids = ids = np.array([model.actuator(name).id for name in context.actuators[:nu]])
+        if nu != len(actuators) or (labels is not None and tuple(labels) != actuators):
+            channels = tuple(labels) if labels is not None else f"{nu} unnamed channels"
+            raise ValueError(f"the trajectory's channels {channels} are not the commanded actuators {actuators}")
+        self.actuator_ids = ids = np.array([model.actuator(name).id for name in actuators])
         if self.kp is None:
             self.kp = model.actuator_gainprm[ids, 0].copy()
         if self.kv is None:
@@ -110,8 +112,8 @@ class ServoFeedforwardController:
         self.z = np.zeros(nu)
         self._gain = 0.0 if self.integral_time is None else context.control_dt / self.integral_time
         self._inv_dt = 1.0 / context.control_dt
-        self._command = context.command[:nu]  # a view: written in place every tick
-        context.setpoint[:nu] = self.setpoints[0]
+        self._command = context.command  # written in place every tick
+        context.setpoint[:] = self.setpoints[0]
 
     def __call__(self, tick: int, observation) -> None:
         target = self.setpoints[min(tick + 1, self.setpoints.shape[0] - 1)]

@@ -3,7 +3,8 @@
 The adapter (``TaskAdapter``) is the runner's loop with the agent in the controller's place:
 each episode starts from the task's initial state (``sims.task.Task``: its
 ``initialize_episode``, the sensors and the disturbance seeded from a fresh seed drawn from the
-adapter's ``random``, as dm_control's suite tasks draw theirs), and each action is one control
+adapter's ``random``, as dm_control's suite tasks draw theirs; a disturbance whose random state
+sets the start, the antenna's sea, draws a new sea and its start from it), and each action is one control
 tick as the runner takes it: the task's disturbance (``Task.before_step``), ``steps_per_tick``
 physics steps with ``mj_step`` (MuJoCo's own step, not dm_control's legacy one, as in the
 runner), then the sensors (``Task.observe``). The action is the commands of the actuators a
@@ -71,10 +72,12 @@ class TaskAdapter(base.Task):
     def initialize_episode(self, physics):
         task = self._setup.task
         task.restore_initial_state(physics)
-        self.episode_seed = int(self.random.randint(SEED_RANGE))
-        self._observation = task.initialize_episode(physics, self._times, self.episode_seed)
         physics.data.act[self._act_adr] = self._setpoint
         mujoco.mj_forward(physics.model.ptr, physics.data.ptr)
+        self.episode_seed = int(self.random.randint(SEED_RANGE))
+        # After the set-points: a task with a random start (the antenna's sea) puts the
+        # drives at the start it draws.
+        self._observation = task.initialize_episode(physics, self._times, self.episode_seed)
         self.tick = 0
         task.observe(0, physics)  # the runner's first tick reads the sensors before the controller
 

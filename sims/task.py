@@ -187,7 +187,13 @@ class JointEncoders(Sensors):
 @runtime_checkable
 class Disturbance(Protocol):
     """Wind, ship motion, payload forces...: applied once per control tick. Part of the
-    plant, so it may read and write the physics."""
+    plant, so it may read and write the physics.
+
+    A disturbance whose random state sets where an episode starts (the antenna's sea: the
+    deck and the antenna start where the sea puts them) also has ``draw_start(physics,
+    seed)``: it puts the physics at the start drawn from ``seed``, before the sensors and the
+    disturbance reset, and leaves the task's initial state as it is for the seed the task
+    was built with."""
 
     def reset(self, physics, times: np.ndarray, rng: np.random.Generator) -> None: ...
 
@@ -270,8 +276,12 @@ class Task:
         return control_ticks(self.duration, self.control_dt)
 
     def initialize_episode(self, physics, times: np.ndarray, seed: int) -> dict:
-        """Start an episode from the physics' present state: the sensors and the disturbance
-        reset, seeded from ``seed``; returns the observation at t = 0."""
+        """Start an episode from the physics' present state (or, for a disturbance with a
+        random start, from the state it draws from ``seed``): the sensors and the disturbance reset,
+        seeded from ``seed``; returns the observation at t = 0."""
+        draw_start = getattr(self.disturbance, "draw_start", None)
+        if draw_start is not None:
+            draw_start(physics, seed)
         observation = self.sensors.reset(physics, times, seed)
         if self.disturbance is not None:
             self.disturbance.reset(physics, times, np.random.default_rng(seed))

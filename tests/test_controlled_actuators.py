@@ -101,3 +101,25 @@ def test_the_servo_controller_finds_its_drives_by_name():
     assert min(ids) == 4
     np.testing.assert_array_equal(servo.kp, model.actuator_gainprm[ids, 0])
     np.testing.assert_array_equal(servo.force_limit, model.actuator_forcerange[ids, 1])
+
+
+@pytest.mark.parametrize("channels", [4, 3])
+def test_the_servo_controller_refuses_a_reference_that_is_not_its_command(channels):
+    """The reference's channels are the command's actuators one for one: a reordered or short
+    trajectory is refused by name in reset, not driven onto the wrong joints."""
+    from types import SimpleNamespace
+
+    from planners.trajectory import TrajectorySample
+    from sims.controllers import ServoFeedforwardController
+    from sims.task import ControlContext
+
+    setup = build("antenna-paper-motion", None)
+    n = 3
+    reference = TrajectorySample(np.arange(n) * 0.005, *(np.zeros((n, channels)),) * 3)
+    labels = tuple(reversed(JOINT_LABELS))[:channels]
+    context = ControlContext(model=setup.physics.model.ptr, nominal_physics=lambda: setup.physics, problem=None,
+                             trajectory=SimpleNamespace(labels=labels), reference=reference, control_dt=0.005,
+                             command=np.zeros(4), setpoint=np.zeros(4), actuators=tuple(JOINT_LABELS),
+                             observation={})
+    with pytest.raises(ValueError, match="are not the commanded actuators"):
+        ServoFeedforwardController(feedforward=False).reset(context)

@@ -117,3 +117,34 @@ for _name in scenarios.SCENARIOS:  # every registered scenario, no new test code
     _case = _conformance_case(_name)
     globals()[_case.__name__] = _case
 del _case, _name
+
+
+def test_each_sea_state_episode_has_its_own_sea():
+    """The antenna's sea is the disturbance's random state: an episode with a new seed starts
+    on that seed's sea (another deck attitude at t = 0, the antenna pointing at the satellite
+    through it, its drives at rest on the start), and the seed the scenario was built with
+    starts where a run starts."""
+    from sims.antenna import pointing_errors
+
+    env = envs.make("antenna-sea-state", duration=EPISODE_S, seed=3)
+    physics, task = env.physics, env.task
+    drive, deck = task.setup.task.disturbance, physics.deck_qpos
+    built = physics.data.qpos[deck].copy()
+    starts = []
+    for _ in range(3):
+        env.reset()
+        starts.append(physics.data.qpos[deck].copy())
+        np.testing.assert_allclose(drive.motion.sample(0.0).joint_arrays()[0][0], starts[-1], atol=1e-12)
+        pointing, _ = pointing_errors(physics.dish_rotation(physics.data.qpos), task.setup.task.problem.satellite)
+        assert np.degrees(pointing[0]) < 1e-6, pointing
+        # The set-points are the start with the servo's velocity lead: no force step at reset.
+        kp, kv = physics.drive_gains()
+        np.testing.assert_allclose(physics.data.act[physics.antenna_actuators],
+                                   physics.data.qpos[physics.antenna_qpos] + kv / kp * physics.data.qvel[physics.antenna_dofs])
+    assert len({s.tobytes() for s in starts}) == 3
+    assert np.abs(np.diff(starts, axis=0)).max() > np.radians(0.1)
+    # The built seed: the built sea and the built start.
+    drive.draw_start(physics, 3)
+    assert drive.motion is drive.built_motion
+    task.setup.task.restore_initial_state(physics)
+    np.testing.assert_array_equal(physics.data.qpos[deck], built)

@@ -66,14 +66,29 @@ class ShipMotionDrive:
 
     A servo controller with the model's inverse dynamics as feed-forward, so the deck tracks
     the prescribed motion to a few thousandths of a degree whatever the antenna does.
+
+    Args:
+      motion: the ship motion the task was built with (``sims.antenna.ship_motion``).
+      seed: the seed ``motion`` was drawn from.
+      sea_start: for a random sea, draws another sea and its start for another episode seed
+        (``draw_start``); None: every episode has ``motion``.
     """
 
-    def __init__(self, physics: AntennaPhysics, motion):
+    def __init__(self, physics: AntennaPhysics, motion, seed: int | None = None, sea_start: "SeaStart | None" = None):
         kp, kv = physics.drive_gains(DECK_JOINTS)
-        self.motion = motion
+        self.motion = self.built_motion = motion
+        self.seed, self.sea_start = seed, sea_start
         self.servo = ServoFeedforwardController(kp, kv)
         self.qpos_adr = physics.deck_qpos
         self.reference = None
+
+    def draw_start(self, physics, seed: int) -> None:
+        """A random sea (``sea_start``) is drawn afresh for each seed but the one it was built
+        with; the physics is put at that sea's start (``sims.task.Disturbance``)."""
+        if self.sea_start is None or seed == self.seed:
+            self.motion = self.built_motion
+        else:
+            self.motion = self.sea_start(physics, seed)
 
     def reset(self, physics, times, rng) -> None:
         # The sea's servo reads the deck joints exactly (it is the plant, not a controller
@@ -85,10 +100,14 @@ class ShipMotionDrive:
         self.observation = encoders.reset(physics, times, 0)
         self.encoders = encoders
         dt = times[1] - times[0] if times.size > 1 else CONTROL_DT
+        # Views of the deck drives' commands and set-points (each a contiguous run), written
+        # in place by the servo.
+        ids, adr = physics.deck_actuators, model.actuator_actadr[physics.deck_actuators]
+        assert np.all(np.diff(ids) == 1) and np.all(np.diff(adr) == 1), "the deck drives are one contiguous run"
         self.servo.reset(ControlContext(
             model=model, nominal_physics=nominal_copy(physics), problem=None, trajectory=None,
-            reference=self.reference, control_dt=dt, command=data.ctrl, setpoint=data.act,
-            actuators=DECK_JOINTS, observation=self.observation))
+            reference=self.reference, control_dt=dt, command=data.ctrl[ids[0]:ids[-1] + 1],
+            setpoint=data.act[adr[0]:adr[-1] + 1], actuators=DECK_JOINTS, observation=self.observation))
 
     def __call__(self, tick: int, physics) -> None:
         self.encoders(tick, physics)
@@ -297,6 +316,33 @@ class AntennaOptions:
     omega_method: str = "log"
 
 
+class SeaStart:
+    """The random start of a sea-state episode (``ShipMotionDrive.draw_start``): a fresh
+    JONSWAP sea drawn from the episode's seed, the deck at its state at t = 0 and the antenna at
+    the joint angles and rates that hold the satellite there (``start_angles``; with a biased
+    IMU, ``tracked_start``), its set-points with them."""
+
+    #: s of ideal path solved for the start's joint rates (the same as the whole run's to
+    #: round-off: the path's first samples do not depend on its length).
+    RATE_SPAN_S = 1.0
+
+    def __init__(self, params: "AntennaSeaParams", satellite: np.ndarray, plant: "AntennaPlant | None"):
+        self.params, self.satellite, self.plant = params, satellite, plant
+
+    def __call__(self, physics: AntennaPhysics, seed: int):
+        """Puts ``physics`` at the start of the sea drawn from ``seed``; returns that sea."""
+        motion = motion_of(self.params, seed)
+        az, el, pol = satellite_of(self.params)
+        theta = start_angles(motion, self.satellite, az, el, pol)
+        start = ideal_path(motion, self.satellite, self.RATE_SPAN_S, theta).sample(0.0)
+        theta = start.position[0]
+        if self.plant is not None:
+            theta = tracked_start(motion, self.satellite, theta, self.plant)
+        deck_pos, deck_vel, _ = motion.sample(0.0).joint_arrays()
+        physics.set_state(deck_pos[0], deck_vel[0], theta, start.velocity[0])
+        return motion
+
+
 def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_max_deg,
            rms_limit_deg, description, antenna_options: AntennaOptions,
            video_length_s: float = 60.0, planner=None, controller=None, params=None, plant=None) -> Setup:
@@ -314,7 +360,8 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
     deck_pos, deck_vel, _ = ship0.joint_arrays()
     for p in {id(physics): physics, id(nominal): nominal}.values():
         p.set_state(deck_pos[0], deck_vel[0], theta_start, start.velocity[0])
-    drive = ShipMotionDrive(physics, motion)
+    sea_start = SeaStart(params, satellite, plant if perturbed else None) if isinstance(params, AntennaSeaParams) else None
+    drive = ShipMotionDrive(physics, motion, seed, sea_start)
     imu = antenna_options.imu
     problem = ant.AntennaProblem(satellite, float(azimuth), float(elevation), float(polarization),
                                  theta_start.copy(), ant.AntennaLimits(rate=nominal.rate_limit()),
@@ -352,9 +399,9 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
     )
 
 
-def motion_of(params: "AntennaParams"):
+def motion_of(params: "AntennaParams", seed: int | None = None):
     """The ship's motion: the paper's eq. (15)-(16) with the run's amplitudes and periods, or
-    a JONSWAP sea drawn from the run's seed."""
+    a JONSWAP sea drawn from ``seed`` (default the run's seed)."""
     if isinstance(params, AntennaPaperParams):
         # At the defaults this is eq. (15)-(16) to the bit (radians(1 deg/s) equals the
         # paper's 0.01 deg per 0.01 s sample).
@@ -363,7 +410,8 @@ def motion_of(params: "AntennaParams"):
                             "roll": params.roll_amplitude},
             periods_s={"heading": params.heading_period, "pitch": params.pitch_period, "roll": params.roll_period},
             turn_rate_deg_s=params.turn_rate, course_deg=-params.ship_heading)
-    return SeaStateMotion(params.hs, params.tp, params.wave_heading, np.random.default_rng([params.seed, 0x5EA]),
+    seed = params.seed if seed is None else seed
+    return SeaStateMotion(params.hs, params.tp, params.wave_heading, np.random.default_rng([seed, 0x5EA]),
                           gamma=params.gamma, speed=params.ship_speed, course_deg=-params.ship_heading)
 
 
