@@ -361,6 +361,13 @@ class ScenarioParams(Params):
     seed: int = param(0, "seed of every random process of the run (disturbances, noise)", low=0,
                       high=2**63 - 1, reason="numpy's SeedSequence takes non-negative 64-bit integers")
 
+    def log_bytes_per_tick(self) -> float:
+        """Bytes a run of these parameters holds per control tick: the runner's log and what
+        the task's sensors, disturbance and reference controller keep per tick. The check of
+        the run's length (``sims.run_limits.check_duration``) multiplies it by the ticks; each
+        mechanism's scenario parameters define it."""
+        raise NotImplementedError(f"{type(self).__name__} does not say its log's bytes per control tick")
+
 
 @dataclass(frozen=True)
 class PlantParams(Params):

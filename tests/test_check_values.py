@@ -169,9 +169,17 @@ def scenario_fixture(name: str):
     return run
 
 
-@pytest.fixture(scope="module", params=list(CHECKS))
+@pytest.fixture(scope="module", params=list(scenarios.SCENARIOS))
 def any_run(request, tmp_path_factory):
     return request.getfixturevalue(_FIXTURE[request.param])
+
+
+def test_every_registered_scenario_has_its_checks_pinned():
+    """A scenario added to the registry is recomputed here too: its check names, its run's
+    length and its fixture are pinned before the suite passes."""
+    registered = set(scenarios.SCENARIOS)
+    for table in (CHECKS, DURATIONS, _FIXTURE):
+        assert registered <= set(table), sorted(registered - set(table))
 
 
 # ---------------------------------------------------------------- MuJoCo on logged rows

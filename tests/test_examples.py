@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-
+from sims import scenarios
 from sims.cli import main
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -88,3 +88,14 @@ def test_fast_straight_switch_keeps_the_observation(tmp_path):
                           "--duration", "180")
     assert summary["passed"] and summary["metrics"]["observing_s"] > 50.0
     assert summary["components"]["trajectory"] == "planners.fast.plan.FastPlan"
+
+
+def test_every_mechanism_has_examples_and_each_plug_in_is_run_here():
+    """Each registered mechanism has its examples/<name>/ with a README, and every plug-in
+    module there is run by a test of this file (its path appears in it)."""
+    text = Path(__file__).read_text()
+    for mechanism in scenarios.mechanisms():
+        folder = EXAMPLES / mechanism.name
+        assert (folder / "README.md").is_file(), folder
+        for module in sorted(folder.glob("*.py")):
+            assert f'"{mechanism.name}/{module.name}:' in text, module

@@ -161,28 +161,17 @@ def test_the_limits_themselves_are_accepted(args):
 
 
 def test_default_runs_are_well_under_the_memory_limit():
-    """Every scenario's default run (what ``make demo`` runs) needs under 1 GiB of log, a
-    quarter of the fallback limit, so it runs on any machine the limit would allow; with
-    14-segment cables FAST's longest still under the 4 GiB fallback."""
-    durations = {
-        "loader-supply": loader.loader_planner.supply_plan().duration + loader.SETTLE_S,
-        "loader-direct": loader.loader_planner.direct_plan().duration + loader.SETTLE_S,
-        "hexapod-sync-move": hexapod.plan(scenarios.get("hexapod-sync-move").params).duration + hexapod.SETTLE_S,
-        "hexapod-async-move": hexapod.plan(scenarios.get("hexapod-async-move").params).duration + hexapod.SETTLE_S,
-        "antenna-paper-motion": antenna.PAPER_DURATION_S,
-        "antenna-sea-state": antenna.SEA_DURATION_S,
-        "fast-tracking": fast.tracking_plan().duration,
-        "fast-ra-scan": fast.ra_scan_plan().duration,
-        "fast-source-switch": fast.source_switch_plan().duration,
-    }
-    per_tick = {"loader": loader.log_bytes_per_tick(), "hexapod": hexapod.log_bytes_per_tick(),
-                "antenna": antenna.log_bytes_per_tick(), "fast": fast.log_bytes_per_tick()}
+    """Every registered scenario's default run (what ``make demo`` runs) needs under 1 GiB of
+    log, a quarter of the fallback limit, so it runs on any machine the limit would allow;
+    with 14-segment cables FAST's longest still under the 4 GiB fallback."""
     limit = run_limits.FALLBACK_LOG_LIMIT_BYTES
-    for name, duration in durations.items():
-        dt = scenarios.get(name).control_dt
-        need = (duration / dt + 1) * per_tick[name.split("-")[0]]
+    durations = {}
+    for name, scenario in scenarios.SCENARIOS.items():
+        params = scenario.resolve()
+        durations[name] = duration = scenario.build(params).task.duration  # the default run's length
+        need = (duration / scenario.control_dt + 1) * params.log_bytes_per_tick()
         assert need < limit / 4, (name, run_limits.format_bytes(need))
-        run_limits.check_duration(duration, dt, per_tick[name.split("-")[0]], (limit, "test"))
+        run_limits.check_duration(duration, scenario.control_dt, params.log_bytes_per_tick(), (limit, "test"))
     assert durations["fast-tracking"] == pytest.approx(1330.0, abs=1.0)
     longest = (durations["fast-tracking"] / fast.CONTROL_DT + 1) * fast.log_bytes_per_tick(14)
     assert longest < limit
@@ -221,31 +210,32 @@ def _held_bytes(*objects) -> int:
     return sum(buffers.values())
 
 
-@pytest.mark.parametrize("name, estimate", [
-    ("loader-supply", lambda o: loader.log_bytes_per_tick()),
-    ("hexapod-sync-move", lambda o: hexapod.log_bytes_per_tick()),
-    ("hexapod-async-move", lambda o: hexapod.log_bytes_per_tick(wind=False)),
-    ("antenna-paper-motion", lambda o: antenna.log_bytes_per_tick(antenna.ImuModel(rate_hz=25.0))),
-    ("antenna-sea-state", lambda o: antenna.log_bytes_per_tick()),
-    ("fast-tracking", lambda o: fast.log_bytes_per_tick()),
-    ("fast-source-switch", lambda o: fast.log_bytes_per_tick(3)),
-])
-def test_log_estimate_matches_the_arrays_a_run_holds(name, estimate):
-    """The per-tick estimate against what two short runs hold after the loop (log,
-    controller, sensors, planner, disturbance, trajectory): the difference of their bytes over the difference
-    of their ticks. Within 10 %, never below."""
+#: Knobs that change what a run keeps per tick, beside every scenario at its defaults.
+_LOG_KNOBS = [
+    ("hexapod-async-move", {"wind": 0.0}),  # no wind series
+    ("antenna-paper-motion", {"imu": {"rate_hz": 25.0}}),  # fewer IMU samples
+    ("fast-source-switch", {"cable_segments": 3}),  # cables of beads
+]
+
+
+@pytest.mark.parametrize("name, extra", [(name, {}) for name in scenarios.SCENARIOS] + _LOG_KNOBS)
+def test_log_estimate_matches_the_arrays_a_run_holds(name, extra):
+    """The parameters' per-tick estimate (``ScenarioParams.log_bytes_per_tick``) against what two
+    short runs hold after the loop (log, controller, sensors, planner, disturbance,
+    trajectory): the difference of their bytes over the difference of their ticks. Within
+    10 %, never below."""
     scenario = scenarios.get(name)
-    extra = {"hexapod-async-move": {"wind": 0.0}, "antenna-paper-motion": {"imu": {"rate_hz": 25.0}},
-             "fast-source-switch": {"cable_segments": 3}}.get(name, {})
     held = []
     for ticks in (20, 120):
-        setup = scenario.build(scenario.resolve(duration=ticks * scenario.control_dt, **extra))
+        params = scenario.resolve(duration=ticks * scenario.control_dt, **extra)
+        setup = scenario.build(params)
         log = runner.simulate(setup)
         held.append((log.t.size, _held_bytes(log, setup.components.controller, setup.task.sensors, setup.components.planner, setup.task.disturbance,
                                              setup.components.trajectory)))
     (n1, b1), (n2, b2) = held
     measured = (b2 - b1) / (n2 - n1)
-    assert measured <= estimate(None) <= 1.1 * measured, (measured, estimate(None))
+    estimate = params.log_bytes_per_tick()
+    assert measured <= estimate <= 1.1 * measured, (measured, estimate)
 
 
 # ---------------------------------------------------------------- the Python API
@@ -261,20 +251,17 @@ def test_build_refuses_a_duration_under_one_tick(name):
         scenario.resolve(duration=1e12)
 
 
-@pytest.mark.parametrize("name, heavy", [
-    ("loader-supply", "sims.loader.LoaderPhysics.load"),
-    ("hexapod-sync-move", "sims.hexapod.HexapodPhysics.load"),
-    ("antenna-paper-motion", "sims.antenna.task.ideal_path"),
-    ("antenna-sea-state", "sims.antenna.task.ideal_path"),
-    ("fast-tracking", "sims.fast.FastPhysics.load"),
-])
-def test_build_checks_before_any_work(monkeypatch, name, heavy):
-    """The refusal comes before the work proportional to the duration (the antenna's ideal
-    path) and before any physics is loaded."""
-    def must_not_run(*args, **kwargs):
-        raise AssertionError(f"{heavy} ran before the duration was checked")
+@pytest.mark.parametrize("name", list(scenarios.SCENARIOS))
+def test_build_checks_before_any_work(monkeypatch, name):
+    """The refusal comes before any model file is opened (every mechanism's physics loads its
+    scene through ``models.scene_path``), and so before the work proportional to the duration
+    that follows it (the antenna's ideal path)."""
+    import models
 
-    monkeypatch.setattr(heavy, must_not_run)
+    def must_not_run(*args, **kwargs):
+        raise AssertionError(f"{name}: a model was loaded before the duration was checked")
+
+    monkeypatch.setattr(models, "scene_path", must_not_run)
     scenario = scenarios.get(name)
     with pytest.raises(run_limits.RunLimitError, match="duration 1e\\+12 s needs"):
         scenario.build(scenario.resolve(duration=1e12))

@@ -207,7 +207,10 @@ class AntennaParams(ScenarioParams):
         elif self.satellite_look[1] < MIN_SATELLITE_ELEVATION_DEG:
             raise ParamError(f"satellite_look elevation = {self.satellite_look[1]:g} deg is below the "
                              f"{MIN_SATELLITE_ELEVATION_DEG:g} deg a ship's dish tracks down to")
-        run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.imu))
+        run_limits.check_duration(self.duration, CONTROL_DT, self.log_bytes_per_tick())
+
+    def log_bytes_per_tick(self) -> float:
+        return log_bytes_per_tick(self.imu)
 
 
 @dataclass(frozen=True)

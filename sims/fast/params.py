@@ -300,8 +300,10 @@ class FastParams(ScenarioParams):
                              f"control tick ({self.control_dt * 1e3:g} ms) at control_rate_hz = "
                              f"{self.control_rate_hz:g} Hz")
         if self.duration is not None:
-            run_limits.check_duration(self.duration, self.control_dt,
-                                      log_bytes_per_tick(self.cable_segments, self.sensors, self.control_dt))
+            run_limits.check_duration(self.duration, self.control_dt, self.log_bytes_per_tick())
+
+    def log_bytes_per_tick(self) -> float:
+        return log_bytes_per_tick(self.cable_segments, self.sensors, self.control_dt)
 
     @property
     def control_dt(self) -> float:

@@ -23,7 +23,7 @@ from sims.fast.controller import ControllerOptions, FastController, parked_comma
 from sims.fast.loads import CableLoads, ChainCableLoads
 from sims.fast.measurement import FusedSensors, SensorOptions, estimate_errors, make_sensors
 from sims.fast.params import (DEC_SCAN, RA_SCAN, FastParams, FastPlant, FastScanParams, FastSwitchParams,
-                              FastTrackingParams, _radec, _start, _transit, log_bytes_per_tick)
+                              FastTrackingParams, _radec, _start, _transit)
 from sims.fast.physics import CONTROL_DT, STRING_MODE_HZ, FastPhysics
 from sims.params import ParamError
 from sims.runner import RunLog, Setup
@@ -423,7 +423,7 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     if perturbed:
         plant.check_segments(segments)
     control_dt = params.control_dt
-    run_limits.check_duration(duration, control_dt, log_bytes_per_tick(segments, params.sensors, control_dt))
+    run_limits.check_duration(duration, control_dt, params.log_bytes_per_tick())
     measured = None
     if params.wind_file is not None:
         measured = MeasuredWind(params.wind_file)

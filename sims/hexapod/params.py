@@ -103,7 +103,10 @@ class HexapodParams(ScenarioParams):
                                  "a move of zero length")
             previous = move.target
         if self.duration is not None:
-            run_limits.check_duration(self.duration, CONTROL_DT, log_bytes_per_tick(self.wind > 0))
+            run_limits.check_duration(self.duration, CONTROL_DT, self.log_bytes_per_tick())
+
+    def log_bytes_per_tick(self) -> float:
+        return log_bytes_per_tick(self.wind > 0)
 
 
 @dataclass(frozen=True)

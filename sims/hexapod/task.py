@@ -19,7 +19,7 @@ from sims.controllers import demanded_force
 from sims.envs import joint_tracking_reward
 from sims.hexapod.controller import HexapodController
 from sims.hexapod.params import CONTROL_DT, SETTLE_S, HexapodParams, HexapodPlant, pose_si
-from sims.hexapod.physics import HexapodPhysics, log_bytes_per_tick, magnified_qpos
+from sims.hexapod.physics import HexapodPhysics, magnified_qpos
 from sims.hexapod.sensors import sensors
 from sims.runner import RunLog, Setup
 from sims.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
@@ -452,7 +452,7 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
     plant = HexapodPlant() if plant is None else plant
     trajectory, moves, starts, durations = plan_moves(params, planner)
     duration = params.duration if params.duration is not None else default_duration(starts, durations)
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick(params.wind > 0))
+    run_limits.check_duration(duration, CONTROL_DT, params.log_bytes_per_tick())
     physics = HexapodPhysics.load(params.elevation, plant)
     start = moves[0].start_pose
     nominal_physics = None  # the nominal plant: a copy of the physics, as it is now

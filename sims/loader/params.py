@@ -56,7 +56,10 @@ class LoaderParams(ScenarioParams):
     def check(self) -> None:
         duration = self.duration if self.duration is not None else \
             (len(self.key_points) - 1) * self.key_interval + self.settle
-        run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
+        run_limits.check_duration(duration, CONTROL_DT, self.log_bytes_per_tick())
+
+    def log_bytes_per_tick(self) -> float:
+        return log_bytes_per_tick()
 
 
 #: Each encoder's zero offset range, in Table 1's units (mm, deg).

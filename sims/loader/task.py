@@ -13,7 +13,7 @@ from sims.checks import Check
 from sims.controllers import demanded_force
 from sims.loader.collision import clearance, obstacle_contact_pairs
 from sims.loader.controller import reference_controller
-from sims.loader.params import CONTROL_DT, LoaderParams, LoaderPlant, log_bytes_per_tick
+from sims.loader.params import CONTROL_DT, LoaderParams, LoaderPlant
 from sims.loader.physics import LoaderPhysics, _joint_dofs, plant_chain
 from sims.loader.sensors import sensors
 from sims.runner import RunLog, Setup
@@ -173,7 +173,7 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
     planner = loader_planner.CubicBSplinePlanner() if planner is None else planner
     trajectory = plan_checked(planner, task, task.labels)
     duration = params.duration if params.duration is not None else trajectory.duration + params.settle
-    run_limits.check_duration(duration, CONTROL_DT, log_bytes_per_tick())
+    run_limits.check_duration(duration, CONTROL_DT, params.log_bytes_per_tick())
     physics = LoaderPhysics.load(params.payload_mass, plant)
     bias = plant.encoder_bias_si()
     physics.set_start(task.key_points[0] - bias if bias.any() else task.key_points[0])

@@ -79,7 +79,10 @@ class PendulumParams(ScenarioParams):
                         reason="at least the arrival window")
 
     def check(self) -> None:
-        run_limits.check_duration(self.move_time + self.hold, CONTROL_DT, log_bytes_per_tick())
+        run_limits.check_duration(self.move_time + self.hold, CONTROL_DT, self.log_bytes_per_tick())
+
+    def log_bytes_per_tick(self) -> float:
+        return log_bytes_per_tick()
 
 
 class PendulumEvaluation:
