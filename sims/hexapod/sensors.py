@@ -13,10 +13,8 @@ def sensors(physics: HexapodPhysics) -> JointEncoders:
     """The hexapod's sensors: the six strut encoders (length change from the zero pose),
     exact, every tick (Rubin's encoders resolve far below the 1 um check; README.md), with the
     plant's encoder bias (``physics.encoder_bias``) if it has one."""
-    model = physics.model.ptr
-    acts = [model.actuator(j).actadr[0] for j in range(6)]
     bias = physics.encoder_bias
-    encoders = JointEncoders(physics.strut_qpos, physics.strut_dofs, acts,
+    encoders = JointEncoders(physics.strut_qpos, physics.strut_dofs, physics.strut_act,
                              "strut encoders (length change from the zero pose)", "m", CONTROL_DT,
                              bias=0.0 if bias is None else bias)
     if bias is not None and bias.any():
