@@ -7,6 +7,8 @@ import copy
 import mujoco
 import numpy as np
 
+from sims.drives import load_joint, transmission_stiffness
+
 
 
 class ServoFeedforwardController:
@@ -54,14 +56,17 @@ class ServoFeedforwardController:
         self.reference = None
         self.tau_ff = None
         self.actuator_ids = None
+        self.compliance = None
         self.z = None
         self._inv_dt = None
         self._gain = 0.0
 
     @staticmethod
     def joint_addresses(model, actuators: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(qpos addresses, dof addresses) of the joints the actuators (indices) drive."""
-        joints = model.actuator_trnid[actuators, 0]
+        """(qpos addresses, dof addresses) of the joints the actuators (indices) finally move:
+        through a drive train's compliant transmission, the load's joints
+        (``sims.drives.load_joint``)."""
+        joints = np.array([load_joint(model, int(a)) for a in actuators])
         return model.jnt_qposadr[joints].copy(), model.jnt_dofadr[joints].copy()
 
     def feedforward_forces(self, context) -> np.ndarray:
@@ -109,8 +114,20 @@ class ServoFeedforwardController:
         self.tau_ff = (self.feedforward_forces(context) if self.feedforward else np.zeros((n, nu)))
         self.reference = reference.position
         self.setpoints = reference.position + (self.tau_ff + self.kv * reference.velocity) / self.kp
+        # A compliant transmission (as-built drives) deflects by f / k between the motor,
+        # which the drive positions, and the load the reference is for.
+        stiffness = np.array([transmission_stiffness(model, model.joint(int(j)).name)
+                              for j in (load_joint(model, int(a)) for a in ids)])
+        self.compliance = None  # m/N or rad/(N m) per drive; None: rigid transmissions
+        if np.isfinite(stiffness).any():
+            self.compliance = np.where(np.isfinite(stiffness), 1.0 / stiffness, 0.0)
+            self.setpoints = self.setpoints + self.tau_ff * self.compliance
         self.z = np.zeros(nu)
         self._gain = 0.0 if self.integral_time is None else context.control_dt / self.integral_time
+        if self._gain:
+            # The set-point offset that makes the drive's largest force at the load.
+            self._bound = self.force_limit / self.kp if self.compliance is None else \
+                self.force_limit * (1.0 / self.kp + self.compliance)
         self._inv_dt = 1.0 / context.control_dt
         self._command = context.command  # written in place every tick
         context.setpoint[:] = self.setpoints[0]
@@ -119,8 +136,7 @@ class ServoFeedforwardController:
         target = self.setpoints[min(tick + 1, self.setpoints.shape[0] - 1)]
         if self._gain:
             z = self.z + self._gain * (self.reference[tick] - observation["joint_positions"])
-            bound = self.force_limit / self.kp
-            self.z = np.clip(z, -bound, bound)
+            self.z = np.clip(z, -self._bound, self._bound)
             target = target + self.z
         self._command[:] = (target - observation["setpoints"]) * self._inv_dt
 

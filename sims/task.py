@@ -57,6 +57,8 @@ class SensorSpec:
       noise: its noise in words with units (e.g. "white, 1 mm and 20 urad 1-sigma per axis"),
         "none" for an ideal sensor.
       bias: its bias in words, "none" without.
+      resolution: one count of its reading, in its unit; 0 for a continuous reading (listed
+        in JSON only when it counts).
     """
 
     name: str
@@ -66,9 +68,13 @@ class SensorSpec:
     latency_s: float = 0.0
     noise: str = "none"
     bias: str = "none"
+    resolution: float = 0.0
 
     def to_json(self) -> dict:
-        return asdict(self)
+        out = asdict(self)
+        if not self.resolution:
+            del out["resolution"]
+        return out
 
 
 def _is_run(index: np.ndarray) -> bool:
@@ -116,39 +122,48 @@ class JointEncoders(Sensors):
 
     Observation keys: ``joint_positions`` (m or rad), ``joint_velocities`` (m/s or rad/s, the
     drive's velocity estimate), ``setpoints`` (the drives' position set-points: a motion
-    controller knows what it commanded). Without noise and bias the readings are exact, as
-    read-only views of the physics' buffers (no cost per tick); with them, each tick's
-    position reading is the true one plus ``bias`` plus white noise of ``noise`` (1 sigma),
-    seeded from the run's seed.
+    controller knows what it commanded). Without noise, bias and resolution the readings are
+    exact, as read-only views of the physics' buffers (no cost per tick); with them, each
+    tick's position reading is the true one plus ``bias`` plus white noise of ``noise`` (1
+    sigma, seeded from the run's seed), counted in steps of ``resolution``: the encoder's
+    count times its resolution, floor(x / r) r (computed as floor(x (1/r)) r).
 
     Args:
       qpos, dofs, acts: the joints' qpos and dof addresses and the drives' activation
         addresses, in the controller's channel order.
       measures: what they read, in words; unit: of the positions.
       noise, bias: per joint (or one for all), in the positions' unit.
+      resolution: per joint (or one for all), one count in the positions' unit; 0: exact.
     """
 
     def __init__(self, qpos, dofs, acts, measures: str, unit: str, control_dt: float,
-                 noise=0.0, bias=0.0):
+                 noise=0.0, bias=0.0, resolution=0.0):
         super().__init__()
         self.qpos = np.asarray(qpos, dtype=int)
         self.dofs = np.asarray(dofs, dtype=int)
         self.acts = np.asarray(acts, dtype=int)
         self.noise = np.broadcast_to(np.asarray(noise, dtype=float), self.qpos.shape).copy()
         self.bias = np.broadcast_to(np.asarray(bias, dtype=float), self.qpos.shape).copy()
-        if not (np.isfinite(self.noise).all() and np.isfinite(self.bias).all() and (self.noise >= 0).all()):
-            raise ValueError(f"encoder noise {self.noise.tolist()} must be finite and >= 0 and bias "
-                             f"{self.bias.tolist()} finite")
+        self.resolution = np.broadcast_to(np.asarray(resolution, dtype=float), self.qpos.shape).copy()
+        if not (np.isfinite(self.noise).all() and np.isfinite(self.bias).all() and (self.noise >= 0).all()
+                and np.isfinite(self.resolution).all() and (self.resolution >= 0).all()):
+            raise ValueError(f"encoder noise {self.noise.tolist()} and resolution {self.resolution.tolist()} must be "
+                             f"finite and >= 0 and bias {self.bias.tolist()} finite")
         rate = 1.0 / control_dt
-        ideal = not self.noise.any() and not self.bias.any()
+        ideal = not self.noise.any() and not self.bias.any() and not self.resolution.any()
         noise_text = "none" if not self.noise.any() else f"white, {self.noise.tolist()} {unit} 1-sigma"
         bias_text = "none" if not self.bias.any() else f"{self.bias.tolist()} {unit}"
         self.specs = [
-            SensorSpec("joint_positions", measures, unit, rate, 0.0, noise_text, bias_text),
+            SensorSpec("joint_positions", measures, unit, rate, 0.0, noise_text, bias_text,
+                       float(self.resolution.max())),
             SensorSpec("joint_velocities", f"rates of the {measures}", f"{unit}/s", rate),
             SensorSpec("setpoints", "the drives' position set-points (what was commanded)", unit, rate),
         ]
         self._ideal = ideal
+        self._counted = self.resolution > 0
+        self._all_counted = bool(self._counted.all())
+        self._counts_per_unit = np.divide(1.0, self.resolution, out=np.zeros_like(self.resolution),
+                                          where=self._counted)
         self._copies = []  # (buffer getter, index, out) read by __call__ every tick
 
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
@@ -178,7 +193,17 @@ class JointEncoders(Sensors):
         for getter, index, out in self._copies:
             np.take(getter(data), index, out=out)
         if not self._ideal:
-            self._positions += self.bias + self.noise * self._rng.standard_normal(self.noise.size)
+            if self.noise.any() or self.bias.any():
+                self._positions += self.bias + self.noise * self._rng.standard_normal(self.noise.size)
+            if self._all_counted:  # in place: a tick's reading costs no new arrays
+                positions = self._positions
+                np.multiply(positions, self._counts_per_unit, out=positions)
+                np.floor(positions, out=positions)
+                positions *= self.resolution
+            elif self._counted.any():
+                counted = self._counted
+                self._positions[counted] = (np.floor(self._positions[counted] * self._counts_per_unit[counted])
+                                            * self.resolution[counted])
 
 
 # ----------------------------------------------------------------------------- the task

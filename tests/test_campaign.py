@@ -79,9 +79,10 @@ def test_campaign_table_has_a_row_per_run(local_campaign):
     assert summary["parameters"]["wind"] == 6.0 and summary["parameters"]["elevation"] == 30.0
     value = [c["value"] for c in summary["checks"] if c["name"] == "pose_error_final"][0]
     assert value == table.column("check.pose_error_final")[5].as_py()
-    # The wind changes the strut forces' spread: the axis reaches the physics.
-    force = table.column("check.following_error").to_numpy()
-    assert force[4:].mean() > force[:4].mean()
+    # The wind changes the tracking: the axis reaches the physics (as built the struts'
+    # friction, not the wind, sets the size of the following error).
+    following = table.column("check.following_error").to_numpy()
+    assert np.all(np.abs(following[4:] - following[:4]) > 1e-3)
 
 
 def test_campaign_report(local_campaign):

@@ -47,8 +47,9 @@ def test_loader_quintic_spline_without_key_points_strikes_the_obstacles(tmp_path
 
 def test_hexapod_plain_pd_sags(tmp_path):
     _, checks = run(tmp_path, "hexapod-sync-move", "controller", "hexapod/pd_controller.py:PlainPD")
-    assert failed(checks) == {"following_error", "pose_error_final"}
-    assert checks["pose_error_final"]["value"] > 100.0  # um: 413 measured, the limit 1
+    # As built the unfed start also drops the rotors into the load: 51.7 kN demanded.
+    assert failed(checks) == {"following_error", "pose_error_final", "strut_force"}
+    assert checks["pose_error_final"]["value"] > 100.0  # um: 282 measured, the limit 1
 
 
 def test_hexapod_quintic_move_passes_sync_and_is_not_an_async_move(tmp_path):

@@ -27,14 +27,15 @@ PERFECT = SensorOptions(imu_gyro_noise=0.0, imu_gyro_bias=0.0, imu_gyro_bias_wal
 
 @functools.cache
 def tracking(duration: float = 60.0, wind: float = 4.0, stewart: bool = True, sensors: SensorOptions = SensorOptions(),
-             cable_segments: int | None = None, seed: int = 0, control_rate_hz: float | None = None):
+             cable_segments: int | None = None, seed: int = 0, control_rate_hz: float | None = None,
+             drives: str = "as-built"):
     """(result, setup) of fast-tracking's first ``duration`` s (the switch from park: the
     cabin descends at up to 0.4 m/s, the hardest part for the filters)."""
     kw = {} if cable_segments is None else {"cable_segments": cable_segments}
     if control_rate_hz is not None:
         kw["control_rate_hz"] = control_rate_hz
     setup = build_scenario(FastTrackingParams(duration=duration, wind=wind, stewart=stewart, sensors=sensors,
-                                              seed=seed, **kw))
+                                              seed=seed, drives=drives, **kw))
     return runner.run("fast-tracking", setup), setup
 
 
@@ -136,13 +137,14 @@ BEFORE = {"feed_error_rms": 0.5704301260969762, "feed_error_max": 1.591034054028
 
 
 def test_the_ideal_option_gives_the_figures_of_before():
-    """system = "ideal" on the lumped cables at the earlier 100 Hz control rate reproduces the
-    earlier run: bit for bit on the machine that recorded BEFORE, to round-off on another.
+    """system = "ideal" on the lumped cables and the ideal winches at the earlier 100 Hz control
+    rate reproduces the earlier run: bit for bit on the machine that recorded BEFORE, to round-off on another.
     On 2026-12-02's machine (an AVX-512 AMD EPYC) the recording commit's code itself gives
     values within 4e-11 of them: the libraries' last bits differ by CPU (not numpy's SIMD
     kernels alone: they were switched off, tried), and 30 s of simulation carry them that far.
     A change of behaviour moves these values by 1e-3 or more."""
-    result, _ = tracking(30.0, sensors=SensorOptions(system="ideal"), cable_segments=0, control_rate_hz=100.0)
+    result, _ = tracking(30.0, sensors=SensorOptions(system="ideal"), cable_segments=0, control_rate_hz=100.0,
+                         drives="ideal")
     values = {c.name: c.value for c in result.checks if c.name in BEFORE}
     assert values.keys() == BEFORE.keys()
     for name, value in BEFORE.items():

@@ -11,6 +11,12 @@ from sims.wind import AIR_DENSITY, kaimal_spectrum, wind_speed_series
 EXPECTED = {"strut_velocity", "strut_accel", "hexapod_speed", "following_error", "pose_error_final",
             "strut_force", "stroke", "simulation_warnings", "controller_errors"}
 WIND_M_S = 10.0
+#: The ball constraints' largest violation (um) under the full load: MuJoCo's stiffest
+#: constraint (solref 2 steps, impedance 0.9999) gives way in proportion to the inverse mass
+#: at the rod's tip, which the drives as built make the rod's own 8 kg (the rotor's 16 t
+#: reflected inertia sits on the motor): 0.32 um at 15 deg measured (0.18 um with the
+#: ideal drives); models/hexapod/README.md.
+CLOSURE_FLOOR_UM = 0.4
 
 
 def run(name, controller=None, trajectory=None, **options):
@@ -42,7 +48,7 @@ def test_checks_hold(name, elevation, wind):
         assert result.metrics["arrival_spread_s"] > 0.5  # async struts really end apart
     # The run covered the move and the settling time.
     assert result.sim_time_s >= setup.components.trajectory.duration + sim_hexapod.SETTLE_S - 1e-9
-    assert result.metrics["loop_closure_um"] < 0.3
+    assert result.metrics["loop_closure_um"] < CLOSURE_FLOOR_UM
 
 
 def test_wind_loads_the_camera_with_its_drag():
@@ -66,8 +72,11 @@ def test_wind_loads_the_camera_with_its_drag():
     last = n - 1
     expected = drag_force(u[last], wind.direction, cylinder_projected_area(axis, wind.direction, 1.65, 3.0), 1.0)
     np.testing.assert_allclose(wind.force[last], expected, rtol=2e-3)
-    calm, _ = run("hexapod-sync-move", elevation=45.0, wind=0.0)
-    assert checks(result)["following_error"].value > 3 * checks(calm)["following_error"].value
+    # What the wind does to the tracking, on the ideal drives (as built, the struts' friction
+    # dominates the following error: tests/test_hexapod_drives.py).
+    windy, _ = run("hexapod-sync-move", elevation=45.0, wind=WIND_M_S, drives="ideal")
+    calm, _ = run("hexapod-sync-move", elevation=45.0, wind=0.0, drives="ideal")
+    assert checks(windy)["following_error"].value > 3 * checks(calm)["following_error"].value
 
 
 def test_wind_series_variance_equals_the_spectrum_integral():

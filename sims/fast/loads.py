@@ -19,10 +19,73 @@ import numpy as np
 from planners import fast
 from planners.errors import LimitError
 from sims.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICIENT, CABIN_HEIGHT, CABLE_DAMPING_S,
-                               CABLE_EA, NODE_DAMPING_RATIO, SEGMENT_OMEGA_DT_LIMIT, STRING_MODE_HZ, FastPhysics,
+                               CABLE_EA, CONTROL_DT, NODE_DAMPING_RATIO, SEGMENT_OMEGA_DT_LIMIT, STRING_MODE_HZ, FastPhysics,
                                cable_drag_force, catenary_tension, chord_factor, end_fraction, max_cable_segments,
                                moment_sum, node_mass_factor, tangent_stiffness)
 from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
+
+
+#: The winches' rope speed and acceleration limits, m/s and m/s^2 (models/fast/README.md "Winches
+#: as built"): 25 % above the paper's source-switching speed of the cabin (0.4 m/s, which no
+#: rope exceeds), twice its 0.025 m/s^2.
+WINCH_MAX_SPEED = 0.5
+WINCH_MAX_ACCEL = 0.05
+
+
+class Winches:
+    """FAST's six winches as built: each pays its rope out or in toward the controller's command
+    (the unstretched length L0, the ``ctrl`` of its cable actuator) as its drive's position loop
+    does, within the drive's speed and acceleration limits.
+
+    Per control tick the rope moves to the command when that takes at most ``max_speed`` and a
+    change of speed of at most ``max_accel`` dt; otherwise at the speed a limited position loop
+    takes: the command's own rate plus a closing speed min(|e| / dt, v_close(|e|)), v_close
+    the speed from which ticks braking at a still close the gap e, within v_max and a change
+    of speed of a dt. The rope length it reached is what the cable's law
+    sees (it replaces the command in ``ctrl``). The drive's own loop is taken as faster than a
+    tick (the cable's lowest mode is 0.19 Hz).
+
+    Args:
+      max_speed: m/s. max_accel: m/s^2.
+    """
+
+    def __init__(self, max_speed: float = WINCH_MAX_SPEED, max_accel: float = WINCH_MAX_ACCEL):
+        self.max_speed = float(max_speed)
+        self.max_accel = float(max_accel)
+        self.length = None
+        self.rate = None
+
+    def reset(self, lengths: np.ndarray, dt: float) -> None:
+        """Start at rest with the ropes at ``lengths`` (m), ticks of ``dt`` s."""
+        self.length = np.array(lengths, dtype=float)
+        self.rate = np.zeros_like(self.length)
+        self._last_command = self.length.copy()
+        self.dt = float(dt)
+        self._dv = self.max_accel * self.dt
+
+    def __call__(self, command: np.ndarray) -> None:
+        """Move the ropes toward ``command`` (m, (6,)) for one tick and write where they are
+        into it."""
+        rate = (command - self.length) / self.dt
+        target_rate = (command - self._last_command) / self.dt
+        self._last_command[:] = command
+        if np.all(np.abs(rate) <= self.max_speed) and np.all(np.abs(rate - self.rate) <= self._dv):
+            self.length[:] = command  # within the limits: the command, to the bit
+            self.rate = rate
+            return
+        # Toward the command moving at its own rate: the gap closes at most at the speed from
+        # which ticks slowing by a dt each still close it within |e|, v = (n + f) a dt for
+        # a dt^2 (n + 1) (n / 2 + f) = |e|, n whole, 0 <= f < 1.
+        error = command - self.length
+        ticks = np.abs(error) / (self._dv * self.dt)
+        n = np.floor((np.sqrt(1.0 + 8.0 * ticks) - 1.0) / 2.0)
+        closing = np.minimum(self._dv * (n + np.clip(ticks / (n + 1.0) - n / 2.0, 0.0, 1.0)),
+                             np.abs(error) / self.dt)
+        rate = np.clip(target_rate + np.sign(error) * closing, -self.max_speed, self.max_speed)
+        rate = np.clip(rate, self.rate - self._dv, self.rate + self._dv)
+        self.length += rate * self.dt
+        self.rate = rate
+        command[:] = self.length
 
 
 class CableLoads:
@@ -48,11 +111,14 @@ class CableLoads:
       ea, mass_per_length: the true cables' EA (N) and mass per length (kg/m) for the plant's
         law and loads; default the nominal ones (a perturbed plant's: ``FastPlant``). The
         controller's feed-forward keeps the nominal ones (``winch_feedforward``).
+      winches: the winches as built (``Winches``) between the command and the ropes; None: the
+        ideal winches, whose ropes are the command.
     """
 
     def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal",
                  turbulence_intensity: float | None = None, measured=None, ea: float = CABLE_EA,
-                 mass_per_length: float = fast.FAST.cable_mass_per_length):
+                 mass_per_length: float = fast.FAST.cable_mass_per_length, winches: Winches | None = None):
+        self.winches = winches
         self.ea = float(ea)
         self.mass_per_length = float(mass_per_length)
         self.weight = self.mass_per_length * fast.GRAVITY  # N/m; CABLE_WEIGHT at the nominal mass
@@ -85,6 +151,8 @@ class CableLoads:
         self._towers = physics.tower_tops
         self._cabin = physics.cabin_body
         self._xfrc = data.xfrc_applied[self._cabin]
+        if self.winches is not None:
+            self.winches.reset(data.ctrl[self._cables], times[1] - times[0] if times.size > 1 else CONTROL_DT)
         mujoco.mj_forward(model, data)
         chord, span, _ = self._geometry()
         self.tension = catenary_tension(chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60,
@@ -147,6 +215,10 @@ class CableLoads:
     def __call__(self, tick: int, physics) -> None:
         if self._directions is not None:
             self.direction = self._directions[tick]
+        if self.winches is not None:
+            ropes = self._data.ctrl[self._cables]
+            self.winches(ropes)
+            self._data.ctrl[self._cables] = ropes
         self.apply(physics, tick)
 
 

@@ -249,6 +249,9 @@ class FastParams(ScenarioParams):
         None, "measured wind instead of the model: CSV rows t (s), speed (m/s)[, direction (deg)], covering the "
         "run; resampled to the control ticks (a relative path is the scenario file's directory's)", path=True)
     stewart: bool = param(True, "the Stewart stabilizer in the cabin on (off: the feed rides the A-B rotator)")
+    drives: str = param("as-built", "the winches: as-built (each rope within its drive's speed and acceleration, "
+                        "0.5 m/s and 0.05 m/s^2; models/fast/README.md) or ideal (each rope at its command every "
+                        "tick)", choices=("as-built", "ideal"))
     sensors: SensorOptions = param(SensorOptions(), "the measurement system (sims.fast.measurement.SensorOptions: "
                                    "fused, FAST's, or ideal; its rates, latencies, noises and biases)")
     cable_segments: int = param(DEFAULT_CABLE_SEGMENTS, "each cable as a chain of this many elastic segments (2: "

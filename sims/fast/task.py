@@ -20,7 +20,7 @@ from sims import run_limits
 from sims.checks import Check
 from sims.controllers import demanded_force
 from sims.fast.controller import ControllerOptions, FastController, parked_command, winch_feedforward
-from sims.fast.loads import CableLoads, ChainCableLoads
+from sims.fast.loads import CableLoads, ChainCableLoads, Winches
 from sims.fast.measurement import FusedSensors, SensorOptions, estimate_errors, make_sensors
 from sims.fast.params import (DEC_SCAN, RA_SCAN, FastParams, FastPlant, FastScanParams, FastSwitchParams,
                               FastTrackingParams, _radec, _start, _transit)
@@ -451,7 +451,8 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
         controller = FastController(controller_options)
         description["stewart"] = "on" if controller_options.stewart else "off"
     wind = dict(wind_speed=params.wind, wind_azimuth_deg=params.wind_direction, spectrum=params.wind_spectrum,
-                turbulence_intensity=params.turbulence_intensity, measured=measured)
+                turbulence_intensity=params.turbulence_intensity, measured=measured,
+                winches=Winches() if params.drives == "as-built" else None)
     if perturbed:
         loads = plant.loads(segments, **wind)  # the true cables' EA and weight
     else:

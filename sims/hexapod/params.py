@@ -14,7 +14,7 @@ from planners import hexapod as hexapod_planner
 from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS
 from sims import run_limits
-from sims.hexapod.physics import DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
+from sims.hexapod.physics import DEFAULT_ELEVATION_DEG, DRIVES, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
 from sims.params import Params, ParamError, PlantParams, ScenarioParams, param
 from sims.wind import MEAN_SPEED
 
@@ -87,6 +87,9 @@ class HexapodParams(ScenarioParams):
                              "deg", low=ELEVATION_RANGE_DEG[0], high=ELEVATION_RANGE_DEG[1],
                              reason="the telescope's elevation range")
     wind: float = param(DEFAULT_WIND_M_S, "mean wind on the camera (Kaimal turbulence), 0 for none", **MEAN_SPEED)
+    drives: str = param("as-built", "the struts' drives: as-built (motor, gearbox, ball screw, friction, the drive's "
+                        "loops, a counting encoder; models/hexapod/README.md) or ideal (one stiff servo per strut)",
+                        choices=DRIVES)
     duration: float | None = param(None, "simulated time; none: to the tick the last move's trajectory ends on, "
                                    "plus 1 s of settling", "s",
                                    low=CONTROL_DT, reason="at least one control tick (5 ms)")
@@ -106,7 +109,7 @@ class HexapodParams(ScenarioParams):
             run_limits.check_duration(self.duration, CONTROL_DT, self.log_bytes_per_tick())
 
     def log_bytes_per_tick(self) -> float:
-        return log_bytes_per_tick(self.wind > 0)
+        return log_bytes_per_tick(self.wind > 0, self.drives)
 
 
 @dataclass(frozen=True)
@@ -138,7 +141,8 @@ class HexapodPlant(PlantParams):
         reason="machining and assembly of the pivot circles before a kinematic calibration, assumed +-1 mm; "
                "ts_mthexapod's constants.py gives the calibrated pivots to 1 um")
     drive_stiffness_error: float = param(
-        0.0, "every strut's stiffness kp (servo and axial, 100 N/um in the model) relative to the model's",
+        0.0, "every strut drive's servo stiffness kp relative to the model's (ideal drives: servo and axial, "
+        "100 N/um; as built: the position loop's 96.8 N/um)",
         "fraction", low=-0.3, high=0.3,
         reason="the 100 N/um is an order-of-magnitude assumption (models/hexapod/README.md); ball-screw "
                "preload, bearings and the flexures spread it by tens of %: +-30 % assumed")
@@ -146,6 +150,19 @@ class HexapodPlant(PlantParams):
         1.0, "every strut drive's force limit relative to its 50 kN rating", "fraction", low=0.5, high=1.0,
         reason="a drive delivers at most its rated force; down to half of it when derated (heat, a low DC "
                "bus); assumption")
+    friction_error: float = param(
+        0.0, "as-built drives: every strut's Coulomb and viscous friction relative to the model's", "fraction",
+        low=-0.5, high=1.0,
+        reason="ball-screw preload drag and gearbox losses vary with preload, lubrication and temperature: "
+               "half to twice the model's (assumption; models/hexapod/README.md)")
+    screw_stiffness_error: float = param(
+        0.0, "as-built drives: every strut's axial stiffness (screw, nut, bearings, gearbox) relative to the "
+        "model's", "fraction", low=-0.3, high=0.3,
+        reason="preload and bearing spread of catalogue rigidity figures, +-30 % (assumption)")
+    torque_constant_error: float = param(
+        0.0, "as-built drives: every strut motor's torque constant relative to its datasheet's (every force the "
+        "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
+        reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
     encoder_bias_um: tuple[float, ...] = param(
         (0.0,) * 6, "zero offset of each strut's encoder, strut1 ... strut6: the drive and the controller read "
         "q + bias", "um", low=-10.0, high=10.0, length=6,

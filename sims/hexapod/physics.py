@@ -25,6 +25,7 @@ from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
 from planners.rotations import wxyz
 from sims import run_limits
+from sims.drives import DriveTrain, add_drive_train, motor_joint, servo_gains, transmission_stiffness
 from sims.plant import set_inertial
 from sims.runner import RunLog
 
@@ -57,17 +58,63 @@ def check_elevation(elevation_deg: float) -> float:
     return float(elevation_deg)
 
 
-@functools.lru_cache(maxsize=16)
-def _compiled(elevation_deg: float) -> mujoco.MjModel:
-    """The nominal scene at ``elevation_deg`` (deg), compiled."""
-    return _spec(elevation_deg).compile()
+#: One strut's drive train as built (models/hexapod/README.md "Drives as built" gives each
+#: number's source or assumption): a brushless servo motor through a 10:1 precision planetary
+#: gearbox on a 40 x 10 mm ball screw, N = 2 pi 10 / 0.01 m = 6283 rad/m; the nut, the screw
+#: shaft and the support bearings in series as one axial stiffness; the drive's position and
+#: velocity loops (a 20 Hz, zeta 0.7 position loop against the reflected rotor and a strut's
+#: share of the payload).
+STRUT_RATIO = 2.0 * math.pi * 10.0 / 0.010
+STRUT_ROTOR_INERTIA = 4e-4  # kg m^2
+STRUT_EFFICIENCY = 0.97 * 0.9  # the planetary stage's and the ball screw's
+STRUT_TORQUE_CONSTANT = 0.9  # N m/A
+STRUT_LOOP_INERTIA = STRUT_ROTOR_INERTIA * STRUT_RATIO ** 2 + 1000.0  # kg: rotor + a strut's share
+STRUT_KP, STRUT_KV = servo_gains(STRUT_LOOP_INERTIA, 20.0, 0.7)
+#: The drive's current limits, set to the strut's 50 kN rating and a 40 kN continuous load, A.
+_AMPS_PER_NEWTON = 1.0 / (STRUT_TORQUE_CONSTANT * STRUT_RATIO * STRUT_EFFICIENCY)
+STRUT_DRIVE = DriveTrain(
+    ratio=STRUT_RATIO, rotor_inertia=STRUT_ROTOR_INERTIA, torque_constant=STRUT_TORQUE_CONSTANT,
+    peak_current=50e3 * _AMPS_PER_NEWTON, continuous_current=40e3 * _AMPS_PER_NEWTON,
+    max_motor_speed=6000 * 2 * math.pi / 60, efficiency=STRUT_EFFICIENCY,
+    stiffness=2.8e8, coulomb_friction=1300.0, viscous_friction=2.0e4,
+    kp=STRUT_KP, kv=STRUT_KV, encoder_resolution=50e-9)
+#: Bending stiffness of each end flexure about each axis, N m/rad (the universal joints'
+#: stiffness, zero moment at the zero pose).
+FLEXURE_STIFFNESS = 2.6e4
+
+
+def strut_drive(plant: "HexapodPlant | None" = None) -> DriveTrain:
+    """A strut's drive train as built (``STRUT_DRIVE``), with ``plant``'s errors of its friction,
+    screw stiffness and torque constant."""
+    drive = STRUT_DRIVE
+    if plant is None:
+        return drive
+    # A torque constant off by e scales every force the drive makes, its loops' too.
+    torque = 1.0 + plant.torque_constant_error
+    return drive.replace(coulomb_friction=drive.coulomb_friction * (1.0 + plant.friction_error),
+                         viscous_friction=drive.viscous_friction * (1.0 + plant.friction_error),
+                         stiffness=drive.stiffness * (1.0 + plant.screw_stiffness_error),
+                         torque_constant=drive.torque_constant * torque, kp=drive.kp * torque, kv=drive.kv * torque)
+
+
+#: The drive options: the struts' drive trains as built (``STRUT_DRIVE``: motor, gearbox, ball
+#: screw, friction, the drive's loops, the linear encoder) or the ideal servo of the MJCF
+#: (one stiff PD per strut on the strut's own slide).
+DRIVES = ("as-built", "ideal")
 
 
 @functools.lru_cache(maxsize=16)
-def _compiled_plant(elevation_deg: float, plant: "HexapodPlant") -> mujoco.MjModel:
-    """The scene at ``elevation_deg`` (deg) perturbed into the plant ``plant``, compiled."""
-    spec = _spec(elevation_deg)
-    apply_plant(spec, plant, _compiled(elevation_deg))
+def _compiled(elevation_deg: float, drives: str = "ideal") -> mujoco.MjModel:
+    """The nominal scene at ``elevation_deg`` (deg) with ``drives`` (``DRIVES``), compiled."""
+    return _spec(elevation_deg, drives).compile()
+
+
+@functools.lru_cache(maxsize=16)
+def _compiled_plant(elevation_deg: float, plant: "HexapodPlant", drives: str = "ideal") -> mujoco.MjModel:
+    """The scene at ``elevation_deg`` (deg) with ``drives`` perturbed into the plant ``plant``,
+    compiled."""
+    spec = _spec(elevation_deg, drives, plant)
+    apply_plant(spec, plant, _compiled(elevation_deg, drives))
     return spec.compile()
 
 
@@ -76,9 +123,21 @@ def _compiled_plant(elevation_deg: float, plant: "HexapodPlant") -> mujoco.MjMod
 PLATFORM_KEY_QPOS = -7
 
 
-def _spec(elevation_deg: float) -> mujoco.MjSpec:
-    """The scene's MjSpec with the top end tilted to ``elevation_deg`` (deg)."""
+def _spec(elevation_deg: float, drives: str = "ideal", plant: "HexapodPlant | None" = None) -> mujoco.MjSpec:
+    """The scene's MjSpec with the top end tilted to ``elevation_deg`` (deg) and its struts'
+    drives (``DRIVES``; as built: ``STRUT_DRIVE``, with ``plant``'s errors of its elements)."""
+    if drives not in DRIVES:
+        raise LimitError(f"drives = {drives!r} is not one of {', '.join(DRIVES)}")
     spec = mujoco.MjSpec.from_file(str(models.scene_path("hexapod")))
+    if drives == "as-built":
+        drive = strut_drive(plant)
+        for name in STRUT_LABELS:
+            add_drive_train(spec, name, name, drive)
+            for axis in ("u1", "u2"):
+                spec.joint(f"{name}_{axis}").stiffness = [FLEXURE_STIFFNESS, 0.0, 0.0]
+        # 30 dofs and 24 constraint rows: the dense constraint Jacobian is the faster one
+        # (0.8 us a step less than MuJoCo's automatic choice, sparse, measured).
+        spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
     top_end = spec.body("top_end")
     rotation = top_end_rotation(elevation_deg)
     origin = np.array(top_end.pos)
@@ -89,7 +148,10 @@ def _spec(elevation_deg: float) -> mujoco.MjSpec:
     platform.pos = platform_pos
     platform.quat = quat
     key = spec.key("home")
-    qpos = np.array(key.qpos)
+    # Every joint but the platform's is at 0 at home (the model's zero pose), the motors'
+    # too: the key's qpos is rebuilt for the joints the drives added.
+    hinges = sum(1 for j in spec.joints if j.type != mujoco.mjtJoint.mjJNT_FREE)
+    qpos = np.zeros(hinges + 7)
     free = PLATFORM_KEY_QPOS
     qpos[free:free + 3] = platform_pos
     qpos[free + 3:] = quat
@@ -151,16 +213,20 @@ class HexapodPhysics(dm_mujoco.Physics):
     #: encoders' biases (m; None: none).
     geometry = RUBIN_CAMERA
     encoder_bias = None
+    drives = "ideal"
 
     @classmethod
-    def load(cls, elevation_deg: float = 90.0, plant: "HexapodPlant | None" = None) -> "HexapodPhysics":
-        """The scene at ``elevation_deg`` (deg) at its home keyframe; ``plant`` (None: the
-        nominal plant) the true machine, perturbed as ``HexapodPlant`` says (``apply_plant``)."""
+    def load(cls, elevation_deg: float = 90.0, plant: "HexapodPlant | None" = None,
+             drives: str = "ideal") -> "HexapodPhysics":
+        """The scene at ``elevation_deg`` (deg) at its home keyframe with the struts' ``drives``
+        (``DRIVES``); ``plant`` (None: the nominal plant) the true machine, perturbed as
+        ``HexapodPlant`` says (``apply_plant``)."""
         elevation_deg = check_elevation(elevation_deg)
         nominal = plant is None or plant.is_nominal
-        model = _compiled(elevation_deg) if nominal else _compiled_plant(elevation_deg, plant)
+        model = _compiled(elevation_deg, drives) if nominal else _compiled_plant(elevation_deg, plant, drives)
         physics = cls.from_model(dm_mujoco.wrapper.MjModel(copy.copy(model)))
         physics.elevation_deg = elevation_deg
+        physics.drives = drives
         if not nominal:
             physics.geometry = plant.geometry()
             physics.encoder_bias = plant.encoder_bias_si()
@@ -179,6 +245,24 @@ class HexapodPhysics(dm_mujoco.Physics):
         """dof index of each strut's slide."""
         model = self.model.ptr
         return np.array([model.joint(n).dofadr[0] for n in STRUT_LABELS])
+
+    @functools.cached_property
+    def drive_qpos(self) -> np.ndarray:
+        """qpos index of the coordinate each strut's drive acts on and its loops read: the
+        motor's (as built), the strut's slide (ideal)."""
+        model = self.model.ptr
+        return np.array([model.jnt_qposadr[motor_joint(model, n)] for n in STRUT_LABELS])
+
+    @functools.cached_property
+    def drive_dofs(self) -> np.ndarray:
+        model = self.model.ptr
+        return np.array([model.jnt_dofadr[motor_joint(model, n)] for n in STRUT_LABELS])
+
+    @functools.cached_property
+    def transmission_stiffness(self) -> np.ndarray:
+        """(6,) each strut's axial stiffness between its motor and its rod, N/m (inf: ideal)."""
+        model = self.model.ptr
+        return np.array([transmission_stiffness(model, n) for n in STRUT_LABELS])
 
     @functools.cached_property
     def strut_actuators(self) -> np.ndarray:
@@ -300,6 +384,12 @@ class HexapodPhysics(dm_mujoco.Physics):
             data.qpos[self.strut_qpos[i]] = length - model.body(f"{name}_rod").pos[2]
         data.qvel[:] = 0.0
         data.act[:] = data.qpos[self.strut_qpos]
+        if np.isfinite(self.transmission_stiffness).all():
+            # As built: each motor stands off its rod by the screw's deflection under the
+            # static load, F / k, so that the machine starts at rest.
+            force = static_drive_forces(self, data.qpos[self.strut_qpos][None, :])[0]
+            data.qpos[self.drive_qpos] = data.qpos[self.strut_qpos] + force / self.transmission_stiffness
+            data.act[:] = data.qpos[self.drive_qpos]
         mujoco.mj_forward(model, data)
 
     def set_struts(self, strut_positions, guess=None) -> None:
@@ -317,6 +407,44 @@ class HexapodPhysics(dm_mujoco.Physics):
         data = self.data.ptr
         rows = data.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
         return float(np.abs(data.efc_pos[rows]).max()) if rows.any() else 0.0
+
+
+def static_drive_forces(physics: HexapodPhysics, strut_positions: np.ndarray) -> np.ndarray:
+    """(n, 6) drive forces (N, push positive) that hold the hexapod statically with its struts
+    at ``strut_positions`` (n, 6) m (the nominal pivots' kinematics).
+
+    Exact statics of the model: the payload's weight, and each strut's own weight. A strut's
+    housing and rod hang on its base universal joint; the moment of their weights about it,
+    M = sum_k r_k x m_k g (r_k along the strut), is held by a transverse force at the top pivot,
+    F_t = (l x M) / |l|^2, whose reaction loads the platform. The rod's weight along the strut
+    is the drive's own. Tensions from ``planners.hexapod.static_strut_forces`` of the total
+    wrench on the platform.
+    """
+    model = physics.model.ptr
+    lengths = strut_positions + RUBIN_CAMERA.nominal_lengths
+    poses, _ = hexapod_planner.forward_kinematics(lengths)
+    mass, com_local = physics.payload_mass_properties()
+    gravity = physics.gravity_in_hexapod_frame()
+    origin, rotation = hexapod_planner.platform_frame(poses)
+    force = np.broadcast_to(mass * gravity, poses[:, :3].shape).copy()
+    moment = np.cross(rotation @ com_local, force)
+    pivots = hexapod_planner.pivot_positions(poses)
+    legs = pivots - RUBIN_CAMERA.base_pivots
+    leg_length = np.linalg.norm(legs, axis=-1, keepdims=True)
+    units = legs / leg_length
+    housing = np.array([model.body(f"{n}_housing").id for n in STRUT_LABELS])
+    rod = np.array([model.body(f"{n}_rod").id for n in STRUT_LABELS])
+    # Centres of mass along the strut from its base pivot, m (rod frame origin = tip).
+    housing_arm = model.body_ipos[housing, 2]
+    rod_arm = leg_length[..., 0] + model.body_ipos[rod, 2]
+    weight_moment = (model.body_mass[housing] * housing_arm + model.body_mass[rod] * rod_arm)
+    strut_moment = np.cross(units * weight_moment[..., None], gravity)
+    tip_force = np.cross(legs, strut_moment) / leg_length**2
+    force -= tip_force.sum(axis=1)
+    moment -= np.cross(pivots - origin[:, None, :], tip_force).sum(axis=1)
+    tension = hexapod_planner.static_strut_forces(poses, np.hstack([force, moment]))
+    rod_weight = model.body_mass[rod] * (units @ gravity)
+    return -tension - rod_weight
 
 
 def magnified_qpos(physics: HexapodPhysics, magnification: float):
@@ -337,9 +465,9 @@ def magnified_qpos(physics: HexapodPhysics, magnification: float):
     return frames
 
 
-def log_bytes_per_tick(wind: bool = True) -> float:
+def log_bytes_per_tick(wind: bool = True, drives: str = "ideal") -> float:
     """Bytes a hexapod run preallocates per control tick: the runner's log of the compiled
     model (6 planned struts), the controller's set-points and feed-forward forces (6 + 6
     doubles) and, with wind, its speed and force (1 + 3)."""
-    model = _compiled(DEFAULT_ELEVATION_DEG)  # every elevation has the same sizes
+    model = _compiled(DEFAULT_ELEVATION_DEG, drives)  # every elevation has the same sizes
     return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6 + (4 if wind else 0))

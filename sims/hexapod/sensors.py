@@ -5,18 +5,20 @@ from __future__ import annotations
 import dataclasses
 
 from sims.hexapod.params import CONTROL_DT
-from sims.hexapod.physics import HexapodPhysics
+from sims.hexapod.physics import STRUT_DRIVE, HexapodPhysics
 from sims.task import JointEncoders
 
 
 def sensors(physics: HexapodPhysics) -> JointEncoders:
     """The hexapod's sensors: the six strut encoders (length change from the zero pose),
-    exact, every tick (Rubin's encoders resolve far below the 1 um check; README.md), with the
-    plant's encoder bias (``physics.encoder_bias``) if it has one."""
+    every tick, with the plant's encoder bias (``physics.encoder_bias``) if it has one; with the
+    as-built drives they count in steps of the linear encoder's resolution
+    (``STRUT_DRIVE.encoder_resolution``), with the ideal ones they read exactly."""
     bias = physics.encoder_bias
     encoders = JointEncoders(physics.strut_qpos, physics.strut_dofs, physics.strut_act,
                              "strut encoders (length change from the zero pose)", "m", CONTROL_DT,
-                             bias=0.0 if bias is None else bias)
+                             bias=0.0 if bias is None else bias,
+                             resolution=STRUT_DRIVE.encoder_resolution if physics.drives == "as-built" else 0.0)
     if bias is not None and bias.any():
         # The datasheet a controller is given (ControlContext.sensors) cannot state the true
         # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").

@@ -125,6 +125,13 @@ class HexapodEvaluation:
         self.strut_starts = [hexapod_planner.strut_positions(np.asarray(m.start_pose, dtype=float)) for m in self.moves]
         self.strut_targets = [hexapod_planner.strut_positions(np.asarray(m.target_pose, dtype=float)) for m in self.moves]
 
+    def _demanded(self, log: RunLog) -> np.ndarray:
+        """(n, 6) the drives' demanded forces, N: their loops on the coordinate they read (the
+        motor's as built), before the force clamp."""
+        p = self.physics
+        return demanded_force(p.kp, p.kv, log.act[:, p.strut_act], p.drive_positions(log.qpos[:, p.drive_qpos]),
+                              log.qvel[:, p.drive_dofs])
+
     def _strut_log(self, log: RunLog):
         p = self.physics
         return log.qpos[:, p.strut_qpos], log.qvel[:, p.strut_dofs]
@@ -230,7 +237,7 @@ class HexapodEvaluation:
         poses = p.poses_from_qpos(log.qpos)
         judged = [self._judge_move(log, i, q, poses) for i in range(len(self.moves))]
         several = len(self.moves) > 1
-        demanded = demanded_force(p.kp, p.kv, log.act[:, p.strut_act], p.drive_positions(q), qd)
+        demanded = self._demanded(log)
         force = np.abs(demanded).max()
         stroke = np.abs(q).max()
         v_cmd = np.abs(ref.velocity).max()
@@ -348,7 +355,7 @@ class HexapodEvaluation:
             "strut_velocity_actual": qd,
             "setpoint": log.act[:, p.strut_act],
             "drive_force": log.actuator_force[:, p.strut_actuators],
-            "drive_force_demanded": demanded_force(p.kp, p.kv, log.act[:, p.strut_act], p.drive_positions(q), qd),
+            "drive_force_demanded": self._demanded(log),
             "drive_force_limit": p.force_limit,
             "pose_actual": p.poses_from_qpos(log.qpos),
             "target_pose": (np.asarray(self.moves[0].target_pose) if len(self.moves) == 1
@@ -453,7 +460,7 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
     trajectory, moves, starts, durations = plan_moves(params, planner)
     duration = params.duration if params.duration is not None else default_duration(starts, durations)
     run_limits.check_duration(duration, CONTROL_DT, params.log_bytes_per_tick())
-    physics = HexapodPhysics.load(params.elevation, plant)
+    physics = HexapodPhysics.load(params.elevation, plant, params.drives)
     start = moves[0].start_pose
     nominal_physics = None  # the nominal plant: a copy of the physics, as it is now
     if plant.is_nominal:
@@ -461,7 +468,7 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
     else:
         readings = hexapod_planner.strut_positions(np.asarray(start, dtype=float))
         physics.set_struts(readings - physics.encoder_bias, guess=start)
-        nominal = HexapodPhysics.load(params.elevation)
+        nominal = HexapodPhysics.load(params.elevation, drives=params.drives)
         nominal.set_pose(start)
         nominal_physics = nominal_copy(nominal)
     wind = None
