@@ -8,6 +8,7 @@ defaults and ranges, the scenario defaults, and the memory a run's log needs
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import mujoco
@@ -123,7 +124,7 @@ def _exp_so3(rotvec) -> np.ndarray:
     return mat.reshape(3, 3)
 
 
-def log_bytes_per_tick(imu: ImuModel = ImuModel()) -> float:
+def log_bytes_per_tick(imu: ImuModel = ImuModel(), drives: str = "ideal") -> float:
     """Bytes an antenna run preallocates per control tick: the runner's log of the compiled
     model (4 planned joints); the deck drive's ship-motion reference (t and 3 x 4) and its
     servo's set-points and feed-forward (4 + 4); the task's record of the planner's updates
@@ -132,14 +133,89 @@ def log_bytes_per_tick(imu: ImuModel = ImuModel()) -> float:
     REFERENCE_DT (t, 4 angles, error, iterations, two flags and its spline's 16
     coefficients)."""
     period, _ = imu.ticks(CONTROL_DT)
-    floats = (run_limits.runlog_floats_per_tick(_model(), 4) + 13 + 8 + (15 + 2 / 8) / period
+    floats = (run_limits.runlog_floats_per_tick(_model(drives), 4) + 13 + 8 + (15 + 2 / 8) / period
               + (7 + 2 / 8 + 16) * CONTROL_DT / REFERENCE_DT)
     return run_limits.floats(floats)
 
 
-@functools.lru_cache(maxsize=1)
-def _model() -> mujoco.MjModel:
-    return models.load("antenna")
+#: The drive options: the pedestal as built (``as_built``: motors, a belt on azimuth, geared
+#: axes with backlash, friction, the mast's bending mode, axis encoders) or the MJCF as it is.
+DRIVES = ("as-built", "ideal")
+#: The as-built pedestal (models/antenna/README.md "Drives as built"): each axis's reduction,
+#: its transmission's stiffness at the axis (N m/rad), the gears' backlash (rad), bearing and
+#: seal friction (N m), the axis encoders' count (rad), and the mast's bending mode (Hz, damping).
+AXIS_RATIO = 100.0
+BELT_STIFFNESS = 6.0e4
+GEAR_STIFFNESS = 7.9e4
+GEAR_BACKLASH = math.radians(3.0 / 60.0)
+AXIS_FRICTION = 1.0
+AXIS_ENCODER = 2.0 * math.pi / 2**17
+MAST_MODE_HZ, MAST_DAMPING_RATIO = 30.0, 0.02
+MAST_JOINTS = ("mast_x", "mast_y")
+
+
+def axis_drive(nominal: mujoco.MjModel, name: str, friction: float = AXIS_FRICTION):
+    """The drive train of the antenna axis ``name`` as built (``sims.drives.DriveTrain``): its
+    motor's rotor is the model's armature (J N^2), its loop gains and torque limit the model's
+    drive's; azimuth through a belt, the others through gears with backlash."""
+    from sims.drives import DriveTrain
+
+    joint, actuator = nominal.joint(name), nominal.actuator(name)
+    belt = name == "azimuth"
+    peak = float(actuator.forcerange[1])
+    torque_constant = 0.1  # N m/A, a 100-200 W servo motor (assumption)
+    return DriveTrain(
+        ratio=AXIS_RATIO, rotor_inertia=float(nominal.dof_armature[joint.dofadr[0]]) / AXIS_RATIO**2,
+        torque_constant=torque_constant, peak_current=peak / (torque_constant * AXIS_RATIO),
+        continuous_current=0.5 * peak / (torque_constant * AXIS_RATIO), max_motor_speed=3000 * 2 * math.pi / 60,
+        kp=float(actuator.gainprm[0]), kv=float(-actuator.biasprm[2]),
+        stiffness=BELT_STIFFNESS if belt else GEAR_STIFFNESS, backlash=0.0 if belt else GEAR_BACKLASH,
+        coulomb_friction=friction, encoder_resolution=AXIS_ENCODER)
+
+
+def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXIS_FRICTION) -> None:
+    """Edit the antenna's MjSpec into the pedestal as built: the mast's bending at the pedestal
+    (two hinges, ``MAST_JOINTS``, whose stiffness puts the mode at MAST_MODE_HZ against the
+    antenna's inertia about them) and each axis's drive train (``axis_drive``); the home
+    keyframe rebuilt for the joints added (the motors with their axes, the mast straight)."""
+    from sims.drives import MOTOR_SUFFIX, add_drive_train
+
+    pedestal = spec.body("pedestal")
+    for name, axis in zip(MAST_JOINTS, ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])):
+        pedestal.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    for name in JOINTS:
+        add_drive_train(spec, name, name, axis_drive(nominal, name, friction))
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    inertia = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, inertia)
+    omega = 2.0 * math.pi * MAST_MODE_HZ
+    for name in MAST_JOINTS:
+        i = model.joint(name).dofadr[0]
+        spec.joint(name).stiffness = [inertia[i, i] * omega**2, 0.0, 0.0]
+        spec.joint(name).damping = [2.0 * MAST_DAMPING_RATIO * inertia[i, i] * omega, 0.0, 0.0]
+    key = spec.key("home")
+    qpos, act = model.qpos0.copy(), np.zeros(model.na)
+    for j in range(nominal.njnt):
+        name = nominal.joint(j).name
+        value = nominal.key_qpos[0][nominal.jnt_qposadr[j]]
+        qpos[model.jnt_qposadr[model.joint(name).id]] = value
+        if name in JOINTS:
+            qpos[model.jnt_qposadr[model.joint(name + MOTOR_SUFFIX).id]] = value
+    for a in range(nominal.nu):
+        act[model.actuator_actadr[model.actuator(nominal.actuator(a).name).id]] = nominal.key_act[0][nominal.actuator_actadr[a]]
+    key.qpos, key.act = qpos, act
+
+
+@functools.lru_cache(maxsize=2)
+def _model(drives: str = "ideal") -> mujoco.MjModel:
+    """The nominal antenna with ``drives`` (``DRIVES``), compiled."""
+    if drives == "ideal":
+        return models.load("antenna")
+    spec = mujoco.MjSpec.from_file(str(models.scene_path("antenna")))
+    as_built(spec, models.load("antenna"))
+    return spec.compile()
 
 
 def satellite_of(params: "AntennaParams") -> tuple[float, float, float]:
@@ -187,6 +263,9 @@ class AntennaParams(ScenarioParams):
     imu: ImuModel = param(ImuModel(), "the pedestal IMU (sims.antenna.ImuModel: rate_hz, latency_s, "
                           "attitude_noise_deg, attitude_noise_time_s, gyro_noise_deg_s)")
     prediction: bool = param(True, "the controller predicts the IMU's latency away with its gyro")
+    drives: str = param("as-built", "the pedestal's drives: as-built (motors, an azimuth belt, geared axes with backlash, "
+                        "friction, the mast's 30 Hz bending, 17-bit axis encoders; models/antenna/README.md) or ideal "
+                        "(one stiff servo per axis on a rigid mast)", choices=DRIVES)
     duration: float = param(SEA_DURATION_S, "simulated time", "s", low=CONTROL_DT, reason="at least one control tick (5 ms)")
 
     def check(self) -> None:
@@ -210,7 +289,7 @@ class AntennaParams(ScenarioParams):
         run_limits.check_duration(self.duration, CONTROL_DT, self.log_bytes_per_tick())
 
     def log_bytes_per_tick(self) -> float:
-        return log_bytes_per_tick(self.imu)
+        return log_bytes_per_tick(self.imu, self.drives)
 
 
 @dataclass(frozen=True)
@@ -309,13 +388,15 @@ class AntennaPlant(PlantParams):
         """B = exp([imu_bias]x), (3, 3): measured attitude = true attitude B (world from IMU)."""
         return _exp_so3(np.radians(self.imu_bias))
 
-    def model(self) -> mujoco.MjModel:
+    def model(self, drives: str = "ideal") -> mujoco.MjModel:
         """models/antenna/scene.xml with this plant's masses, balance, friction and torque
         limits (MjSpec): body_mass and body_inertia of MOVING_BODIES times (1 + mass_error)
         (explicit inertials with the same principal axes), body_ipos of the polarization and
         reflector bodies moved by imbalance_offset, dof_frictionloss of the four antenna joints
         = joint_friction, their drives' actuator_forcerange times torque_limit_scale. MuJoCo
-        derives the rest (subtree masses, qM at qpos0) from them."""
+        derives the rest (subtree masses, qM at qpos0) from them. With the as-built ``drives``
+        the pedestal is then built (``as_built``), its axes' friction the model's plus
+        joint_friction, on the motors."""
         nominal = _model()
         spec = mujoco.MjSpec.from_file(str(models.scene_path("antenna")))
         shift = np.asarray(self.imbalance_offset) * 1e-3  # m; the reflector's axes are the antenna frame's
@@ -326,4 +407,7 @@ class AntennaPlant(PlantParams):
             spec.joint(name).frictionloss = self.joint_friction
             actuator = spec.actuator(name)
             actuator.forcerange = nominal.actuator_forcerange[nominal.actuator(name).id] * self.torque_limit_scale
+        if drives == "as-built":
+            edited = spec.compile()
+            as_built(spec, edited, AXIS_FRICTION + self.joint_friction)
         return spec.compile()

@@ -5,25 +5,35 @@ accessors of the deck and antenna joints, drives and sensors.
 
 from __future__ import annotations
 
+import copy
+
 import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import antenna as ant
-from sims.antenna.params import DECK_JOINTS, JOINTS, AntennaPlant
+from sims.antenna.params import DECK_JOINTS, JOINTS, AntennaPlant, _model
+from sims.drives import motor_joint
 from sims.antenna.ship_motion import world_from_ship
 
 
 class AntennaPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/antenna/scene.xml with named accessors."""
 
+    drives = "ideal"
+
     @classmethod
-    def load(cls, plant: "AntennaPlant | None" = None) -> "AntennaPhysics":
-        """The scene at its home keyframe; ``plant`` (None or nominal: the model as it is)
-        perturbs the compiled model (``AntennaPlant.model``)."""
-        model = models.load("antenna") if plant is None or plant.is_nominal else plant.model()
+    def load(cls, plant: "AntennaPlant | None" = None, drives: str = "ideal") -> "AntennaPhysics":
+        """The scene at its home keyframe with the pedestal's ``drives`` (``DRIVES``);
+        ``plant`` (None or nominal: the model as it is) perturbs the compiled model
+        (``AntennaPlant.model``)."""
+        if plant is not None and not plant.is_nominal:
+            model = plant.model(drives)
+        else:  # a model of its own: the nominal as-built compile is cached
+            model = models.load("antenna") if drives == "ideal" else copy.copy(_model(drives))
         physics = cls.from_model(dm_mujoco.wrapper.MjModel(model))
+        physics.drives = drives
         physics.reset(keyframe_id=0)
         return physics
 
@@ -46,6 +56,18 @@ class AntennaPhysics(dm_mujoco.Physics):
     @property
     def antenna_dofs(self) -> np.ndarray:
         return self.model.ptr.jnt_dofadr[self._ids(JOINTS, "joint")]
+
+    @property
+    def drive_qpos(self) -> np.ndarray:
+        """qpos index of the coordinate each axis's drive acts on and reads: its motor's (as
+        built), the axis's own (ideal)."""
+        model = self.model.ptr
+        return model.jnt_qposadr[[motor_joint(model, n) for n in JOINTS]]
+
+    @property
+    def drive_dofs(self) -> np.ndarray:
+        model = self.model.ptr
+        return model.jnt_dofadr[[motor_joint(model, n) for n in JOINTS]]
 
     @property
     def antenna_actuators(self) -> np.ndarray:
@@ -95,6 +117,9 @@ class AntennaPhysics(dm_mujoco.Physics):
         data.qvel[self.deck_dofs] = deck_velocity
         data.qpos[self.antenna_qpos] = theta
         data.qvel[self.antenna_dofs] = theta_rate
+        if self.drives != "ideal":  # the motors with their axes, the mast straight
+            data.qpos[self.drive_qpos] = theta
+            data.qvel[self.drive_dofs] = theta_rate
         kp, kv = self.drive_gains()
         data.act[self.antenna_actuators] = theta + kv / kp * theta_rate
         mujoco.mj_forward(self.model.ptr, data)

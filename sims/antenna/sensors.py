@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 
 from sims.task import JointEncoders, Sensors, SensorSpec
-from sims.antenna.params import AntennaPlant, ImuModel, _exp_so3
+from sims.antenna.params import AXIS_ENCODER, AntennaPlant, ImuModel, _exp_so3
 from sims.antenna.physics import AntennaPhysics
 
 
@@ -59,7 +59,8 @@ class AntennaImu(Sensors):
         self.bias_rotation = None if errors is None else errors.bias_rotation()
         self.encoders = JointEncoders(physics.antenna_qpos, physics.antenna_dofs,
                                       physics.model.ptr.actuator_actadr[physics.antenna_actuators],
-                                      "antenna joint encoders theta1 ... theta4", "rad", control_dt)
+                                      "antenna joint encoders theta1 ... theta4", "rad", control_dt,
+                                      resolution=AXIS_ENCODER if physics.drives == "as-built" else 0.0)
         self.specs = [
             SensorSpec("imu_attitude", "deck attitude of the pedestal IMU (world from IMU)", "rotation matrix",
                        imu.rate_hz, imu.latency_s,

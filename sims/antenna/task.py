@@ -168,12 +168,20 @@ class AntennaEvaluation:
         pointing, twist = pointing_errors(self.physics.dish_rotation(log.qpos), self.satellite)
         return np.degrees(pointing), np.degrees(twist)
 
+    def _demanded(self, log: RunLog) -> np.ndarray:
+        """(n, 4) the drives' demanded torques, N m: their loops on the coordinate they read
+        (the motor's as built), before the torque clamp."""
+        p = self.physics
+        kp, kv = p.drive_gains()
+        return demanded_force(kp, kv, log.act[:, p.antenna_actuators], log.qpos[:, p.drive_qpos],
+                              log.qvel[:, p.drive_dofs])
+
     def evaluate(self, log: RunLog):
         p = self.physics
         pointing, polarization = self.errors_deg(log)
         q, qd = self._joint_log(log)
         kp, kv = p.drive_gains()
-        torque = demanded_force(kp, kv, log.act[:, p.antenna_actuators], q, qd)
+        torque = self._demanded(log)
         torque_ratio = np.abs(torque).max(0) / p.torque_limit()
         rate_ratio = np.abs(qd).max(0) / p.rate_limit()
         ctrl_ratio = np.abs(log.ctrl[:, p.antenna_actuators]).max(0) / p.rate_limit()
@@ -240,7 +248,7 @@ class AntennaEvaluation:
             "ship_pitch": deck[:, 2], "ship_roll": deck[:, 3],
             "theta_planned": log.reference.position, "theta_actual": q, "theta_rate": qd,
             "setpoint": log.act[:, p.antenna_actuators],
-            "torque_demanded": demanded_force(kp, kv, log.act[:, p.antenna_actuators], q, qd),
+            "torque_demanded": self._demanded(log),
             "torque_limit": p.torque_limit(), "rate_limit": p.rate_limit(),
             "pointing_error_deg": pointing, "polarization_error_deg": polarization,
             "update_t": updates["t"], "update_theta": updates["theta"],
@@ -349,8 +357,9 @@ def _setup(motion, azimuth, elevation, polarization, duration, seed, pointing_ma
     perturbed = plant is not None and not plant.is_nominal
     # The plant (perturbed or not) and the model the planner and the controller know, both
     # at the same initial state; the deck's drive is the sea's, so it drives the plant.
-    physics = AntennaPhysics.load(plant if perturbed else None)
-    nominal = AntennaPhysics.load() if perturbed else physics
+    drives = params.drives if params is not None else "ideal"
+    physics = AntennaPhysics.load(plant if perturbed else None, drives)
+    nominal = AntennaPhysics.load(drives=drives) if perturbed else physics
     satellite = ant.satellite_attitude(azimuth, elevation, polarization)
     theta0 = start_angles(motion, satellite, azimuth, elevation, polarization)
     reference = ideal_path(motion, satellite, duration, theta0)
