@@ -15,14 +15,16 @@ import pytest
 import models
 from model_diff import changed_fields
 from plant_model import assert_edits_only
+from sims.antenna import params as antenna_params
 from sims import antenna, api, runner, scenarios
 from sims.antenna.ship_motion import world_from_ship
 from sims.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("antenna-sea-state")
-#: The IMU without noise: what a perturbation does is then not hidden by the noise.
-QUIET = dict(imu={"attitude_noise_deg": 0.0, "gyro_noise_deg_s": 0.0})
+#: The IMU without noise and the ideal drives: what a perturbation does is then not hidden by
+#: the noise, nor by the gears' backlash and friction (tests/test_antenna_drives.py).
+QUIET = dict(imu={"attitude_noise_deg": 0.0, "gyro_noise_deg_s": 0.0}, drives="ideal")
 #: Every field off nominal at once, inside its range.
 EVERYTHING = dict(mass_error=0.1, imbalance_offset=(4.0, -3.0, 2.0), joint_friction=1.0, torque_limit_scale=0.8,
                   imu_bias=(0.05, -0.02, 0.1))
@@ -124,7 +126,7 @@ def test_the_imu_bias_is_the_sensor_s_and_leaves_the_model():
 
 def test_the_controller_gets_the_nominal_model_at_the_plant_s_start():
     setup = build(0.1, EVERYTHING)
-    nominal = models.load("antenna")
+    nominal = antenna_params._model(setup.provenance.params.drives)  # the as-built model, unperturbed
     assert changed_fields(nominal, setup.physics.model.ptr)  # the plant is perturbed
     given = setup.task.nominal_physics()
     assert changed_fields(nominal, given.model.ptr) == {}

@@ -148,3 +148,24 @@ def test_each_sea_state_episode_has_its_own_sea():
     assert drive.motion is drive.built_motion
     task.setup.task.restore_initial_state(physics)
     np.testing.assert_array_equal(physics.data.qpos[deck], built)
+
+
+@pytest.mark.parametrize("mechanism", [m.name for m in scenarios.mechanisms()])
+def test_uniform_random_actions_in_the_spec_are_physically_realizable(mechanism):
+    """Every action inside a mechanism's bounded action spec is a command its drives accept:
+    five 1 s episodes of uniform random actions run without a PhysicsError."""
+    from dm_control.rl.control import PhysicsError
+
+    name = next(m for m in scenarios.mechanisms() if m.name == mechanism).scenarios[0].name
+    env = envs.make(name, duration=1.0)
+    spec = env.action_spec()
+    assert np.isfinite(spec.minimum).all() and np.isfinite(spec.maximum).all()
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        step = env.reset()
+        try:
+            while not step.last():
+                step = env.step(rng.uniform(spec.minimum, spec.maximum))
+        except PhysicsError as error:
+            pytest.fail(f"{name}: {error}")
+        assert np.isfinite(env.physics.data.qpos).all()

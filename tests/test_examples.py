@@ -72,7 +72,7 @@ def test_antenna_sample_and_hold_lags_the_paper_motion_and_holds_the_sea(tmp_pat
     assert {"pointing_error_max", "polarization_error_max"} <= failed(checks)
     summary, checks = run(tmp_path / "sea", "antenna-sea-state", "controller",
                           "antenna/hold_controller.py:SampleAndHold", "--duration", "30")
-    assert summary["passed"] and checks["pointing_error_rms"]["value"] > 0.05  # deg: 0.076, ours 0.028
+    assert summary["passed"] and checks["pointing_error_rms"]["value"] > 0.05  # deg: 0.090, ours 0.040 (as built)
 
 
 def test_fast_feedforward_alone_is_worse_than_the_stabilized_feed(tmp_path):

@@ -166,3 +166,16 @@ def test_shell_tip_sensor_matches_planner_kinematics(supply):
     tip_speed = np.linalg.norm(np.diff(expected, axis=0), axis=1) / setup.task.control_dt
     lag = np.linalg.norm(tip - expected, axis=1)
     assert np.all(lag[1:] <= 1.5 * tip_speed.max() * step + 1e-9)
+
+
+@pytest.mark.parametrize("mass", [1e-12, 1e-7, 0.0])
+def test_a_shell_lighter_than_a_milligram_is_none(mass):
+    """MuJoCo cannot diagonalize the inertia of geoms that light (found by hypothesis at
+    1e-12 kg): the model then carries no shell, as at 0 kg, and still builds and runs."""
+    from sims.loader.physics import LoaderPhysics
+
+    physics = LoaderPhysics.load(mass)
+    model = physics.model.ptr
+    assert model.body_subtreemass[model.body("shell").id] == 0.0
+    scenario = scenarios.get("loader-supply")
+    runner.run("loader-supply", scenario.build(scenario.resolve(payload_mass=mass, duration=0.1)))

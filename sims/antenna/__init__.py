@@ -36,7 +36,7 @@ from __future__ import annotations
 from sims.scenarios import Mechanism
 from sims.antenna.params import (CONTROL_DT, DECK_JOINTS, IMU_ATTITUDE_NOISE_DEG, IMU_ATTITUDE_NOISE_TIME_S,
                                  IMU_GYRO_NOISE_DEG_S, IMU_LATENCY_MAX_S, IMU_LATENCY_S, IMU_RATE_HZ, IMU_RATE_MIN_HZ,
-                                 JOINTS, MAX_SAILED_M, MIN_SATELLITE_ELEVATION_DEG, MOVING_BODIES, PAPER_DURATION_S,
+                                 DRIVES, JOINTS, MAST_JOINTS, MAX_SAILED_M, MIN_SATELLITE_ELEVATION_DEG, MOVING_BODIES, PAPER_DURATION_S,
                                  REFERENCE_DT, SATELLITE_LON_DEG, SEA_DURATION_S, SEA_HEADING_DEG, SEA_HS_M, SEA_TP_S,
                                  SHIP_LAT_DEG, SHIP_LON_DEG, AntennaPaperParams, AntennaParams, AntennaPlant,
                                  AntennaSeaParams, ImuModel, log_bytes_per_tick, satellite_of)

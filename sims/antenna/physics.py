@@ -13,7 +13,7 @@ from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import antenna as ant
-from sims.antenna.params import DECK_JOINTS, JOINTS, AntennaPlant, _model
+from sims.antenna.params import DECK_JOINTS, JOINTS, MAST_JOINTS, AntennaPlant, _model
 from sims.drives import motor_joint
 from sims.antenna.ship_motion import world_from_ship
 
@@ -103,12 +103,29 @@ class AntennaPhysics(dm_mujoco.Physics):
         s = self.model.ptr.sensor(name)
         return slice(int(s.adr[0]), int(s.adr[0] + s.dim[0]))
 
-    def dish_rotation(self, qpos) -> np.ndarray:
-        """(n, 3, 3) world-from-antenna rotations of logged qpos rows: eTb(deck) f(Theta)."""
+    def pedestal_rotation(self, qpos) -> np.ndarray:
+        """(n, 3, 3) world-from-pedestal rotations of logged qpos rows: eTb(deck), times the
+        mast's bending Rx(mast_x) Ry(mast_y) as built (the IMU sits on the pedestal)."""
         qpos = np.atleast_2d(qpos)
         deck = qpos[:, self.deck_qpos]
-        return world_from_ship(deck[:, 1], deck[:, 2], deck[:, 3]) @ ant.forward_kinematics(
-            qpos[:, self.antenna_qpos])
+        rotation = world_from_ship(deck[:, 1], deck[:, 2], deck[:, 3])
+        if self.drives == "ideal":
+            return rotation
+        model = self.model.ptr
+        x, y = (qpos[:, model.jnt_qposadr[model.joint(n).id]] for n in MAST_JOINTS)
+        cx, sx, cy, sy = np.cos(x), np.sin(x), np.cos(y), np.sin(y)
+        zero, one = np.zeros_like(x), np.ones_like(x)
+        rx = np.stack([np.stack([one, zero, zero], -1), np.stack([zero, cx, -sx], -1),
+                       np.stack([zero, sx, cx], -1)], -2)
+        ry = np.stack([np.stack([cy, zero, sy], -1), np.stack([zero, one, zero], -1),
+                       np.stack([-sy, zero, cy], -1)], -2)
+        return rotation @ rx @ ry
+
+    def dish_rotation(self, qpos) -> np.ndarray:
+        """(n, 3, 3) world-from-antenna rotations of logged qpos rows: eTb(deck) (the mast's
+        bending) f(Theta)."""
+        qpos = np.atleast_2d(qpos)
+        return self.pedestal_rotation(qpos) @ ant.forward_kinematics(qpos[:, self.antenna_qpos])
 
     def set_state(self, deck_position, deck_velocity, theta, theta_rate) -> None:
         """Put the deck and the antenna at a state (SI) and the antenna set-points with it."""

@@ -20,6 +20,10 @@ ROBOT_CONTYPE = 1
 OBSTACLE_CONTYPE = 2
 
 
+#: The lightest shell the model carries, kg; lighter is none.
+MIN_PAYLOAD_KG = 1e-6
+
+
 class LoaderPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/loader/scene.xml with readable accessors."""
 
@@ -38,6 +42,10 @@ class LoaderPhysics(dm_mujoco.Physics):
             mass = shell_mass() if payload_mass is None else payload_mass
             if not nominal:
                 mass = mass * (1.0 + plant.payload_mass_error)
+            if mass < MIN_PAYLOAD_KG:
+                # MuJoCo cannot find the principal axes of geoms this light (their inertia's
+                # eigenvalues round to zero): a shell under a milligram is no shell.
+                mass = 0.0
             factor = mass / shell_mass()
             if factor != 1.0:
                 for geom in spec.body("shell").find_all(mujoco.mjtObj.mjOBJ_GEOM):
