@@ -71,11 +71,22 @@ class ServoFeedforwardController:
 
     def feedforward_forces(self, context) -> np.ndarray:
         """(n, nu) drive forces along the reference: inverse dynamics of the nominal model in
-        free space, from its initial configuration."""
+        free space, from its initial configuration. With a drive train as built the motor
+        moves with its load (the transmission's deflection is added to the set-points in
+        ``reset``): the drive's force is the load's plus the rotor's, at the motor's dof."""
         reference = context.reference
         nu = reference.position.shape[1]
         nominal = context.nominal_physics()
-        qpos_adr, dofs = self.joint_addresses(nominal.model.ptr, self.actuator_ids)
+        model = nominal.model.ptr
+        qpos_adr, dofs = self.joint_addresses(model, self.actuator_ids)
+        motors = model.actuator_trnid[self.actuator_ids, 0]
+        if np.any(motors != [load_joint(model, int(a)) for a in self.actuator_ids]):
+            # The motors' coordinates follow the loads'; qfrc_inverse summed over both dofs.
+            qpos_adr = np.concatenate([qpos_adr, model.jnt_qposadr[motors]])
+            dofs = np.concatenate([dofs, model.jnt_dofadr[motors]])
+            reference = type(reference)(reference.t, *(np.hstack([x, x]) for x in
+                                                       (reference.position, reference.velocity,
+                                                        reference.acceleration)))
         n = reference.t.size
         tau = np.zeros((n, nu))
         # A copy of the model (MjModel's copy is a full mj_copyModel) with contacts
@@ -91,7 +102,8 @@ class ServoFeedforwardController:
             inv_data.qacc[:] = 0.0
             inv_data.qacc[dofs] = reference.acceleration[i]
             mujoco.mj_inverse(inv_model, inv_data)
-            tau[i] = inv_data.qfrc_inverse[dofs]
+            forces = inv_data.qfrc_inverse[dofs]
+            tau[i] = forces if forces.size == nu else forces[:nu] + forces[nu:]
         return tau
 
     def reset(self, context) -> None:

@@ -32,6 +32,7 @@ load's position in steps of ``encoder_resolution``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -112,8 +113,6 @@ class DriveTrain:
         return math.isinf(self.stiffness)
 
     def replace(self, **changes) -> "DriveTrain":
-        import dataclasses
-
         return dataclasses.replace(self, **changes)
 
 

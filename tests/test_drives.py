@@ -150,3 +150,27 @@ def test_an_encoder_reads_whole_counts(position, resolution):
     count = reading / resolution
     assert count == pytest.approx(round(count), abs=1e-6)
     assert 0.0 <= position - reading < resolution * (1 + 1e-9)
+
+
+def test_the_servo_feedforward_through_a_drive_train_is_the_load_s_plus_the_rotor_s():
+    """Inverse dynamics on a model with a drive train as built: the motor moves with its load,
+    so the feed-forward is (M + J N^2) a, not a force stretching the transmission."""
+    from planners.trajectory import TrajectorySample
+    from sims.controllers import ServoFeedforwardController
+    from sims.task import ControlContext
+
+    train = drive()
+    model = axis_model(train)
+    physics = type("P", (), {"model": type("M", (), {"ptr": model})(), "data": type("D", (), {"ptr": mujoco.MjData(model)})()})()
+    physics.data.qpos = physics.data.ptr.qpos
+    n = 5
+    t = np.arange(n) * 0.005
+    a = np.full((n, 1), 2.0)  # m/s^2
+    reference = TrajectorySample(t, 0.5 * a * t[:, None] ** 2, a * t[:, None], a)
+    context = ControlContext(model=model, nominal_physics=lambda: physics, problem=None, trajectory=None,
+                             reference=reference, control_dt=0.005, command=np.zeros(1), setpoint=np.zeros(1),
+                             actuators=("axis",), observation={})
+    servo = ServoFeedforwardController()
+    servo.reset(context)
+    mass = LOAD_MASS + train.reflected_inertia + drives.ROTOR_BODY_MASS  # the rotor body moves too
+    np.testing.assert_allclose(servo.tau_ff[:, 0], mass * 2.0, rtol=1e-9)

@@ -13,6 +13,7 @@ from dm_control import mujoco as dm_mujoco
 
 import models
 from planners import antenna as ant
+from planners.rotations import rot_x, rot_y
 from sims.antenna.params import DECK_JOINTS, JOINTS, MAST_JOINTS, AntennaPlant, _model
 from sims.drives import motor_joint
 from sims.antenna.ship_motion import world_from_ship
@@ -113,13 +114,7 @@ class AntennaPhysics(dm_mujoco.Physics):
             return rotation
         model = self.model.ptr
         x, y = (qpos[:, model.jnt_qposadr[model.joint(n).id]] for n in MAST_JOINTS)
-        cx, sx, cy, sy = np.cos(x), np.sin(x), np.cos(y), np.sin(y)
-        zero, one = np.zeros_like(x), np.ones_like(x)
-        rx = np.stack([np.stack([one, zero, zero], -1), np.stack([zero, cx, -sx], -1),
-                       np.stack([zero, sx, cx], -1)], -2)
-        ry = np.stack([np.stack([cy, zero, sy], -1), np.stack([zero, one, zero], -1),
-                       np.stack([-sy, zero, cy], -1)], -2)
-        return rotation @ rx @ ry
+        return rotation @ rot_x(x) @ rot_y(y)
 
     def dish_rotation(self, qpos) -> np.ndarray:
         """(n, 3, 3) world-from-antenna rotations of logged qpos rows: eTb(deck) (the mast's

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from sims.controllers import ServoFeedforwardController
-from sims.hexapod.physics import HexapodPhysics, static_drive_forces
+from sims.hexapod.physics import static_drive_forces
 
 INTEGRAL_TIME_S = 0.1  # integral action's time constant; the lowest mode is ~12 Hz
 
@@ -18,7 +18,7 @@ class HexapodController(ServoFeedforwardController):
     the set-point, integral action on the encoder error) with its feed-forward replaced:
     inverse dynamics does not apply to the closed loops, so f_ff is the set of drive forces
     that hold the payload in static equilibrium at the reference pose, what a real hexapod's
-    gravity table supplies (``static_drive_forces``). The integral action takes what the
+    gravity table supplies (``sims.hexapod.physics.static_drive_forces``). The integral action takes what the
     model leaves out (wind, the constraint compliance, the payload's tiny inertial forces).
     Gains and force limits are read from the nominal model in ``reset``; the statics use the
     nominal model at the start pose (``ControlContext.nominal_physics``).
@@ -36,10 +36,5 @@ class HexapodController(ServoFeedforwardController):
         """(n, 6) the static drive forces along the reference, N (push positive)."""
         return self.tau_ff
 
-    def static_drive_forces(self, physics: HexapodPhysics, strut_positions: np.ndarray) -> np.ndarray:
-        """(n, 6) drive forces (N, push positive) that hold the reference poses statically
-        (``sims.hexapod.physics.static_drive_forces``)."""
-        return static_drive_forces(physics, strut_positions)
-
     def feedforward_forces(self, context) -> np.ndarray:
-        return self.static_drive_forces(context.nominal_physics(), context.reference.position)
+        return static_drive_forces(context.nominal_physics(), context.reference.position)
