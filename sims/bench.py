@@ -73,6 +73,13 @@ def bench_scenario(name: str, repeats: int = REPEATS) -> dict:
     # One more run with the loop's clocks on: physics, code under test, the testbed's own cost.
     profiled = pipeline.execute(scenario, scenario.params, profile=True)[1].log
     bare = bare_steps_per_second(pipeline.build(scenario, scenario.params), best_run.log.physics_steps)
+    drives_cost = None
+    if "drives" in type(scenario.params).names() and scenario.params.drives != "ideal":
+        # The drive trains' cost: the loop's wall time per tick against the ideal drives'.
+        ideal = scenario.params.replace(drives="ideal")
+        ideal_loop = max(result.log.physics_steps / result.log.loop_wall_s
+                         for _, result in (pipeline.execute(scenario, ideal) for _ in range(repeats)))
+        drives_cost = ideal_loop / best_loop - 1.0
     return {
         "scenario": name,
         "sim_time_s": best_run.sim_time_s,
@@ -85,6 +92,7 @@ def bench_scenario(name: str, repeats: int = REPEATS) -> dict:
         "planner_wall_s": best_run.metrics.get("planner_wall_s"),
         "physics_share": profiled.physics_wall_s / profiled.loop_wall_s,
         "code_under_test_share": profiled.controller_wall_s / profiled.loop_wall_s,
+        "drives_cost": drives_cost,
         "passed": best_run.passed,
     }
 
@@ -117,6 +125,10 @@ def format_table(rows: list[dict]) -> str:
             lines.append(f"{r['scenario']}: the online planner's updates take {r['planner_wall_s']:.2f} s "
                          f"({100 * share:.0f} % of the loop); without them loop/bare would be "
                          f"{r['loop_ratio'] / (1 - share):.2f}")
+    for r in rows:
+        if r.get("drives_cost") is not None:
+            lines.append(f"{r['scenario']}: the drive trains as built take {100 * r['drives_cost']:+.0f} % wall time "
+                         f"per physics step of the loop against the ideal drives (target <= +20 %)")
     for r in rows:
         if r["scenario"] == "fast-tracking":
             lines.append(f"fast-tracking: 20 min of observation (the plan's {r['sim_time_s']:.0f} s with the "

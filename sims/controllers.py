@@ -80,11 +80,13 @@ class ServoFeedforwardController:
         model = nominal.model.ptr
         qpos_adr, dofs = self.joint_addresses(model, self.actuator_ids)
         motors = model.actuator_trnid[self.actuator_ids, 0]
-        if np.any(motors != [load_joint(model, int(a)) for a in self.actuator_ids]):
-            # The motors' coordinates follow the loads'; qfrc_inverse summed over both dofs.
-            qpos_adr = np.concatenate([qpos_adr, model.jnt_qposadr[motors]])
-            dofs = np.concatenate([dofs, model.jnt_dofadr[motors]])
-            reference = type(reference)(reference.t, *(np.hstack([x, x]) for x in
+        # The channels whose motor is a coordinate of its own (a compliant transmission): the
+        # motor follows its load, and qfrc_inverse is summed over both dofs.
+        own = np.flatnonzero(motors != [load_joint(model, int(a)) for a in self.actuator_ids])
+        if own.size:
+            qpos_adr = np.concatenate([qpos_adr, model.jnt_qposadr[motors[own]]])
+            dofs = np.concatenate([dofs, model.jnt_dofadr[motors[own]]])
+            reference = type(reference)(reference.t, *(np.hstack([x, x[:, own]]) for x in
                                                        (reference.position, reference.velocity,
                                                         reference.acceleration)))
         n = reference.t.size
@@ -103,7 +105,8 @@ class ServoFeedforwardController:
             inv_data.qacc[dofs] = reference.acceleration[i]
             mujoco.mj_inverse(inv_model, inv_data)
             forces = inv_data.qfrc_inverse[dofs]
-            tau[i] = forces if forces.size == nu else forces[:nu] + forces[nu:]
+            tau[i] = forces[:nu]
+            tau[i, own] += forces[nu:]
         return tau
 
     def reset(self, context) -> None:

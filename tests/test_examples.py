@@ -37,7 +37,9 @@ def test_loader_plain_pd_fails_the_tracking_check(tmp_path):
 
 def test_loader_quintic_spline_passes(tmp_path):
     summary, checks = run(tmp_path, "loader-supply", "planner", "loader/quintic_planner.py:QuinticPlanner")
-    assert summary["passed"] and checks["keypoint_error"]["value"] < 0.01
+    # 0.0296 deg as built (the motors' friction dead band, F_c / kp = 0.0086 deg, and the reducers'
+    # compliance), 0.0019 deg on the ideal drives; the limit 0.1 deg.
+    assert summary["passed"] and checks["keypoint_error"]["value"] < 0.05
 
 
 def test_loader_quintic_spline_without_key_points_strikes_the_obstacles(tmp_path):

@@ -17,12 +17,21 @@ CONTROL_DT = 0.005  # s: 200 Hz motion controller; the drives run at the 0.5 ms 
 SETTLE_S = 0.5  # s simulated after the plan ends, so the arrival is seen at rest
 
 
-@functools.lru_cache(maxsize=1)
-def log_bytes_per_tick() -> float:
+#: The drive options: the arm's drive trains as built (motors, ball screw, RV and strain-wave
+#: reducers with their stiffness and backlash, friction, the motors' encoders;
+#: ``sims.loader.physics.as_built``) or the MJCF's ideal servos (one PD per joint).
+DRIVES = ("as-built", "ideal")
+
+
+@functools.lru_cache(maxsize=2)
+def log_bytes_per_tick(drives: str = "ideal") -> float:
     """Bytes a loader run preallocates per control tick: the runner's log of the compiled
-    model (6 planned joints) and the servo controller's set-points and feed-forward torques
-    (6 + 6 doubles). The contact list of loader-direct (a few hundred ticks) is left out."""
-    model = models.load("loader")
+    model with ``drives`` (6 planned joints) and the servo controller's set-points and
+    feed-forward torques (6 + 6 doubles). The contact list of loader-direct (a few hundred
+    ticks) is left out."""
+    from sims.loader.physics import LoaderPhysics  # the physics module imports this one
+
+    model = LoaderPhysics.load(drives=drives).model.ptr
     return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6)
 
 
@@ -50,6 +59,9 @@ class LoaderParams(ScenarioParams):
                                 low=0.0, high=90.0,
                                 reason="none to twice the 45 kg 155 mm shell the drives are sized for "
                                        "(models/loader/README.md)")
+    drives: str = param("as-built", "the arm's drives: as-built (motors, a ball screw, RV and strain-wave reducers "
+                        "with their stiffness and backlash, friction, the motors' encoders; models/loader/README.md) "
+                        "or ideal (one stiff servo per joint)", choices=DRIVES)
     duration: float | None = param(None, "simulated time; none: the key points' span plus the settle time",
                                    "s", low=CONTROL_DT, reason="at least one control tick (5 ms)")
 
@@ -59,7 +71,7 @@ class LoaderParams(ScenarioParams):
         run_limits.check_duration(duration, CONTROL_DT, self.log_bytes_per_tick())
 
     def log_bytes_per_tick(self) -> float:
-        return log_bytes_per_tick()
+        return log_bytes_per_tick(self.drives)
 
 
 #: Each encoder's zero offset range, in Table 1's units (mm, deg).
@@ -102,6 +114,25 @@ class LoaderPlant(PlantParams):
         low=0.5, high=1.0,
         reason="a drive delivers at most its rated force; down to half of it when derated (heat, a low DC bus, "
                "an aged motor); assumption")
+    friction_error: float = param(
+        0.0, "as-built drives: every axis's Coulomb and viscous friction relative to the model's", "fraction",
+        low=-0.5, high=1.0,
+        reason="reducer and seal friction varies with temperature, lubrication and load: half to twice the "
+               "model's (assumption; a cold robot joint's friction is several times a warm one's, "
+               "models/loader/README.md)")
+    reducer_stiffness_error: float = param(
+        0.0, "as-built drives: every reducer's torsional stiffness relative to the model's", "fraction",
+        low=-0.3, high=0.3,
+        reason="catalogue rigidity figures are typical values; unit-to-unit and mounting spread +-30 % "
+               "(assumption)")
+    backlash_error: float = param(
+        0.0, "as-built drives: the RV reducers' lost motion relative to the model's 1 arcmin", "fraction",
+        low=-1.0, high=2.0,
+        reason="none (a preloaded reducer) to three times the catalogue's 1 arcmin (a worn one; assumption)")
+    torque_constant_error: float = param(
+        0.0, "as-built drives: every motor's torque constant relative to its datasheet's (every force the "
+        "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
+        reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
     encoder_bias: tuple[float, ...] = param(
         (0.0,) * 6, "zero offset of each drive's encoder, theta1 (mm), theta2 ... theta6 (deg): the drive and "
         "the controller read q + bias", unit=_BIAS_UNITS, low=tuple(-b for b in _BIAS_LIMIT), high=_BIAS_LIMIT,

@@ -3,16 +3,21 @@ with the payload's mass, and the plant's edits of its MjSpec (``apply_plant``, `
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import functools
+import math
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
 import models
+from planners.errors import LimitError
+from sims.drives import TRANSMISSION_SUFFIX, DriveTrain, add_drive_train, motor_joint
 from sims.loader.collision import geoms_by_contype
-from sims.loader.params import LoaderPlant
+from sims.loader.params import DRIVES, LoaderPlant
 from sims.plant import set_inertial
 
 #: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
@@ -24,43 +29,150 @@ OBSTACLE_CONTYPE = 2
 MIN_PAYLOAD_KG = 1e-6
 
 
+@dataclass(frozen=True)
+class Transmission:
+    """One axis's transmission as built (models/loader/README.md "Drives as built").
+
+    Attributes:
+      kind: what it is, in words.
+      ratio: motor rad per joint unit (rad/m for the slide's screw).
+      stiffness: torsional (N m/rad) or axial (N/m) at the joint; inf: rigid.
+      backlash: lost motion at the joint, rad or m.
+      efficiency: of the reducer or screw.
+      torque_constant: of the motor, N m/A.
+    """
+
+    kind: str
+    ratio: float
+    stiffness: float
+    backlash: float
+    efficiency: float
+    torque_constant: float
+
+
+_ARCMIN = math.radians(1.0 / 60.0)
+#: Each axis's transmission: a preloaded ball screw on the rail (its axial mode, about 500 Hz
+#: against the reflected rotor, lies far above the 10 Hz loop: rigid); RV cycloidal reducers on
+#: the shoulder and elbow, Harmonic Drive strain-wave gears (no backlash) on the wrist.
+TRANSMISSIONS = {
+    "slide": Transmission("ball screw 32 x 10 mm, preloaded, direct drive", 2.0 * math.pi / 0.010, math.inf, 0.0,
+                          0.90, 1.0),
+    "shoulder": Transmission("RV cycloidal reducer (RV-320E class)", 120.0, 3.0e6, _ARCMIN, 0.85, 1.9),
+    "elbow": Transmission("RV cycloidal reducer (RV-160E class)", 120.0, 1.5e6, _ARCMIN, 0.85, 1.9),
+    "wrist_pitch": Transmission("strain-wave gear, size 50, ratio 50", 50.0, 2.8e5, 0.0, 0.75, 1.2),
+    "wrist_yaw": Transmission("strain-wave gear, size 32, ratio 50", 50.0, 7.8e4, 0.0, 0.75, 0.6),
+    "wrist_roll": Transmission("strain-wave gear, size 20, ratio 50", 50.0, 1.6e4, 0.0, 0.75, 0.3),
+}
+#: Coulomb friction and viscous friction at rated speed, each as a fraction of the axis's
+#: peak torque (reducer, bearings, seals; assumption, models/loader/README.md).
+COULOMB_FRACTION = 0.03
+VISCOUS_FRACTION = 0.03
+#: The motors' encoders (the arm has no joint-side encoders): counts per motor turn.
+MOTOR_ENCODER_COUNTS = 2**20
+
+
+def joint_drive(nominal: mujoco.MjModel, name: str, plant: "LoaderPlant | None" = None) -> DriveTrain:
+    """The drive train of the loader's joint ``name`` as built (``TRANSMISSIONS``), with ``plant``'s
+    errors of its friction, stiffness, backlash and torque constant. The motor's rotor is the
+    model's armature (J N^2), the drive's loop gains, peak torque and rated speed the model's."""
+    t = TRANSMISSIONS[name]
+    joint, actuator = nominal.joint(name), nominal.actuator(name)
+    peak = float(actuator.forcerange[1])
+    rated_speed = float(actuator.ctrlrange[1])
+    amps = 1.0 / (t.torque_constant * t.ratio * t.efficiency)  # A per N m (or N) at the joint
+    friction = 1.0 if plant is None else 1.0 + plant.friction_error
+    torque = 1.0 if plant is None else 1.0 + plant.torque_constant_error
+    stiffness = t.stiffness if plant is None else t.stiffness * (1.0 + plant.reducer_stiffness_error)
+    backlash = t.backlash if plant is None else t.backlash * (1.0 + plant.backlash_error)
+    # A torque constant off by e scales every force the drive makes, its loops' too.
+    return DriveTrain(
+        ratio=t.ratio, rotor_inertia=float(nominal.dof_armature[joint.dofadr[0]]) / t.ratio**2,
+        torque_constant=t.torque_constant * torque, peak_current=peak * amps, continuous_current=0.5 * peak * amps,
+        max_motor_speed=rated_speed * t.ratio, efficiency=t.efficiency,
+        kp=float(actuator.gainprm[0]) * torque, kv=float(-actuator.biasprm[2]) * torque,
+        stiffness=stiffness, backlash=backlash,
+        coulomb_friction=friction * COULOMB_FRACTION * peak,
+        viscous_friction=friction * VISCOUS_FRACTION * peak / rated_speed,
+        encoder_resolution=2.0 * math.pi / MOTOR_ENCODER_COUNTS / t.ratio)
+
+
+def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, plant: "LoaderPlant | None" = None) -> None:
+    """Edit the loader's MjSpec into the arm as built: each joint's drive train (``joint_drive``),
+    the home keyframe rebuilt for the motors' joints (each at its load's value)."""
+    for name in models.loader_spec().names:
+        add_drive_train(spec, name, name, joint_drive(nominal, name, plant))
+    # The friction's constraint rows on 11 dofs: the dense Jacobian is the faster one (7.1 against
+    # 7.7 us a step with MuJoCo's automatic choice, measured).
+    spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
+    model = spec.compile()
+    qpos = model.qpos0.copy()
+    for j in range(nominal.njnt):
+        name = nominal.joint(j).name
+        value = nominal.key_qpos[0][nominal.jnt_qposadr[j]]
+        qpos[model.jnt_qposadr[model.joint(name).id]] = value
+        qpos[model.jnt_qposadr[motor_joint(model, name)]] = value
+    spec.key("home").qpos = qpos
+
+
 class LoaderPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/loader/scene.xml with readable accessors."""
 
+    drives = "ideal"
+
     @classmethod
-    def load(cls, payload_mass: float = None, plant: "LoaderPlant | None" = None) -> "LoaderPhysics":
+    def load(cls, payload_mass: float = None, plant: "LoaderPlant | None" = None,
+             drives: str = "ideal") -> "LoaderPhysics":
         """The scene at its home keyframe; ``payload_mass`` (kg, None: the model's 45 kg) scales
         the shell's geoms' masses, so its inertia scales with them (same shape and density
         distribution), edited with MjSpec before compiling. ``plant`` (None: the nominal
         plant): the true machine, perturbed as ``LoaderPlant`` says (``apply_plant``); its
-        ``payload_mass_error`` makes the shell's true mass payload_mass (1 + error)."""
+        ``payload_mass_error`` makes the shell's true mass payload_mass (1 + error).
+        ``drives`` (``DRIVES``): the arm's drive trains as built (``as_built``) or the MJCF's
+        ideal servos."""
+        if drives not in DRIVES:
+            raise LimitError(f"drives = {drives!r} is not one of {', '.join(DRIVES)}")
         nominal = plant is None or plant.is_nominal
-        if nominal and (payload_mass is None or payload_mass == shell_mass()):
+        mass = shell_mass() if payload_mass is None else float(payload_mass)
+        if not nominal:
+            mass = mass * (1.0 + plant.payload_mass_error)
+        if mass < MIN_PAYLOAD_KG:
+            # MuJoCo cannot find the principal axes of geoms this light (their inertia's
+            # eigenvalues round to zero): a shell under a milligram is no shell.
+            mass = 0.0
+        if nominal and drives == "ideal" and mass == shell_mass():
             physics = cls.from_xml_path(str(models.scene_path("loader")))
         else:
-            spec = mujoco.MjSpec.from_file(str(models.scene_path("loader")))
-            mass = shell_mass() if payload_mass is None else payload_mass
-            if not nominal:
-                mass = mass * (1.0 + plant.payload_mass_error)
-            if mass < MIN_PAYLOAD_KG:
-                # MuJoCo cannot find the principal axes of geoms this light (their inertia's
-                # eigenvalues round to zero): a shell under a milligram is no shell.
-                mass = 0.0
-            factor = mass / shell_mass()
-            if factor != 1.0:
-                for geom in spec.body("shell").find_all(mujoco.mjtObj.mjOBJ_GEOM):
-                    geom.mass = geom.mass * factor
-            if not nominal:
-                apply_plant(spec, plant)
-            physics = cls.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
+            # A copy: the cached model is shared, a run's physics is its own.
+            physics = cls.from_model(dm_mujoco.wrapper.MjModel(
+                copy.copy(_compiled(mass, None if nominal else plant, drives))))
+        physics.drives = drives
         physics.reset(keyframe_id=0)
         return physics
 
     def set_start(self, q: np.ndarray) -> None:
-        """Joints and the drives' set-points at ``q`` (theta1 m, theta2 ... theta6 rad), at rest."""
+        """Joints at ``q`` (theta1 m, theta2 ... theta6 rad), at rest, and the drives' set-points
+        where they hold them there: with drive trains as built each motor stands off its load
+        by the deflection (and half the backlash) that carries the joint's static load, and
+        the set-point off its motor by that load / kp."""
         self.named.data.qpos[self.joint_names] = q
-        self.named.data.qvel[self.joint_names] = 0.0
+        self.data.qvel[:] = 0.0
         self.data.act[:] = q
+        if self.drives != "ideal":
+            model, data = self.model.ptr, self.data.ptr
+            motors = self.motor_qpos
+            data.qpos[motors] = q
+            mujoco.mj_forward(model, data)
+            load = data.qfrc_bias[_joint_dofs(self)]  # the static load at rest: gravity
+            tendons = self.transmission_ids
+            rigid = tendons < 0
+            stiffness = np.where(rigid, np.inf, model.tendon_stiffness[tendons])
+            half_band = np.where(rigid, 0.0, model.tendon_lengthspring[tendons, 1])
+            deflection = load / stiffness + np.sign(load) * half_band
+            data.qpos[motors] = q + deflection
+            mujoco.mj_forward(model, data)
+            drive = data.qfrc_bias[self.motor_dofs] + np.where(rigid, 0.0, load)
+            gains = model.actuator_gainprm[self.actuator_ids, 0]
+            data.act[model.actuator_actadr[self.actuator_ids]] = data.qpos[motors] + drive / gains
         self.forward()
 
     @property
@@ -73,6 +185,36 @@ class LoaderPhysics(dm_mujoco.Physics):
 
     def joint_velocities(self) -> np.ndarray:
         return self.named.data.qvel[self.joint_names].copy()
+
+    @property
+    def actuator_ids(self) -> np.ndarray:
+        """The drives of theta1 ... theta6."""
+        return np.array([self.model.ptr.actuator(n).id for n in self.joint_names])
+
+    @property
+    def motor_qpos(self) -> np.ndarray:
+        """qpos addresses of the coordinates the drives act on and their encoders read: each
+        joint's motor (as built; the slide's rigid screw: the slide itself), else the joint."""
+        model = self.model.ptr
+        return model.jnt_qposadr[[motor_joint(model, n) for n in self.joint_names]]
+
+    @property
+    def motor_dofs(self) -> np.ndarray:
+        model = self.model.ptr
+        return model.jnt_dofadr[[motor_joint(model, n) for n in self.joint_names]]
+
+    @property
+    def transmission_ids(self) -> np.ndarray:
+        """The tendon of each joint's compliant transmission, -1 where the transmission is
+        rigid (or the drives ideal)."""
+        model = self.model.ptr
+        ids = []
+        for n in self.joint_names:
+            try:
+                ids.append(model.tendon(n + TRANSMISSION_SUFFIX).id)
+            except KeyError:
+                ids.append(-1)
+        return np.array(ids)
 
     def setpoints(self) -> np.ndarray:
         """The drives' position set-points (their activations), m and rad."""
@@ -100,6 +242,23 @@ class LoaderPhysics(dm_mujoco.Physics):
 
     def obstacle_geoms(self) -> np.ndarray:
         return geoms_by_contype(self.model.ptr, OBSTACLE_CONTYPE)
+
+
+@functools.lru_cache(maxsize=8)
+def _compiled(mass: float, plant: "LoaderPlant | None", drives: str) -> mujoco.MjModel:
+    """The scene with a shell of ``mass`` kg, perturbed into ``plant`` (None: nominal), with
+    ``drives`` (``DRIVES``), compiled. The drive trains are built from the nominal model (their
+    gains and ratings the drives'), then the plant's edits apply on top."""
+    spec = mujoco.MjSpec.from_file(str(models.scene_path("loader")))
+    factor = mass / shell_mass()
+    if factor != 1.0:
+        for geom in spec.body("shell").find_all(mujoco.mjtObj.mjOBJ_GEOM):
+            geom.mass = geom.mass * factor
+    if drives == "as-built":
+        as_built(spec, models.load("loader"), plant)
+    if plant is not None:
+        apply_plant(spec, plant)
+    return spec.compile()
 
 
 def joint_kinds() -> list[str]:

@@ -7,21 +7,29 @@ import dataclasses
 import numpy as np
 
 from sims.loader.params import CONTROL_DT
-from sims.loader.physics import LoaderPhysics
+import models
+from sims.loader.physics import LoaderPhysics, joint_drive
 from sims.task import JointEncoders
 
 
 def sensors(physics: LoaderPhysics, bias=None) -> JointEncoders:
-    """The loader's sensors: the drives' encoders on theta1 ... theta6, exact, every tick
-    (no encoder figures are published for it; an assumption, README.md). ``bias`` (6,) m and
-    rad: the plant's encoder zero offsets (``LoaderPlant.encoder_bias``), added to every
-    reading; None or zeros: none."""
+    """The loader's sensors: the drives' encoders on theta1 ... theta6, every tick. With the
+    drives as built they are the motors' encoders (the arm has no joint-side ones, as an
+    industrial arm's): each reads its motor's angle over the transmission ratio, in counts of
+    2 pi / (2^20 N) (``sims.loader.physics.MOTOR_ENCODER_COUNTS``), so it does not see the
+    reducer's deflection or backlash; with the ideal drives they read the joints exactly.
+    ``bias`` (6,) m and rad: the plant's encoder zero offsets (``LoaderPlant.encoder_bias``),
+    added to every reading; None or zeros: none."""
     model = physics.model.ptr
-    joints = [model.joint(n) for n in physics.joint_names]
-    encoders = JointEncoders([j.qposadr[0] for j in joints], [j.dofadr[0] for j in joints],
+    ideal = physics.drives == "ideal"
+    resolution = 0.0 if ideal else [joint_drive(models.load("loader"), n).encoder_resolution
+                                    for n in physics.joint_names]
+    measures = "encoders of theta1 (m) ... theta6 (rad)" if ideal else \
+        "motor encoders of theta1 (m) ... theta6 (rad), read through the transmission ratios"
+    encoders = JointEncoders(physics.motor_qpos, physics.motor_dofs,
                              [model.actuator(n).actadr[0] for n in physics.joint_names],
-                             "encoders of theta1 (m) ... theta6 (rad)", "m|rad", CONTROL_DT,
-                             bias=0.0 if bias is None else bias)
+                             measures, "m|rad", CONTROL_DT, bias=0.0 if bias is None else bias,
+                             resolution=resolution)
     if bias is not None and np.any(bias):
         # The datasheet a controller is given (ControlContext.sensors) cannot state the true
         # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").

@@ -15,9 +15,13 @@ from sims.loader.collision import clearance, obstacle_contact_pairs
 from sims.loader.controller import reference_controller
 from sims.loader.params import CONTROL_DT, LoaderParams, LoaderPlant
 from sims.loader.physics import LoaderPhysics, _joint_dofs, plant_chain
+from sims.params import ParamError
 from sims.loader.sensors import sensors
 from sims.runner import RunLog, Setup
 from sims.task import Components, Provenance, Task, nominal_copy, plan_checked
+
+#: The plant's errors of the drive trains as built, which ideal drives do not have.
+AS_BUILT_PLANT_FIELDS = ("friction_error", "reducer_stiffness_error", "backlash_error", "torque_constant_error")
 
 #: Check limits. 0.1 deg at the key points is 3.8 mm at the 2.2 m reach of the shell tip, a
 #: small fraction of the 6 cm by which the planned path clears the obstacles; the run-wide
@@ -48,8 +52,10 @@ class LoaderEvaluation:
         self.encoder_bias = plant.encoder_bias_si()
 
     def _demanded(self, log: RunLog, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        """(n, 6) force/torque the drives demand, N and N m: their PD on what their encoders
-        read (q + encoder bias)."""
+        """(n, 6) force/torque the drives demand before their clamp, N and N m: their PD on
+        what their encoders read (the motors' coordinates as built, plus the encoder bias)."""
+        if self.physics.drives != "ideal":
+            q, qd = log.qpos[:, self.physics.motor_qpos], log.qvel[:, self.physics.motor_dofs]
         q_drive = q + self.encoder_bias if self.encoder_bias.any() else q
         return demanded_force(self.kp, self.kv, log.act, q_drive, qd)
 
@@ -169,17 +175,21 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
     (the controller sees only the encoders); the checks judge its true joints.
     """
     plant = LoaderPlant() if plant is None else plant
+    if params.drives == "ideal":
+        as_built_only = [f"{name} = {getattr(plant, name):g}" for name in AS_BUILT_PLANT_FIELDS if getattr(plant, name)]
+        if as_built_only:
+            raise ParamError(f"{', '.join(as_built_only)}: the plant's drive-train errors need drives = as-built")
     task = problem(params)
     planner = loader_planner.CubicBSplinePlanner() if planner is None else planner
     trajectory = plan_checked(planner, task, task.labels)
     duration = params.duration if params.duration is not None else trajectory.duration + params.settle
     run_limits.check_duration(duration, CONTROL_DT, params.log_bytes_per_tick())
-    physics = LoaderPhysics.load(params.payload_mass, plant)
+    physics = LoaderPhysics.load(params.payload_mass, plant, params.drives)
     bias = plant.encoder_bias_si()
     physics.set_start(task.key_points[0] - bias if bias.any() else task.key_points[0])
     nominal_physics = None  # the nominal plant: a copy of the physics, as it is now
     if not plant.is_nominal:
-        nominal = LoaderPhysics.load(params.payload_mass)
+        nominal = LoaderPhysics.load(params.payload_mass, drives=params.drives)
         nominal.set_start(task.key_points[0])
         nominal_physics = nominal_copy(nominal)
     evaluation = LoaderEvaluation(physics, task.key_times, task.key_points, plant)
@@ -198,4 +208,6 @@ def environment_reward(setup: Setup):
     # Lazy: sims.envs loads dm_control.suite (about a second), needed only by the environments.
     from sims.envs import joint_tracking_reward
 
-    return joint_tracking_reward(setup.task.sensors.qpos, np.deg2rad(0.1))
+    physics = setup.physics
+    return joint_tracking_reward(physics.model.ptr.jnt_qposadr[[physics.model.ptr.joint(n).id
+                                                                for n in physics.joint_names]], np.deg2rad(0.1))
