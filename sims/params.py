@@ -381,10 +381,27 @@ class PlantParams(Params):
     declares its fields in a subclass and its ``build`` takes ``plant=``.
     """
 
+    #: The fields that are errors of the drive trains as built (friction, stiffness, backlash,
+    #: torque constant): the ideal drives have none of those elements.
+    AS_BUILT_FIELDS = ()
+
     @property
     def is_nominal(self) -> bool:
         """True when every field has its nominal (default) value."""
         return self == type(self)()
+
+    def check_drives(self, drives: str) -> None:
+        """A ParamError, before any work, if ``drives`` is "ideal" and a field of
+        ``AS_BUILT_FIELDS`` is off nominal: an error of an element the ideal drives lack would
+        be silently ignored."""
+        if drives != "ideal":
+            return
+        nominal = type(self)()
+        given = [f"{name} = {getattr(self, name)!r}" for name in self.AS_BUILT_FIELDS
+                 if getattr(self, name) != getattr(nominal, name)]
+        if given:
+            raise ParamError(f"plant {', '.join(given)}: an error of the drive trains as built; "
+                             "the ideal drives have none (drives = as-built)")
 
 
 @typing.no_type_check

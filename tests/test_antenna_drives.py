@@ -75,3 +75,24 @@ def test_the_controller_reads_17_bit_axis_encoders():
     episode = runner.start_episode(setup)
     counts = episode.observation["joint_positions"] / spec.resolution
     np.testing.assert_allclose(counts, np.round(counts), atol=1e-6)
+
+
+def test_the_plants_drive_train_errors_edit_their_elements():
+    """transmission_stiffness_error scales the belt's and the gears' stiffness,
+    gear_backlash_error the gears' dead band (not the belt's: it has none), and
+    torque_constant_error every force the drive makes: its loop gains (the peak current stays,
+    so the torque limit scales too)."""
+    from sims.antenna.params import AntennaPlant
+
+    nominal = AntennaPhysics.load(drives="as-built").model.ptr
+    model = AntennaPhysics.load(AntennaPlant(transmission_stiffness_error=-0.3, gear_backlash_error=2.0,
+                                             torque_constant_error=0.1), drives="as-built").model.ptr
+    for name in JOINTS:
+        tendon = model.tendon(name + "_transmission").id
+        assert model.tendon_stiffness[tendon] == pytest.approx(0.7 * nominal.tendon_stiffness[tendon])
+        np.testing.assert_allclose(model.tendon_lengthspring[tendon], 3.0 * nominal.tendon_lengthspring[tendon])
+        a = model.actuator(name).id
+        assert model.actuator_gainprm[a, 0] == pytest.approx(1.1 * nominal.actuator_gainprm[a, 0])
+        assert model.actuator_biasprm[a, 2] == pytest.approx(1.1 * nominal.actuator_biasprm[a, 2])
+        assert model.actuator_forcerange[a, 1] == pytest.approx(1.1 * nominal.actuator_forcerange[a, 1])
+    assert model.tendon_lengthspring[model.tendon("azimuth_transmission").id].tolist() == [0.0, 0.0]

@@ -3,14 +3,19 @@
 gives the sums of |qpos|, |qvel|, |actuator_force| and |ctrl| over its log pinned here, recorded
 with the code before them. They are bit-for-bit equal on the machine that recorded them, and
 equal to round-off on another: the libraries' last bits differ by CPU. A change of behaviour
-moves them by far more than 1e-9."""
+moves them by far more than 1e-9. The ideal drives refuse the plant's errors of elements they
+do not have."""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 import pytest
 
+import models
 from sims import runner, scenarios
+from sims.params import ParamError
 
 PINNED = {
     'antenna-paper-motion': {'qpos': 252.34256240492317, 'qvel': 128.28624452325786, 'actuator_force': 20713686.967366107, 'ctrl': 127.9771675287166},
@@ -42,3 +47,37 @@ def test_the_as_built_drives_are_another_plant():
     log = runner.simulate(scenario.build(scenario.resolve(duration=0.3)))
     assert float(np.abs(log.actuator_force).sum()) != pytest.approx(PINNED["hexapod-sync-move"]["actuator_force"],
                                                                     rel=1e-6)
+
+
+def _with_drive_train_errors():
+    """(scenario, field, value) for every scenario whose plant declares errors of the drive
+    trains as built: each field at the top of its range."""
+    cases = []
+    for name in scenarios.SCENARIOS:
+        scenario = scenarios.get(name)
+        plant = scenario.plant
+        if plant is None or "drives" not in type(scenario.params).names():
+            continue
+        declared = {f.name: f.metadata["declared"] for f in dataclasses.fields(plant)}
+        cases += [(name, field, declared[field].high) for field in type(plant).AS_BUILT_FIELDS]
+    return cases
+
+
+@pytest.mark.parametrize("name, field, value", _with_drive_train_errors())
+def test_the_ideal_drives_refuse_errors_of_the_drive_trains(name, field, value, monkeypatch):
+    """An error of an element the ideal drives lack would be ignored: it is refused, naming the
+    field and its value, before any model file is opened."""
+    scenario = scenarios.get(name)
+    plant = scenario.resolve_plant({field: value})
+    params = scenario.resolve(drives="ideal", duration=0.01)
+    opened = []
+    original = models.scene_path
+    monkeypatch.setattr(models, "scene_path", lambda *a, **k: opened.append(a) or original(*a, **k))
+    with pytest.raises(ParamError, match=f"plant {field} = {value!r}: an error of the drive trains as built"):
+        scenario.build(params, plant=plant)
+    assert opened == []
+
+
+def test_every_mechanism_with_drive_trains_declares_their_errors():
+    cases = _with_drive_train_errors()
+    assert {name.split("-")[0] for name, _, _ in cases} == {"antenna", "hexapod", "loader"}

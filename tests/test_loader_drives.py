@@ -166,7 +166,7 @@ def test_the_plants_drive_train_errors_edit_their_elements():
 
 def test_the_drive_train_errors_need_the_as_built_drives():
     scenario = scenarios.get("loader-supply")
-    with pytest.raises(ParamError, match="friction_error = 0.5.*drives = as-built"):
+    with pytest.raises(ParamError, match="plant friction_error = 0.5: an error of the drive trains as built"):
         scenario.build(scenario.resolve(drives="ideal"), plant=LoaderPlant(friction_error=0.5))
     with pytest.raises(LimitError, match="'stiff' is not one of as-built, ideal"):
         LoaderPhysics.load(drives="stiff")

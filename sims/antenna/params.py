@@ -154,26 +154,34 @@ MAST_MODE_HZ, MAST_DAMPING_RATIO = 30.0, 0.02
 MAST_JOINTS = ("mast_x", "mast_y")
 
 
-def axis_drive(nominal: mujoco.MjModel, name: str, friction: float = AXIS_FRICTION):
+def axis_drive(nominal: mujoco.MjModel, name: str, friction: float = AXIS_FRICTION,
+               plant: "AntennaPlant | None" = None):
     """The drive train of the antenna axis ``name`` as built (``sims.drives.DriveTrain``): its
     motor's rotor is the model's armature (J N^2), its loop gains and torque limit the model's
-    drive's; azimuth through a belt, the others through gears with backlash."""
+    drive's; azimuth through a belt, the others through gears with backlash. ``plant`` (None:
+    nominal): its errors of the transmissions' stiffness, the gears' backlash and the motors'
+    torque constant (which scales every force the drive makes, its loops' too)."""
     from sims.drives import DriveTrain
 
     joint, actuator = nominal.joint(name), nominal.actuator(name)
     belt = name == "azimuth"
     peak = float(actuator.forcerange[1])
     torque_constant = 0.1  # N m/A, a 100-200 W servo motor (assumption)
+    torque = 1.0 if plant is None else 1.0 + plant.torque_constant_error
+    stiffness = 1.0 if plant is None else 1.0 + plant.transmission_stiffness_error
+    backlash = 1.0 if plant is None else 1.0 + plant.gear_backlash_error
     return DriveTrain(
         ratio=AXIS_RATIO, rotor_inertia=float(nominal.dof_armature[joint.dofadr[0]]) / AXIS_RATIO**2,
-        torque_constant=torque_constant, peak_current=peak / (torque_constant * AXIS_RATIO),
+        torque_constant=torque_constant * torque, peak_current=peak / (torque_constant * AXIS_RATIO),
         continuous_current=0.5 * peak / (torque_constant * AXIS_RATIO), max_motor_speed=3000 * 2 * math.pi / 60,
-        kp=float(actuator.gainprm[0]), kv=float(-actuator.biasprm[2]),
-        stiffness=BELT_STIFFNESS if belt else GEAR_STIFFNESS, backlash=0.0 if belt else GEAR_BACKLASH,
+        kp=float(actuator.gainprm[0]) * torque, kv=float(-actuator.biasprm[2]) * torque,
+        stiffness=(BELT_STIFFNESS if belt else GEAR_STIFFNESS) * stiffness,
+        backlash=0.0 if belt else GEAR_BACKLASH * backlash,
         coulomb_friction=friction, encoder_resolution=AXIS_ENCODER)
 
 
-def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXIS_FRICTION) -> None:
+def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXIS_FRICTION,
+             plant: "AntennaPlant | None" = None) -> None:
     """Edit the antenna's MjSpec into the pedestal as built: the mast's bending at the pedestal
     (two hinges, ``MAST_JOINTS``, whose stiffness puts the mode at MAST_MODE_HZ against the
     antenna's inertia about them) and each axis's drive train (``axis_drive``); the home
@@ -184,7 +192,7 @@ def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXI
     for name, axis in zip(MAST_JOINTS, ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])):
         pedestal.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
     for name in JOINTS:
-        add_drive_train(spec, name, name, axis_drive(nominal, name, friction))
+        add_drive_train(spec, name, name, axis_drive(nominal, name, friction, plant))
     model = spec.compile()
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
@@ -360,6 +368,8 @@ class AntennaPlant(PlantParams):
     tracking with it would; the checks still judge the true pointing.
     """
 
+    AS_BUILT_FIELDS = ("transmission_stiffness_error", "gear_backlash_error", "torque_constant_error")
+
     mass_error: float = param(
         0.0, "error of the moving antenna parts' masses and inertias (azimuth, elevation, cross-elevation, "
         "polarization and reflector bodies, 98 kg) as a fraction; centres of mass unchanged", "fraction",
@@ -378,6 +388,19 @@ class AntennaPlant(PlantParams):
         1.0, "the antenna drives' torque limits as a fraction of their ratings (40, 15, 12, 10 N m)", "fraction",
         low=0.5, high=1.0, reason="the rating is what a drive guarantees; derating (heat, low supply voltage) only "
         "lowers it; half the rating is still 5-10 times the torque the CRR path needs (README)")
+    transmission_stiffness_error: float = param(
+        0.0, "as-built drives: every axis's belt or gear stiffness relative to the model's", "fraction",
+        low=-0.3, high=0.3,
+        reason="belt tension and catalogue rigidity figures spread by tens of %: +-30 % (assumption)")
+    gear_backlash_error: float = param(
+        0.0, "as-built drives: the geared axes' backlash relative to the model's 3 arcmin", "fraction",
+        low=-1.0, high=2.0,
+        reason="none (anti-backlash gears) to 9 arcmin (economy planetaries have up to 8-10 arcmin, "
+               "models/antenna/README.md)")
+    torque_constant_error: float = param(
+        0.0, "as-built drives: every axis motor's torque constant relative to its datasheet's (every force the "
+        "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
+        reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
     imu_bias: tuple[float, ...] = param(
         (0.0, 0.0, 0.0), "constant attitude error of the IMU (its AHRS's bias and its mounting misalignment), "
         "a rotation vector about the IMU axes (x starboard, y bow, z up)", "deg", low=-2.0, high=2.0, length=3,
@@ -396,7 +419,8 @@ class AntennaPlant(PlantParams):
         = joint_friction, their drives' actuator_forcerange times torque_limit_scale. MuJoCo
         derives the rest (subtree masses, qM at qpos0) from them. With the as-built ``drives``
         the pedestal is then built (``as_built``), its axes' friction the model's plus
-        joint_friction, on the motors."""
+        joint_friction, on the motors, with this plant's errors of its transmissions' stiffness,
+        the gears' backlash and the motors' torque constant."""
         nominal = _model()
         spec = mujoco.MjSpec.from_file(str(models.scene_path("antenna")))
         shift = np.asarray(self.imbalance_offset) * 1e-3  # m; the reflector's axes are the antenna frame's
@@ -409,5 +433,5 @@ class AntennaPlant(PlantParams):
             actuator.forcerange = nominal.actuator_forcerange[nominal.actuator(name).id] * self.torque_limit_scale
         if drives == "as-built":
             edited = spec.compile()
-            as_built(spec, edited, AXIS_FRICTION + self.joint_friction)
+            as_built(spec, edited, AXIS_FRICTION + self.joint_friction, self)
         return spec.compile()

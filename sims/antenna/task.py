@@ -432,9 +432,11 @@ def build(params: "AntennaParams", planner=None, controller=None,
     method and the controller's prediction for tests (default: from the parameters).
     ``plant``: the plant's uncertainty (``AntennaPlant``; None or nominal: the model as it
     is); the planner and the controller keep the nominal model and the IMU's datasheet."""
+    if plant is not None:
+        plant.check_drives(params.drives)
     if antenna_options is None:
         antenna_options = AntennaOptions(imu=params.imu, predict=params.prediction)
-    run_limits.check_duration(params.duration, CONTROL_DT, log_bytes_per_tick(antenna_options.imu))
+    run_limits.check_duration(params.duration, CONTROL_DT, log_bytes_per_tick(antenna_options.imu, params.drives))
     az, el, pol = satellite_of(params)
     motion = motion_of(params)
     duration = params.duration

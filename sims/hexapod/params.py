@@ -121,6 +121,8 @@ class HexapodPlant(PlantParams):
     take the bias, ``geometry`` gives the plant's pivots (for its start and the video).
     """
 
+    AS_BUILT_FIELDS = ("friction_error", "screw_stiffness_error", "torque_constant_error")
+
     camera_mass_error: float = param(
         0.0, "true camera mass relative to the model's 3000 kg (its inertia scales with it)", "fraction",
         low=-0.1, high=0.1,

@@ -457,6 +457,7 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
     it. The controller sees only the encoders; the checks judge the platform's true pose.
     """
     plant = HexapodPlant() if plant is None else plant
+    plant.check_drives(params.drives)
     trajectory, moves, starts, durations = plan_moves(params, planner)
     duration = params.duration if params.duration is not None else default_duration(starts, durations)
     run_limits.check_duration(duration, CONTROL_DT, params.log_bytes_per_tick())

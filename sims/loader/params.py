@@ -114,6 +114,8 @@ class LoaderPlant(PlantParams):
         low=0.5, high=1.0,
         reason="a drive delivers at most its rated force; down to half of it when derated (heat, a low DC bus, "
                "an aged motor); assumption")
+    AS_BUILT_FIELDS = ("friction_error", "reducer_stiffness_error", "backlash_error", "torque_constant_error")
+
     friction_error: float = param(
         0.0, "as-built drives: every axis's Coulomb and viscous friction relative to the model's", "fraction",
         low=-0.5, high=1.0,

@@ -15,13 +15,9 @@ from sims.loader.collision import clearance, obstacle_contact_pairs
 from sims.loader.controller import reference_controller
 from sims.loader.params import CONTROL_DT, LoaderParams, LoaderPlant
 from sims.loader.physics import LoaderPhysics, _joint_dofs, plant_chain
-from sims.params import ParamError
 from sims.loader.sensors import sensors
 from sims.runner import RunLog, Setup
 from sims.task import Components, Provenance, Task, nominal_copy, plan_checked
-
-#: The plant's errors of the drive trains as built, which ideal drives do not have.
-AS_BUILT_PLANT_FIELDS = ("friction_error", "reducer_stiffness_error", "backlash_error", "torque_constant_error")
 
 #: Check limits. 0.1 deg at the key points is 3.8 mm at the 2.2 m reach of the shell tip, a
 #: small fraction of the 6 cm by which the planned path clears the obstacles; the run-wide
@@ -175,10 +171,7 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
     (the controller sees only the encoders); the checks judge its true joints.
     """
     plant = LoaderPlant() if plant is None else plant
-    if params.drives == "ideal":
-        as_built_only = [f"{name} = {getattr(plant, name):g}" for name in AS_BUILT_PLANT_FIELDS if getattr(plant, name)]
-        if as_built_only:
-            raise ParamError(f"{', '.join(as_built_only)}: the plant's drive-train errors need drives = as-built")
+    plant.check_drives(params.drives)
     task = problem(params)
     planner = loader_planner.CubicBSplinePlanner() if planner is None else planner
     trajectory = plan_checked(planner, task, task.labels)
