@@ -39,6 +39,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from sims.params import param
+
 #: Mass and inertia of a motor body (kg, kg m^2): the rotor's inertia is the dof's armature;
 #: MuJoCo needs a moving body to have some mass of its own.
 ROTOR_BODY_MASS = 1e-3
@@ -114,6 +116,27 @@ class DriveTrain:
 
     def replace(self, **changes) -> "DriveTrain":
         return dataclasses.replace(self, **changes)
+
+    def with_errors(self, friction: float = 0.0, stiffness: float = 0.0, backlash: float = 0.0,
+                    torque_constant: float = 0.0) -> "DriveTrain":
+        """This drive train as a plant off its datasheet: its Coulomb and viscous friction, its
+        transmission's stiffness, its backlash and its motor's torque constant each times
+        (1 + error). A torque constant off by e scales every force the drive makes: its loops'
+        gains and its peak (the drive's current limit stays)."""
+        torque = 1.0 + torque_constant
+        return dataclasses.replace(
+            self, coulomb_friction=self.coulomb_friction * (1.0 + friction),
+            viscous_friction=self.viscous_friction * (1.0 + friction), stiffness=self.stiffness * (1.0 + stiffness),
+            backlash=self.backlash * (1.0 + backlash), torque_constant=self.torque_constant * torque,
+            kp=self.kp * torque, kv=self.kv * torque)
+
+
+def torque_constant_error(motors: str):
+    """The plant-uncertainty field (``sims.params.param``) of the torque constant of
+    ``motors`` (in words) against their datasheet's, for ``DriveTrain.with_errors``."""
+    return param(0.0, f"as-built drives: {motors}' torque constant relative to the datasheet's (every force the "
+                 "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
+                 reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
 
 
 def servo_gains(inertia: float, bandwidth_hz: float, damping_ratio: float) -> tuple[float, float]:

@@ -19,6 +19,7 @@ from planners import antenna as ant
 from planners.errors import PlanningError
 from planners.antenna.geostationary import look_angles
 from sims import run_limits
+from sims.drives import torque_constant_error
 from sims.antenna.ship_motion import SEA_HS_MAX_M, SEA_TP_RANGE_S, check_sea_state
 from sims.params import ParamError, Params, PlantParams, ScenarioParams, override, param
 from sims.plant import set_inertial
@@ -167,17 +168,17 @@ def axis_drive(nominal: mujoco.MjModel, name: str, friction: float = AXIS_FRICTI
     belt = name == "azimuth"
     peak = float(actuator.forcerange[1])
     torque_constant = 0.1  # N m/A, a 100-200 W servo motor (assumption)
-    torque = 1.0 if plant is None else 1.0 + plant.torque_constant_error
-    stiffness = 1.0 if plant is None else 1.0 + plant.transmission_stiffness_error
-    backlash = 1.0 if plant is None else 1.0 + plant.gear_backlash_error
-    return DriveTrain(
+    drive = DriveTrain(
         ratio=AXIS_RATIO, rotor_inertia=float(nominal.dof_armature[joint.dofadr[0]]) / AXIS_RATIO**2,
-        torque_constant=torque_constant * torque, peak_current=peak / (torque_constant * AXIS_RATIO),
+        torque_constant=torque_constant, peak_current=peak / (torque_constant * AXIS_RATIO),
         continuous_current=0.5 * peak / (torque_constant * AXIS_RATIO), max_motor_speed=3000 * 2 * math.pi / 60,
-        kp=float(actuator.gainprm[0]) * torque, kv=float(-actuator.biasprm[2]) * torque,
-        stiffness=(BELT_STIFFNESS if belt else GEAR_STIFFNESS) * stiffness,
-        backlash=0.0 if belt else GEAR_BACKLASH * backlash,
+        kp=float(actuator.gainprm[0]), kv=float(-actuator.biasprm[2]),
+        stiffness=BELT_STIFFNESS if belt else GEAR_STIFFNESS, backlash=0.0 if belt else GEAR_BACKLASH,
         coulomb_friction=friction, encoder_resolution=AXIS_ENCODER)
+    if plant is None:
+        return drive
+    return drive.with_errors(stiffness=plant.transmission_stiffness_error, backlash=plant.gear_backlash_error,
+                             torque_constant=plant.torque_constant_error)
 
 
 def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXIS_FRICTION,
@@ -397,10 +398,7 @@ class AntennaPlant(PlantParams):
         low=-1.0, high=2.0,
         reason="none (anti-backlash gears) to 9 arcmin (economy planetaries have up to 8-10 arcmin, "
                "models/antenna/README.md)")
-    torque_constant_error: float = param(
-        0.0, "as-built drives: every axis motor's torque constant relative to its datasheet's (every force the "
-        "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
-        reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
+    torque_constant_error: float = torque_constant_error("the axis motors")
     imu_bias: tuple[float, ...] = param(
         (0.0, 0.0, 0.0), "constant attitude error of the IMU (its AHRS's bias and its mounting misalignment), "
         "a rotation vector about the IMU axes (x starboard, y bow, z up)", "deg", low=-2.0, high=2.0, length=3,

@@ -14,6 +14,7 @@ from planners import hexapod as hexapod_planner
 from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS
 from sims import run_limits
+from sims.drives import torque_constant_error
 from sims.hexapod.physics import DEFAULT_ELEVATION_DEG, DRIVES, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
 from sims.params import Params, ParamError, PlantParams, ScenarioParams, param
 from sims.wind import MEAN_SPEED
@@ -161,10 +162,7 @@ class HexapodPlant(PlantParams):
         0.0, "as-built drives: every strut's axial stiffness (screw, nut, bearings, gearbox) relative to the "
         "model's", "fraction", low=-0.3, high=0.3,
         reason="preload and bearing spread of catalogue rigidity figures, +-30 % (assumption)")
-    torque_constant_error: float = param(
-        0.0, "as-built drives: every strut motor's torque constant relative to its datasheet's (every force the "
-        "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
-        reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
+    torque_constant_error: float = torque_constant_error("the strut motors")
     encoder_bias_um: tuple[float, ...] = param(
         (0.0,) * 6, "zero offset of each strut's encoder, strut1 ... strut6: the drive and the controller read "
         "q + bias", "um", low=-10.0, high=10.0, length=6,

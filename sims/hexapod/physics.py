@@ -86,15 +86,10 @@ FLEXURE_STIFFNESS = 2.6e4
 def strut_drive(plant: "HexapodPlant | None" = None) -> DriveTrain:
     """A strut's drive train as built (``STRUT_DRIVE``), with ``plant``'s errors of its friction,
     screw stiffness and torque constant."""
-    drive = STRUT_DRIVE
     if plant is None:
-        return drive
-    # A torque constant off by e scales every force the drive makes, its loops' too.
-    torque = 1.0 + plant.torque_constant_error
-    return drive.replace(coulomb_friction=drive.coulomb_friction * (1.0 + plant.friction_error),
-                         viscous_friction=drive.viscous_friction * (1.0 + plant.friction_error),
-                         stiffness=drive.stiffness * (1.0 + plant.screw_stiffness_error),
-                         torque_constant=drive.torque_constant * torque, kp=drive.kp * torque, kv=drive.kv * torque)
+        return STRUT_DRIVE
+    return STRUT_DRIVE.with_errors(friction=plant.friction_error, stiffness=plant.screw_stiffness_error,
+                                   torque_constant=plant.torque_constant_error)
 
 
 #: The drive options: the struts' drive trains as built (``STRUT_DRIVE``: motor, gearbox, ball

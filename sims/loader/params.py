@@ -11,6 +11,7 @@ import numpy as np
 import models
 from planners import loader as loader_planner
 from sims import run_limits
+from sims.drives import torque_constant_error
 from sims.params import PlantParams, ScenarioParams, param
 
 CONTROL_DT = 0.005  # s: 200 Hz motion controller; the drives run at the 0.5 ms physics step
@@ -131,10 +132,7 @@ class LoaderPlant(PlantParams):
         0.0, "as-built drives: the RV reducers' lost motion relative to the model's 1 arcmin", "fraction",
         low=-1.0, high=2.0,
         reason="none (a preloaded reducer) to three times the catalogue's 1 arcmin (a worn one; assumption)")
-    torque_constant_error: float = param(
-        0.0, "as-built drives: every motor's torque constant relative to its datasheet's (every force the "
-        "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
-        reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
+    torque_constant_error: float = torque_constant_error("the joint motors")
     encoder_bias: tuple[float, ...] = param(
         (0.0,) * 6, "zero offset of each drive's encoder, theta1 (mm), theta2 ... theta6 (deg): the drive and "
         "the controller read q + bias", unit=_BIAS_UNITS, low=tuple(-b for b in _BIAS_LIMIT), high=_BIAS_LIMIT,

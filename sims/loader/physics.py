@@ -80,20 +80,17 @@ def joint_drive(nominal: mujoco.MjModel, name: str, plant: "LoaderPlant | None" 
     peak = float(actuator.forcerange[1])
     rated_speed = float(actuator.ctrlrange[1])
     amps = 1.0 / (t.torque_constant * t.ratio * t.efficiency)  # A per N m (or N) at the joint
-    friction = 1.0 if plant is None else 1.0 + plant.friction_error
-    torque = 1.0 if plant is None else 1.0 + plant.torque_constant_error
-    stiffness = t.stiffness if plant is None else t.stiffness * (1.0 + plant.reducer_stiffness_error)
-    backlash = t.backlash if plant is None else t.backlash * (1.0 + plant.backlash_error)
-    # A torque constant off by e scales every force the drive makes, its loops' too.
-    return DriveTrain(
+    drive = DriveTrain(
         ratio=t.ratio, rotor_inertia=float(nominal.dof_armature[joint.dofadr[0]]) / t.ratio**2,
-        torque_constant=t.torque_constant * torque, peak_current=peak * amps, continuous_current=0.5 * peak * amps,
+        torque_constant=t.torque_constant, peak_current=peak * amps, continuous_current=0.5 * peak * amps,
         max_motor_speed=rated_speed * t.ratio, efficiency=t.efficiency,
-        kp=float(actuator.gainprm[0]) * torque, kv=float(-actuator.biasprm[2]) * torque,
-        stiffness=stiffness, backlash=backlash,
-        coulomb_friction=friction * COULOMB_FRACTION * peak,
-        viscous_friction=friction * VISCOUS_FRACTION * peak / rated_speed,
+        kp=float(actuator.gainprm[0]), kv=float(-actuator.biasprm[2]), stiffness=t.stiffness, backlash=t.backlash,
+        coulomb_friction=COULOMB_FRACTION * peak, viscous_friction=VISCOUS_FRACTION * peak / rated_speed,
         encoder_resolution=2.0 * math.pi / MOTOR_ENCODER_COUNTS / t.ratio)
+    if plant is None:
+        return drive
+    return drive.with_errors(friction=plant.friction_error, stiffness=plant.reducer_stiffness_error,
+                             backlash=plant.backlash_error, torque_constant=plant.torque_constant_error)
 
 
 def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, plant: "LoaderPlant | None" = None) -> None:
