@@ -334,6 +334,9 @@ def cmd_bench(args) -> int:
         print(text)
     print()
     print(bench.format_campaign(bench.campaign_throughput()))
+    print(bench.format_planner_only(bench.planner_only_throughput()))
+    print()
+    print(bench.format_memory(bench.memory_by_run_length()))
     return EXIT_OK
 
 
