@@ -22,7 +22,6 @@ runs of two lengths (each in a process of its own) with the log a 6 h run would 
 
 from __future__ import annotations
 
-import os
 import re
 import time
 import timeit
@@ -264,21 +263,37 @@ MEMORY_DURATIONS_S = (300.0, None)  # None: the scenario's own length
 SIX_HOURS_S = 6 * 3600.0
 
 
+#: The child that ``peak_memory`` runs: the command line, which writes its own memory's high-water
+#: mark (VmHWM, of its own address space: a forked child's ru_maxrss would count the parent's
+#: pages it held before exec) to stderr as it exits.
+_PEAK_CHILD = """\
+import atexit, sys
+
+def _peak():
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmHWM:"):
+                sys.stderr.write("PEAK_KB " + line.split()[1] + "\\n")
+
+atexit.register(_peak)
+from sims.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
 def peak_memory(scenario: str, duration: float | None) -> float:
     """Peak resident memory of ``planbench run SCENARIO [--duration D] --quiet`` in a process
-    of its own, MB (the kernel's ru_maxrss of that child)."""
+    of its own, MB (its VmHWM: Linux)."""
     import subprocess
     import sys
 
-    command = [sys.executable, "-m", "sims.cli", "run", scenario, "--quiet"]
-    if duration is not None:
-        command += ["--duration", repr(duration)]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    _, status, usage = os.wait4(process.pid, 0)
-    process.returncode = os.waitstatus_to_exitcode(status)
-    if process.returncode not in (0, 1):  # 1: a check failed, which still ran the whole run
-        raise RuntimeError(f"{' '.join(command)} exited {process.returncode}")
-    return usage.ru_maxrss / 1024.0  # KiB on Linux
+    command = ["run", scenario, "--quiet"] + ([] if duration is None else ["--duration", repr(duration)])
+    done = subprocess.run([sys.executable, "-c", _PEAK_CHILD, *command], stdout=subprocess.DEVNULL,
+                          stderr=subprocess.PIPE, text=True)
+    peaks = [line.split()[1] for line in done.stderr.splitlines() if line.startswith("PEAK_KB ")]
+    if done.returncode not in (0, 1) or not peaks:  # 1: a check failed, which still ran the whole run
+        raise RuntimeError(f"planbench {' '.join(command)} exited {done.returncode}: {done.stderr[-500:]}")
+    return int(peaks[-1]) / 1024.0
 
 
 def memory_by_run_length() -> list[dict]:

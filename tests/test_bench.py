@@ -1,0 +1,33 @@
+"""planbench bench's measurements that are not timings: a run's peak memory in a process of its
+own, and a planner-only campaign's counts (never a timed assertion)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sims import bench
+
+
+def test_peak_memory_is_the_childs_own_not_its_parents():
+    """The child's high-water mark is of its own address space: a parent holding 800 MB more
+    does not raise it (a forked child's ru_maxrss would count those pages)."""
+    small = bench.peak_memory("loader-supply", 0.05)
+    ballast = np.ones((100, 1000, 1000))  # 800 MB resident in this process
+    assert ballast.sum() > 0
+    beside = bench.peak_memory("loader-supply", 0.05)
+    assert 50.0 < small < 700.0 and 50.0 < beside < 700.0  # MB: Python, MuJoCo and the loader
+    assert abs(beside - small) < 100.0
+
+
+def test_the_planner_only_campaign_counts_its_runs():
+    row = bench.planner_only_throughput(workers=1, samples=100)
+    assert row["runs"] == 200 and 0 < row["valid"] <= row["runs"]
+    assert row["runs_per_s"] > 0 and row["valid_per_s"] <= row["runs_per_s"]
+    assert "200 random hexapod moves" in bench.format_planner_only(row)
+
+
+def test_the_memory_table_names_its_runs_and_the_6_h_log():
+    rows = [{"duration_s": 300.0, "peak_mb": 240.0}, {"duration_s": 1330.0, "peak_mb": 300.0},
+            {"duration_s": bench.SIX_HOURS_S, "peak_mb": None, "log_mb": 2911.0}]
+    text = bench.format_memory(rows)
+    assert "1330 s over 300 s: 1.25 x" in text and "2911 MB" in text and "not run" in text
