@@ -287,13 +287,18 @@ sys.exit(main(sys.argv[1:]))
 
 def peak_memory(scenario: str, duration: float | None) -> float:
     """Peak resident memory of ``planbench run SCENARIO [--duration D] --quiet`` in a process
-    of its own, MB (``_PEAK_CHILD``: Linux)."""
+    of its own, its outputs written to a temporary directory, MB (``_PEAK_CHILD``: Linux)."""
     import subprocess
     import sys
+    import tempfile
 
-    command = ["run", scenario, "--quiet"] + ([] if duration is None else ["--duration", repr(duration)])
-    done = subprocess.run([sys.executable, "-c", _PEAK_CHILD, *command], stdout=subprocess.DEVNULL,
-                          stderr=subprocess.PIPE, text=True)
+    with tempfile.TemporaryDirectory(prefix="planbench-bench-") as tmp:
+        # Its outputs (written as a run writes them) go to a directory of the bench's own, never
+        # to the default results/NAME, which may hold a run of the user's.
+        command = ["run", scenario, "--quiet", "--out", str(Path(tmp) / "run")] + \
+            ([] if duration is None else ["--duration", repr(duration)])
+        done = subprocess.run([sys.executable, "-c", _PEAK_CHILD, *command], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True)
     peaks = [line.split()[1] for line in done.stderr.splitlines() if line.startswith("PEAK_KB ")]
     if done.returncode not in (0, 1) or not peaks:  # 1: a check failed, which still ran the whole run
         raise RuntimeError(f"planbench {' '.join(command)} exited {done.returncode}: {done.stderr[-500:]}")

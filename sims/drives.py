@@ -26,8 +26,10 @@ bandwidth and damping against the inertia it moves. Each MuJoCo step is one samp
 drive's loops; the current loop, kilohertz-fast in every drive here, is taken as ideal (a
 torque that follows its demand within the step).
 
-The encoder the controller reads (``sims.task.JointEncoders``' ``resolution``) counts the
-load's position in steps of ``encoder_resolution``.
+The encoder the controller reads (``sims.task.JointEncoders``' ``resolution``) counts in
+steps of ``encoder_resolution``: the load's position where the machine has an encoder on the
+load (the hexapod's struts, the antenna's axes), the motor's over N where it has motor encoders
+only (the loader).
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from planners.errors import LimitError
 from sims.params import param
 
 #: Mass and inertia of a motor body (kg, kg m^2): the rotor's inertia is the dof's armature;
@@ -50,6 +53,16 @@ ROTOR_BODY_INERTIA = 1e-6
 #: and the transmission's tendon.
 MOTOR_SUFFIX = "_motor"
 TRANSMISSION_SUFFIX = "_transmission"
+
+#: A mechanism's ``drives`` option: its drive trains as built, or the MJCF's ideal servos.
+DRIVES = ("as-built", "ideal")
+
+
+def check_option(drives: str) -> str:
+    """``drives`` if it is one of ``DRIVES``, else a LimitError naming it."""
+    if drives not in DRIVES:
+        raise LimitError(f"drives = {drives!r} is not one of {', '.join(DRIVES)}")
+    return drives
 
 
 @dataclass(frozen=True)
@@ -113,9 +126,6 @@ class DriveTrain:
     @property
     def rigid(self) -> bool:
         return math.isinf(self.stiffness)
-
-    def replace(self, **changes) -> "DriveTrain":
-        return dataclasses.replace(self, **changes)
 
     def with_errors(self, friction: float = 0.0, stiffness: float = 0.0, backlash: float = 0.0,
                     torque_constant: float = 0.0) -> "DriveTrain":
@@ -202,9 +212,51 @@ def load_joint(model: mujoco.MjModel, actuator_id: int) -> int:
     return joint
 
 
+def drive_coordinates(model: mujoco.MjModel, joints) -> tuple[np.ndarray, np.ndarray]:
+    """(qpos addresses, dof addresses) of the coordinates the drives of ``joints`` (names) act
+    on and their loops read: each one's motor (``motor_joint``)."""
+    ids = [motor_joint(model, name) for name in joints]
+    return model.jnt_qposadr[ids].copy(), model.jnt_dofadr[ids].copy()
+
+
+def _transmission(model: mujoco.MjModel, joint: str) -> int | None:
+    try:
+        return model.tendon(joint + TRANSMISSION_SUFFIX).id
+    except KeyError:
+        return None
+
+
 def transmission_stiffness(model: mujoco.MjModel, joint: str) -> float:
     """The stiffness of the tendon between ``joint`` and its motor, N/m or N m/rad (inf: none)."""
-    try:
-        return float(model.tendon_stiffness[model.tendon(joint + TRANSMISSION_SUFFIX).id])
-    except KeyError:
-        return math.inf
+    tendon = _transmission(model, joint)
+    return math.inf if tendon is None else float(model.tendon_stiffness[tendon])
+
+
+def transmission_deflection(model: mujoco.MjModel, joints, force: np.ndarray) -> np.ndarray:
+    """(..., n) how far each motor stands off its load (q_m - q, m or rad) when its transmission
+    carries ``force`` (..., n) to the load (N or N m; the load's qfrc): f / k, plus half the
+    backlash in the direction of f (the teeth in contact); 0 through a rigid transmission."""
+    tendons = [_transmission(model, name) for name in joints]
+    stiffness = np.array([math.inf if t is None else model.tendon_stiffness[t] for t in tendons])
+    half_band = np.array([0.0 if t is None else model.tendon_lengthspring[t, 1] for t in tendons])
+    return force / stiffness + np.sign(force) * half_band
+
+
+def keyframe_with_motors(spec: mujoco.MjSpec, nominal: mujoco.MjModel) -> None:
+    """Rebuild ``spec``'s ``home`` keyframe for the joints its drive trains (and any other
+    edit) added: every joint of ``nominal`` at its value in ``nominal``'s first keyframe, each
+    motor at its load's, the added joints otherwise at their qpos0. Compiles ``spec``."""
+    model = spec.compile()
+    qpos = model.qpos0.copy()
+    for j in range(nominal.njnt):
+        name = nominal.joint(j).name
+        value = nominal.key_qpos[0][nominal.jnt_qposadr[j]:nominal.jnt_qposadr[j] + _QPOS_SIZE[nominal.jnt_type[j]]]
+        for target in {model.joint(name).id, motor_joint(model, name)}:
+            adr = model.jnt_qposadr[target]
+            qpos[adr:adr + value.size] = value
+    spec.key("home").qpos = qpos
+
+
+#: qpos values per joint type (free, ball, slide, hinge).
+_QPOS_SIZE = {int(mujoco.mjtJoint.mjJNT_FREE): 7, int(mujoco.mjtJoint.mjJNT_BALL): 4,
+              int(mujoco.mjtJoint.mjJNT_SLIDE): 1, int(mujoco.mjtJoint.mjJNT_HINGE): 1}

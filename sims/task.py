@@ -160,6 +160,7 @@ class JointEncoders(Sensors):
             SensorSpec("setpoints", "the drives' position set-points (what was commanded)", unit, rate),
         ]
         self._ideal = ideal
+        self._noisy = bool(self.noise.any() or self.bias.any())
         self._counted = self.resolution > 0
         self._all_counted = bool(self._counted.all())
         self._counts_per_unit = np.divide(1.0, self.resolution, out=np.zeros_like(self.resolution),
@@ -193,7 +194,7 @@ class JointEncoders(Sensors):
         for getter, index, out in self._copies:
             np.take(getter(data), index, out=out)
         if not self._ideal:
-            if self.noise.any() or self.bias.any():
+            if self._noisy:
                 self._positions += self.bias + self.noise * self._rng.standard_normal(self.noise.size)
             if self._all_counted:  # in place: a tick's reading costs no new arrays
                 positions = self._positions

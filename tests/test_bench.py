@@ -8,15 +8,18 @@ import numpy as np
 from sims import bench
 
 
-def test_peak_memory_is_the_childs_own_not_its_parents():
+def test_peak_memory_is_the_childs_own_not_its_parents(tmp_path, monkeypatch):
     """The child's high-water mark is of its own address space: a parent holding 800 MB more
-    does not raise it (a forked child's ru_maxrss would count those pages)."""
+    does not raise it (a forked child's ru_maxrss would count those pages). Its run writes
+    nothing where the bench is run (not the default results/NAME, which may be a user's)."""
+    monkeypatch.chdir(tmp_path)
     small = bench.peak_memory("loader-supply", 0.05)
     ballast = np.ones((100, 1000, 1000))  # 800 MB resident in this process
     assert ballast.sum() > 0
     beside = bench.peak_memory("loader-supply", 0.05)
     assert 50.0 < small < 700.0 and 50.0 < beside < 700.0  # MB: Python, MuJoCo and the loader
     assert abs(beside - small) < 100.0
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_the_planner_only_campaign_counts_its_runs():

@@ -174,3 +174,44 @@ def test_the_servo_feedforward_through_a_drive_train_is_the_load_s_plus_the_roto
     servo.reset(context)
     mass = LOAD_MASS + train.reflected_inertia + drives.ROTOR_BODY_MASS  # the rotor body moves too
     np.testing.assert_allclose(servo.tau_ff[:, 0], mass * 2.0, rtol=1e-9)
+
+
+def test_a_motor_stands_off_its_load_by_the_deflection_and_half_the_backlash():
+    """At rest with F on the load, held through the transmission: q_m - q = F / k + sign(F) b / 2
+    (the teeth in contact), the value ``transmission_deflection`` gives; nothing through a
+    rigid drive."""
+    backlash = 2e-4
+    model = axis_model(drive(stiffness=5e7, backlash=backlash))
+    data = mujoco.MjData(model)
+    load, motor = model.joint("axis").dofadr[0], model.joint("axis_motor").dofadr[0]
+    for force in (-3000.0, 1500.0):
+        standoff = drives.transmission_deflection(model, ["axis"], np.array([force]))[0]
+        assert standoff == pytest.approx(force / 5e7 + math.copysign(backlash / 2, force), rel=1e-12)
+        data.qpos[:] = 0.0
+        data.qpos[model.joint("axis_motor").qposadr[0]] = standoff
+        mujoco.mj_forward(model, data)
+        # The tendon's force on the load is what holds F: qfrc_passive = -F.
+        assert data.qfrc_passive[load] == pytest.approx(force, rel=1e-9)
+        assert data.qfrc_passive[motor] == pytest.approx(-force, rel=1e-9)
+    rigid = axis_model(drive(stiffness=math.inf))
+    assert drives.transmission_deflection(rigid, ["axis"], np.array([1000.0]))[0] == 0.0
+
+
+def test_the_keyframe_puts_each_motor_at_its_load():
+    spec = mujoco.MjSpec.from_string(AXIS.format(dt=DT, mass=LOAD_MASS).replace(
+        "</worldbody>", "</worldbody><keyframe><key name='home' qpos='0.25' act='0.25'/></keyframe>"))
+    nominal = spec.compile()
+    drives.add_drive_train(spec, "axis", "axis", drive())
+    drives.keyframe_with_motors(spec, nominal)
+    model = spec.compile()
+    np.testing.assert_array_equal(model.key_qpos[0][[model.joint("axis").qposadr[0],
+                                                     model.joint("axis_motor").qposadr[0]]], [0.25, 0.25])
+    np.testing.assert_array_equal(model.key_act[0], [0.25])
+    qpos, dofs = drives.drive_coordinates(model, ["axis"])
+    assert qpos.tolist() == [model.joint("axis_motor").qposadr[0]] and dofs.tolist() == [model.joint("axis_motor").dofadr[0]]
+
+
+def test_an_unknown_drive_option_is_refused():
+    assert drives.check_option("ideal") == "ideal"
+    with pytest.raises(ValueError, match="drives = 'geared' is not one of as-built, ideal"):
+        drives.check_option("geared")

@@ -118,7 +118,7 @@ def test_the_controller_reads_the_motors_encoders_in_counts():
     counts = reading / resolution
     np.testing.assert_allclose(counts, np.round(counts), rtol=0, atol=1e-6)
     physics = setup.physics
-    motor = physics.data.qpos[physics.motor_qpos]
+    motor = physics.data.qpos[physics.drive_qpos]
     assert np.all(np.abs(reading - motor) <= resolution)
     shoulder = NAMES.index("shoulder")
     assert abs(reading[shoulder] - physics.joint_positions()[shoulder]) > 1e-4  # rad: the deflection
@@ -132,7 +132,7 @@ def test_the_torque_check_judges_the_motors_demand_with_the_shell_and_the_rotors
     setup = scenario.build(scenario.resolve(duration=1.0))
     log = runner.simulate(setup)
     q, qd = setup.task.evaluation._joint_log(log)
-    demanded = setup.task.evaluation._demanded(log, q, qd)
+    demanded = setup.task.evaluation._demanded(log)
     limit = setup.task.evaluation.force_limit
     assert (np.abs(demanded) < limit).all()
     # MuJoCo's own actuator force at logged states (the log's actuator_force is that of the

@@ -153,7 +153,7 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start(drives):
     if drives == "ideal":
         np.testing.assert_allclose(context.observation["joint_positions"], q0, rtol=0, atol=1e-15)
     else:
-        motors = setup.physics.data.qpos[setup.physics.motor_qpos]
+        motors = setup.physics.data.qpos[setup.physics.drive_qpos]
         resolution = setup.task.sensors.specs[0].resolution
         np.testing.assert_allclose(context.observation["joint_positions"], motors + bias, rtol=0, atol=resolution)
     # Its datasheet does not reveal the bias; the record of the run does.

@@ -19,7 +19,7 @@ from planners import antenna as ant
 from planners.errors import PlanningError
 from planners.antenna.geostationary import look_angles
 from sims import run_limits
-from sims.drives import torque_constant_error
+from sims.drives import DRIVES, torque_constant_error
 from sims.antenna.ship_motion import SEA_HS_MAX_M, SEA_TP_RANGE_S, check_sea_state
 from sims.params import ParamError, Params, PlantParams, ScenarioParams, override, param
 from sims.plant import set_inertial
@@ -139,9 +139,6 @@ def log_bytes_per_tick(imu: ImuModel = ImuModel(), drives: str = "ideal") -> flo
     return run_limits.floats(floats)
 
 
-#: The drive options: the pedestal as built (``as_built``: motors, a belt on azimuth, geared
-#: axes with backlash, friction, the mast's bending mode, axis encoders) or the MJCF as it is.
-DRIVES = ("as-built", "ideal")
 #: The as-built pedestal (models/antenna/README.md "Drives as built"): each axis's reduction,
 #: its transmission's stiffness at the axis (N m/rad), the gears' backlash (rad), bearing and
 #: seal friction (N m), the axis encoders' count (rad), and the mast's bending mode (Hz, damping).
@@ -187,7 +184,7 @@ def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXI
     (two hinges, ``MAST_JOINTS``, whose stiffness puts the mode at MAST_MODE_HZ against the
     antenna's inertia about them) and each axis's drive train (``axis_drive``); the home
     keyframe rebuilt for the joints added (the motors with their axes, the mast straight)."""
-    from sims.drives import MOTOR_SUFFIX, add_drive_train
+    from sims.drives import add_drive_train, keyframe_with_motors
 
     pedestal = spec.body("pedestal")
     for name, axis in zip(MAST_JOINTS, ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])):
@@ -204,17 +201,7 @@ def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXI
         i = model.joint(name).dofadr[0]
         spec.joint(name).stiffness = [inertia[i, i] * omega**2, 0.0, 0.0]
         spec.joint(name).damping = [2.0 * MAST_DAMPING_RATIO * inertia[i, i] * omega, 0.0, 0.0]
-    key = spec.key("home")
-    qpos, act = model.qpos0.copy(), np.zeros(model.na)
-    for j in range(nominal.njnt):
-        name = nominal.joint(j).name
-        value = nominal.key_qpos[0][nominal.jnt_qposadr[j]]
-        qpos[model.jnt_qposadr[model.joint(name).id]] = value
-        if name in JOINTS:
-            qpos[model.jnt_qposadr[model.joint(name + MOTOR_SUFFIX).id]] = value
-    for a in range(nominal.nu):
-        act[model.actuator_actadr[model.actuator(nominal.actuator(a).name).id]] = nominal.key_act[0][nominal.actuator_actadr[a]]
-    key.qpos, key.act = qpos, act
+    keyframe_with_motors(spec, nominal)  # the motors with their axes, the mast straight
 
 
 @functools.lru_cache(maxsize=2)

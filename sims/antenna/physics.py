@@ -15,7 +15,7 @@ import models
 from planners import antenna as ant
 from planners.rotations import rot_x, rot_y
 from sims.antenna.params import DECK_JOINTS, JOINTS, MAST_JOINTS, AntennaPlant, _model
-from sims.drives import motor_joint
+from sims.drives import drive_coordinates
 from sims.antenna.ship_motion import world_from_ship
 
 
@@ -62,13 +62,11 @@ class AntennaPhysics(dm_mujoco.Physics):
     def drive_qpos(self) -> np.ndarray:
         """qpos index of the coordinate each axis's drive acts on and reads: its motor's (as
         built), the axis's own (ideal)."""
-        model = self.model.ptr
-        return model.jnt_qposadr[[motor_joint(model, n) for n in JOINTS]]
+        return drive_coordinates(self.model.ptr, JOINTS)[0]
 
     @property
     def drive_dofs(self) -> np.ndarray:
-        model = self.model.ptr
-        return model.jnt_dofadr[[motor_joint(model, n) for n in JOINTS]]
+        return drive_coordinates(self.model.ptr, JOINTS)[1]
 
     @property
     def antenna_actuators(self) -> np.ndarray:

@@ -15,6 +15,7 @@ from planners.fast import plan as fp
 from planners.fast import sky as sky
 from sims import run_limits
 from sims.fast.loads import CableLoads, ChainCableLoads
+from sims.drives import DRIVES
 from sims.fast.measurement import SensorOptions, floats_per_tick
 from sims.fast.physics import (CABLE_EA, CONTROL_DT, LEG_ACTUATORS, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, _compiled,
                                discretized_spec, max_cable_segments)
@@ -251,7 +252,7 @@ class FastParams(ScenarioParams):
     stewart: bool = param(True, "the Stewart stabilizer in the cabin on (off: the feed rides the A-B rotator)")
     drives: str = param("as-built", "the winches: as-built (each rope within its drive's speed and acceleration, "
                         "0.5 m/s and 0.05 m/s^2; models/fast/README.md) or ideal (each rope at its command every "
-                        "tick)", choices=("as-built", "ideal"))
+                        "tick)", choices=DRIVES)
     sensors: SensorOptions = param(SensorOptions(), "the measurement system (sims.fast.measurement.SensorOptions: "
                                    "fused, FAST's, or ideal; its rates, latencies, noises and biases)")
     cable_segments: int = param(DEFAULT_CABLE_SEGMENTS, "each cable as a chain of this many elastic segments (2: "

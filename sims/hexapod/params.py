@@ -14,8 +14,8 @@ from planners import hexapod as hexapod_planner
 from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS
 from sims import run_limits
-from sims.drives import torque_constant_error
-from sims.hexapod.physics import DEFAULT_ELEVATION_DEG, DRIVES, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
+from sims.drives import DRIVES, torque_constant_error
+from sims.hexapod.physics import DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
 from sims.params import Params, ParamError, PlantParams, ScenarioParams, param
 from sims.wind import MEAN_SPEED
 

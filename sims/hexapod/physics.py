@@ -25,7 +25,8 @@ from planners.errors import LimitError
 from planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
 from planners.rotations import wxyz
 from sims import run_limits
-from sims.drives import DriveTrain, add_drive_train, motor_joint, servo_gains, transmission_stiffness
+from sims.drives import (DRIVES, DriveTrain, add_drive_train, check_option, drive_coordinates, servo_gains,
+                         transmission_deflection)
 from sims.plant import set_inertial
 from sims.runner import RunLog
 
@@ -92,12 +93,6 @@ def strut_drive(plant: "HexapodPlant | None" = None) -> DriveTrain:
                                    torque_constant=plant.torque_constant_error)
 
 
-#: The drive options: the struts' drive trains as built (``STRUT_DRIVE``: motor, gearbox, ball
-#: screw, friction, the drive's loops, the linear encoder) or the ideal servo of the MJCF
-#: (one stiff PD per strut on the strut's own slide).
-DRIVES = ("as-built", "ideal")
-
-
 @functools.lru_cache(maxsize=16)
 def _compiled(elevation_deg: float, drives: str = "ideal") -> mujoco.MjModel:
     """The nominal scene at ``elevation_deg`` (deg) with ``drives`` (``DRIVES``), compiled."""
@@ -121,8 +116,7 @@ PLATFORM_KEY_QPOS = -7
 def _spec(elevation_deg: float, drives: str = "ideal", plant: "HexapodPlant | None" = None) -> mujoco.MjSpec:
     """The scene's MjSpec with the top end tilted to ``elevation_deg`` (deg) and its struts'
     drives (``DRIVES``; as built: ``STRUT_DRIVE``, with ``plant``'s errors of its elements)."""
-    if drives not in DRIVES:
-        raise LimitError(f"drives = {drives!r} is not one of {', '.join(DRIVES)}")
+    check_option(drives)
     spec = mujoco.MjSpec.from_file(str(models.scene_path("hexapod")))
     if drives == "as-built":
         drive = strut_drive(plant)
@@ -245,19 +239,11 @@ class HexapodPhysics(dm_mujoco.Physics):
     def drive_qpos(self) -> np.ndarray:
         """qpos index of the coordinate each strut's drive acts on and its loops read: the
         motor's (as built), the strut's slide (ideal)."""
-        model = self.model.ptr
-        return np.array([model.jnt_qposadr[motor_joint(model, n)] for n in STRUT_LABELS])
+        return drive_coordinates(self.model.ptr, STRUT_LABELS)[0]
 
     @functools.cached_property
     def drive_dofs(self) -> np.ndarray:
-        model = self.model.ptr
-        return np.array([model.jnt_dofadr[motor_joint(model, n)] for n in STRUT_LABELS])
-
-    @functools.cached_property
-    def transmission_stiffness(self) -> np.ndarray:
-        """(6,) each strut's axial stiffness between its motor and its rod, N/m (inf: ideal)."""
-        model = self.model.ptr
-        return np.array([transmission_stiffness(model, n) for n in STRUT_LABELS])
+        return drive_coordinates(self.model.ptr, STRUT_LABELS)[1]
 
     @functools.cached_property
     def strut_actuators(self) -> np.ndarray:
@@ -379,11 +365,11 @@ class HexapodPhysics(dm_mujoco.Physics):
             data.qpos[self.strut_qpos[i]] = length - model.body(f"{name}_rod").pos[2]
         data.qvel[:] = 0.0
         data.act[:] = data.qpos[self.strut_qpos]
-        if np.isfinite(self.transmission_stiffness).all():
+        if self.drives != "ideal":
             # As built: each motor stands off its rod by the screw's deflection under the
             # static load, F / k, so that the machine starts at rest.
             force = static_drive_forces(self, data.qpos[self.strut_qpos][None, :])[0]
-            data.qpos[self.drive_qpos] = data.qpos[self.strut_qpos] + force / self.transmission_stiffness
+            data.qpos[self.drive_qpos] = data.qpos[self.strut_qpos] + transmission_deflection(model, STRUT_LABELS, force)
             data.act[:] = data.qpos[self.drive_qpos]
         mujoco.mj_forward(model, data)
 

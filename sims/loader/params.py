@@ -11,17 +11,11 @@ import numpy as np
 import models
 from planners import loader as loader_planner
 from sims import run_limits
-from sims.drives import torque_constant_error
+from sims.drives import DRIVES, torque_constant_error
 from sims.params import PlantParams, ScenarioParams, param
 
 CONTROL_DT = 0.005  # s: 200 Hz motion controller; the drives run at the 0.5 ms physics step
 SETTLE_S = 0.5  # s simulated after the plan ends, so the arrival is seen at rest
-
-
-#: The drive options: the arm's drive trains as built (motors, ball screw, RV and strain-wave
-#: reducers with their stiffness and backlash, friction, the motors' encoders;
-#: ``sims.loader.physics.as_built``) or the MJCF's ideal servos (one PD per joint).
-DRIVES = ("as-built", "ideal")
 
 
 @functools.lru_cache(maxsize=2)

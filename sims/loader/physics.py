@@ -14,10 +14,10 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 
 import models
-from planners.errors import LimitError
-from sims.drives import TRANSMISSION_SUFFIX, DriveTrain, add_drive_train, motor_joint
+from sims.drives import (DriveTrain, add_drive_train, check_option, drive_coordinates, keyframe_with_motors,
+                         transmission_deflection)
 from sims.loader.collision import geoms_by_contype
-from sims.loader.params import DRIVES, LoaderPlant
+from sims.loader.params import LoaderPlant
 from sims.plant import set_inertial
 
 #: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
@@ -101,14 +101,7 @@ def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, plant: "LoaderPlant |
     # The friction's constraint rows on 11 dofs: the dense Jacobian is the faster one (7.1 against
     # 7.7 us a step with MuJoCo's automatic choice, measured).
     spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
-    model = spec.compile()
-    qpos = model.qpos0.copy()
-    for j in range(nominal.njnt):
-        name = nominal.joint(j).name
-        value = nominal.key_qpos[0][nominal.jnt_qposadr[j]]
-        qpos[model.jnt_qposadr[model.joint(name).id]] = value
-        qpos[model.jnt_qposadr[motor_joint(model, name)]] = value
-    spec.key("home").qpos = qpos
+    keyframe_with_motors(spec, nominal)
 
 
 class LoaderPhysics(dm_mujoco.Physics):
@@ -124,10 +117,9 @@ class LoaderPhysics(dm_mujoco.Physics):
         distribution), edited with MjSpec before compiling. ``plant`` (None: the nominal
         plant): the true machine, perturbed as ``LoaderPlant`` says (``apply_plant``); its
         ``payload_mass_error`` makes the shell's true mass payload_mass (1 + error).
-        ``drives`` (``DRIVES``): the arm's drive trains as built (``as_built``) or the MJCF's
+        ``drives`` (``sims.drives.DRIVES``): the arm's drive trains as built (``as_built``) or the MJCF's
         ideal servos."""
-        if drives not in DRIVES:
-            raise LimitError(f"drives = {drives!r} is not one of {', '.join(DRIVES)}")
+        check_option(drives)
         nominal = plant is None or plant.is_nominal
         mass = shell_mass() if payload_mass is None else float(payload_mass)
         if not nominal:
@@ -156,18 +148,16 @@ class LoaderPhysics(dm_mujoco.Physics):
         self.data.act[:] = q
         if self.drives != "ideal":
             model, data = self.model.ptr, self.data.ptr
-            motors = self.motor_qpos
+            motors, motor_dofs = self.drive_qpos, self.drive_dofs
             data.qpos[motors] = q
             mujoco.mj_forward(model, data)
-            load = data.qfrc_bias[_joint_dofs(self)]  # the static load at rest: gravity
-            tendons = self.transmission_ids
-            rigid = tendons < 0
-            stiffness = np.where(rigid, np.inf, model.tendon_stiffness[tendons])
-            half_band = np.where(rigid, 0.0, model.tendon_lengthspring[tendons, 1])
-            deflection = load / stiffness + np.sign(load) * half_band
-            data.qpos[motors] = q + deflection
+            dofs = _joint_dofs(self)
+            load = data.qfrc_bias[dofs]  # the static load at rest: gravity
+            data.qpos[motors] = q + transmission_deflection(model, self.joint_names, load)
             mujoco.mj_forward(model, data)
-            drive = data.qfrc_bias[self.motor_dofs] + np.where(rigid, 0.0, load)
+            # The drive holds its motor's own load and, through a compliant transmission, the
+            # joint's (a rigid one's motor is the joint).
+            drive = data.qfrc_bias[motor_dofs] + np.where(motor_dofs != dofs, load, 0.0)
             gains = model.actuator_gainprm[self.actuator_ids, 0]
             data.act[model.actuator_actadr[self.actuator_ids]] = data.qpos[motors] + drive / gains
         self.forward()
@@ -189,29 +179,14 @@ class LoaderPhysics(dm_mujoco.Physics):
         return np.array([self.model.ptr.actuator(n).id for n in self.joint_names])
 
     @property
-    def motor_qpos(self) -> np.ndarray:
+    def drive_qpos(self) -> np.ndarray:
         """qpos addresses of the coordinates the drives act on and their encoders read: each
         joint's motor (as built; the slide's rigid screw: the slide itself), else the joint."""
-        model = self.model.ptr
-        return model.jnt_qposadr[[motor_joint(model, n) for n in self.joint_names]]
+        return drive_coordinates(self.model.ptr, self.joint_names)[0]
 
     @property
-    def motor_dofs(self) -> np.ndarray:
-        model = self.model.ptr
-        return model.jnt_dofadr[[motor_joint(model, n) for n in self.joint_names]]
-
-    @property
-    def transmission_ids(self) -> np.ndarray:
-        """The tendon of each joint's compliant transmission, -1 where the transmission is
-        rigid (or the drives ideal)."""
-        model = self.model.ptr
-        ids = []
-        for n in self.joint_names:
-            try:
-                ids.append(model.tendon(n + TRANSMISSION_SUFFIX).id)
-            except KeyError:
-                ids.append(-1)
-        return np.array(ids)
+    def drive_dofs(self) -> np.ndarray:
+        return drive_coordinates(self.model.ptr, self.joint_names)[1]
 
     def setpoints(self) -> np.ndarray:
         """The drives' position set-points (their activations), m and rad."""

@@ -26,7 +26,7 @@ def sensors(physics: LoaderPhysics, bias=None) -> JointEncoders:
                                     for n in physics.joint_names]
     measures = "encoders of theta1 (m) ... theta6 (rad)" if ideal else \
         "motor encoders of theta1 (m) ... theta6 (rad), read through the transmission ratios"
-    encoders = JointEncoders(physics.motor_qpos, physics.motor_dofs,
+    encoders = JointEncoders(physics.drive_qpos, physics.drive_dofs,
                              [model.actuator(n).actadr[0] for n in physics.joint_names],
                              measures, "m|rad", CONTROL_DT, bias=0.0 if bias is None else bias,
                              resolution=resolution)

@@ -47,11 +47,11 @@ class LoaderEvaluation:
         self.chain = plant_chain(plant)
         self.encoder_bias = plant.encoder_bias_si()
 
-    def _demanded(self, log: RunLog, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    def _demanded(self, log: RunLog) -> np.ndarray:
         """(n, 6) force/torque the drives demand before their clamp, N and N m: their PD on
-        what their encoders read (the motors' coordinates as built, plus the encoder bias)."""
-        if self.physics.drives != "ideal":
-            q, qd = log.qpos[:, self.physics.motor_qpos], log.qvel[:, self.physics.motor_dofs]
+        what their encoders read (the motors' coordinates as built, the joints' with the ideal
+        drives, plus the encoder bias)."""
+        q, qd = log.qpos[:, self.physics.drive_qpos], log.qvel[:, self.physics.drive_dofs]
         q_drive = q + self.encoder_bias if self.encoder_bias.any() else q
         return demanded_force(self.kp, self.kv, log.act, q_drive, qd)
 
@@ -83,7 +83,7 @@ class LoaderEvaluation:
         ticks = np.searchsorted(log.t, self.key_times[reached] - 1e-9)
         key_err_deg = np.rad2deg(np.abs(q[ticks, 1:] - self.key_points[reached, 1:]))
         key_err_slide_mm = 1e3 * np.abs(q[ticks, 0] - self.key_points[reached, 0])
-        tau = self._demanded(log, q, qd)
+        tau = self._demanded(log)
         torque_ratio = np.abs(tau) / self.force_limit
         robot, obstacles = self.physics.robot_geoms(), self.physics.obstacle_geoms()
         pairs = obstacle_contact_pairs(log.contacts, robot, obstacles)
@@ -132,7 +132,7 @@ class LoaderEvaluation:
             "qd_actual": qd,
             "setpoint": log.act,
             "drive_force": log.actuator_force,
-            "drive_force_demanded": self._demanded(log, q, qd),
+            "drive_force_demanded": self._demanded(log),
             "drive_force_limit": self.force_limit,
             "shell_tip_pos": self._shell_tip(log),
             "clearance": clear,
