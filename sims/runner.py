@@ -306,7 +306,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     task = setup.task
     observe, before_step = task.observe, task.before_step  # the same tick as sims.envs'
     ctrl_now = context.command
-    contacts = log.contacts
+    contacts = []  # (tick, geoms (ncon, 2), distances (ncon,)) of every tick with contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
                desc="simulating")
     update_every = max(1, (n - 1) // 200)
@@ -348,9 +348,9 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
         else:
             mujoco.mj_step(model, data, nstep=k)
         record(i + 1)
-        if data.ncon:
-            for c in data.contact:
-                contacts.append((i + 1, int(c.geom1), int(c.geom2), float(c.dist)))
+        if data.ncon:  # the contact list's arrays: iterating over its structs costs ~100 us a tick
+            contact = data.contact
+            contacts.append((i + 1, contact.geom.copy(), contact.dist.copy()))
         if i % SCAN_TICKS == 0 or i == n - 2:
             message = _divergence(data, qpos, qvel, times, i + 1, SCAN_TICKS)
             if message:
@@ -370,6 +370,8 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     else:
         ctrl[last] = ctrl[last - 1] if last > 0 else initial_ctrl  # the last good command, held
     log.physics_steps = last * k
+    log.contacts = [(tick, int(g1), int(g2), float(dist)) for tick, geoms, dists in contacts
+                    for (g1, g2), dist in zip(geoms.tolist(), dists.tolist())]
     if last < n - 1:
         for name in ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata",
                      "mocap_pos", "mocap_quat"):
