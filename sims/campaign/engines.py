@@ -26,6 +26,8 @@ ENGINES = ("local", "ray")
 
 def _lost(context, chunk, why: str) -> dict:
     """Rows of a chunk whose worker died: status "error" with the reason."""
+    if isinstance(chunk, worker.ColumnTask):
+        return worker.lost_columns(context, chunk, why)
     rows = [{**worker.row_of(context, task), "status": "error", "passed": None, "error": why, "wall_s": 0.0,
              "sim_s": None} for task in chunk]
     return {"rows": rows, "checks": {}, "files": {}}
@@ -172,13 +174,20 @@ class LocalEngine:
             if not broken and not unsent:
                 return
             retry.extendleft(reversed(unsent))
-            for chunk in sorted(broken, key=lambda c: c[0].index, reverse=True):
-                if chunk[0].index in broke_once:
+            for chunk in sorted(broken, key=_first_run, reverse=True):
+                if _first_run(chunk) in broke_once:
                     yield chunk, _lost(context, chunk, "its worker process died twice running it (out of memory, "
                                        "or a crash in native code)")
                 else:
-                    broke_once.add(chunk[0].index)
+                    broke_once.add(_first_run(chunk))
                     retry.appendleft(chunk)
+
+
+def _first_run(chunk) -> int:
+    """The index of a chunk's first run (a list of RunTasks, or a ColumnTask)."""
+    if isinstance(chunk, worker.ColumnTask):
+        return int(chunk.columns["run"][0])
+    return chunk[0].index
 
 
 def _terminate(pool) -> None:

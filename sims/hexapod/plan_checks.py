@@ -487,7 +487,14 @@ def judge_plans(params_list: Sequence[HexapodParams], planner=None) -> list[list
     synchronous = np.array([m.synchronous for m in flat], dtype=bool)
     start = np.array([m.start_pose for m in flat], dtype=float).reshape(-1, 6)
     target = np.array([m.target_pose for m in flat], dtype=float).reshape(-1, 6)
-    per_move = {k: np.full(len(flat), np.nan) for k in _KEYS}
+    per_move, refused = judge_moves(start, target, synchronous)
+    return checks_of_runs(per_move, refused, synchronous, offsets)
+
+
+def judge_moves(start: np.ndarray, target: np.ndarray, synchronous: np.ndarray) -> tuple[dict, dict]:
+    """(per-move quantities, {move: the planner's refusal}) of the moves ``start`` -> ``target``
+    ((N, 6) SI poses, each move on its own), planned together by mode (``_plan_group``)."""
+    per_move = {k: np.full(len(synchronous), np.nan) for k in _KEYS}
     refused: dict[int, str] = {}
     for mode in (True, False):
         index = np.flatnonzero(synchronous == mode)
@@ -496,8 +503,13 @@ def judge_plans(params_list: Sequence[HexapodParams], planner=None) -> list[list
             for k in _KEYS:
                 per_move[k][index] = judged[k]
             refused.update({int(index[i]): text for i, text in failures.items()})
+    return per_move, refused
+
+
+def checks_of_runs(per_move: dict, refused: dict, synchronous: np.ndarray, offsets) -> list[list[Check]]:
+    """Each run's checks, its moves ``offsets[r]:offsets[r + 1]`` of the per-move arrays."""
     out = []
-    for r in range(len(params_list)):
+    for r in range(len(offsets) - 1):
         lo, hi = int(offsets[r]), int(offsets[r + 1])
         bad = [i for i in refused if lo <= i < hi] if refused else []
         if bad:
