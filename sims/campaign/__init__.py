@@ -34,7 +34,9 @@ class Outcome:
     skipped: int
     table: object
     worst: list
-    engine_wall_s: float = 0.0  # from the first chunk sent to the last row written (workers' start included)
+    engine_wall_s: float = 0.0  # from the first chunk sent to the last row written (what is left of the workers' start included)
+    campaign_wall_s: float = 0.0  # from the call to the last row written: the spec's reading and checks, the
+    #                               workers' whole start, every run (the report not)
 
 
 def context_of(spec) -> worker.Context:
@@ -145,9 +147,25 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
     """Run (or resume) the campaign of ``spec_path`` into ``out``; see the module's steps."""
     from sims.params import ParamError
 
+    start = time.perf_counter()
+    # A local pool's workers start now, while the spec is read and checked; a campaign that
+    # stops before its runs (a bad spec, a held directory) ends them (``close``).
+    early = engines.started_early(engine, workers, address)
+    try:
+        return _sweep(spec_path, out, engine, workers, address, rerun_worst, quiet, echo, early, start)
+    finally:
+        if early is not None:
+            early.close()
+
+
+def _sweep(spec_path, out, engine, workers, address, rerun_worst, quiet, echo, early, campaign_start) -> Outcome:
+    from sims.params import ParamError
+
     spec = spec_module.load(spec_path)
     target = store_module.CampaignDir(out)
     runner_engine = engines.make(engine, workers, address)
+    if early is not None:
+        runner_engine = early
     if rerun_worst < 0:
         raise ParamError(f"--rerun-worst {rerun_worst} must be >= 0")
     if rerun_worst and spec.mode == "plan":
@@ -186,13 +204,14 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
         finally:
             bar.close()
         engine_wall = time.perf_counter() - start
+        campaign_wall = time.perf_counter() - campaign_start
         table = target.table()
         target.write_results(table)
         summary = report.write(target, spec, table)
         worst = []
         if rerun_worst:
             worst = rerun_worst_runs(spec, target, table, rerun_worst, quiet, echo)
-    return Outcome(summary, pending, len(done), table, worst, engine_wall)
+    return Outcome(summary, pending, len(done), table, worst, engine_wall, campaign_wall)
 
 
 def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
