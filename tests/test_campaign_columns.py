@@ -214,3 +214,24 @@ def test_refuse_names_the_first_invalid_run_as_the_per_run_check(tmp_path):
     assert str(columnar.value) == str(per_run.value) and str(columnar.value).startswith("run ")
     assert cli.main(["sweep", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     assert not (tmp_path / "o").exists()
+
+
+def test_a_part_keeps_every_rows_keys():
+    # The first row an invalid run's (no checks): the valid row after it keeps its check values.
+    rows = [{"run": 0, "status": "invalid", "error": "ParamError: x", "wall_s": 0.0},
+            {"run": 1, "check.a": 1.5, "limit.a": 2.0, "pass.a": True, "status": "passed", "error": None, "wall_s": 0.1}]
+    table = worker.rows_table(rows)
+    assert table.column_names == ["run", "status", "error", "wall_s", "check.a", "limit.a", "pass.a"]
+    assert table.column("check.a").to_pylist() == [None, 1.5] and table.column("pass.a").to_pylist() == [None, True]
+
+
+def test_a_refused_spec_ends_the_workers_started_for_it(tmp_path):
+    import multiprocessing
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text('scenario = "hexapod-sync-move"\n[grid]\nwindd = [1.0]\n')
+    before = set(p.pid for p in multiprocessing.active_children())
+    with pytest.raises(ParamError, match="unknown parameter 'windd'"):
+        campaign.sweep(bad, tmp_path / "out", workers=2, quiet=True)
+    assert set(p.pid for p in multiprocessing.active_children()) <= before
+    assert not (tmp_path / "out").exists()
