@@ -4,9 +4,11 @@
   1. read and check the spec (sims.campaign.spec): every axis, value and distribution, and,
      unless ``invalid = "skip"``, every run's parameters, before any run starts;
   2. open DIR (sims.campaign.store): new, or the same spec resumed (finished runs skipped);
-  3. send chunks of runs to the engine (sims.campaign.engines: a spawned process pool or
-     Ray), and write each finished chunk's rows (one part file of the results table) and its
-     runs' summaries as they come, under a tqdm bar of runs done, failures and time left;
+  3. send chunks of runs to the engine (sims.campaign.engines: a spawned process pool, started
+     as the campaign begins, or Ray), and write each finished chunk's rows (one part file of
+     the results table) and its runs' summaries as they come, under a tqdm bar of runs done,
+     failures and time left; a planner-only campaign whose scenario judges columns sends its
+     chunks as arrays (``worker.ColumnTask``) and gets Arrow tables back;
   4. write results.parquet and the report (sims.campaign.report), print its table;
   5. ``--rerun-worst K``: simulate the K worst runs again, with video, into DIR/worst/.
 """

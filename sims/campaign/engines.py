@@ -38,9 +38,14 @@ def _init_worker(parent: int | None = None):
     if parent == os.getpid():  # an in-process stand-in for a pool (tests)
         return
     # What every run needs, imported as the worker starts (while the driver reads the spec):
-    # planbench's scenarios, the pipeline and MuJoCo.
-    import sims.pipeline  # noqa: F401
-    import sims.scenarios  # noqa: F401
+    # planbench's scenarios, the pipeline and MuJoCo. An import that fails here fails again
+    # in the first chunk, which reports it in its rows (an initializer's error would break
+    # the pool instead).
+    try:
+        import sims.pipeline  # noqa: F401
+        import sims.scenarios  # noqa: F401
+    except Exception:  # noqa: BLE001
+        pass
 
 
 def _warm() -> None:

@@ -1,8 +1,9 @@
 """What a campaign's workers run: chunks of runs, rebuilt from plain data (README, "Campaigns").
 
-A worker (a process of the local pool, or a Ray task) gets a ``Context`` once (the scenario's
-name, its base parameters and plant as plain mappings, the plug-in specs, the mode) and then
-chunks of ``RunTask``s (each run's index, seed and parameter overrides). It rebuilds the models
+A worker (a process of the local pool, or a Ray task) gets with each chunk a ``Context`` (the
+scenario's name, its base parameters and plant as plain mappings, the plug-in specs, the mode)
+and the chunk: ``RunTask``s (each run's index, seed and parameter overrides), or a planner-only
+campaign's ``ColumnTask`` (its runs as arrays, ``run_columns``). It rebuilds the models
 from the typed parameters itself; no MjModel, Physics or closure is ever pickled, so a Ray
 cluster needs only planbench installed (and the plug-ins importable). A run that raises, or
 whose parameters break a limit between them, is a row with its error: the chunk never raises.
