@@ -82,7 +82,9 @@ checks, the pose at every tick.
 Throughput (one core of the 2-core development machine, with other jobs on it; the campaign
 examples/hexapod/random_moves_campaign.toml measures it end to end): 10^5 single-move runs, start and target uniform in
 the limits, judged in 26 s of CPU (3800-4300 runs/s: 10^6 in about 4 min); building their
-``HexapodParams`` took 40 s (10^6: about 7 min), longer than judging them.
+``HexapodParams`` took 40 s (10^6: about 7 min), longer than judging them. A campaign's
+columnar path (``sims.hexapod.plan_columns``) builds none: it validates the runs' poses as
+arrays and judges them through ``judge_moves``, the same per-move quantities.
 
 Example::
 
