@@ -54,6 +54,9 @@ class Scenario:
       judge_plans: optional (list of params, planner=None) -> one list of checks per params:
         the run's planner checks on the planned trajectory alone, no physics, vectorized
         over the list (planner-only campaigns, ``mode = "plan"``).
+      plan_columns: optional module with ``supports(base, axis paths)``, ``validate(base,
+        paths, values, n)`` and ``judge(poses)``: a planner-only campaign's chunks validated
+        and judged as columns (sims.hexapod.plan_columns); None: run by run.
       plant: the nominal plant (an instance of the mechanism's ``sims.params.PlantParams``:
         its plant-uncertainty fields at their nominal values); ``build(..., plant=...)`` takes
         a perturbed one. None: the mechanism declares no plant uncertainty.
@@ -74,6 +77,7 @@ class Scenario:
     online_planner: bool = False
     plant: object = None
     judge_plans: Callable | None = None
+    plan_columns: object = None
     tags: tuple = (DEMO,)
 
     @property

@@ -4,9 +4,11 @@
   1. read and check the spec (sims.campaign.spec): every axis, value and distribution, and,
      unless ``invalid = "skip"``, every run's parameters, before any run starts;
   2. open DIR (sims.campaign.store): new, or the same spec resumed (finished runs skipped);
-  3. send chunks of runs to the engine (sims.campaign.engines: a spawned process pool or
-     Ray), and write each finished chunk's rows (one part file of the results table) and its
-     runs' summaries as they come, under a tqdm bar of runs done, failures and time left;
+  3. send chunks of runs to the engine (sims.campaign.engines: a spawned process pool, started
+     as the campaign begins, or Ray), and write each finished chunk's rows (one part file of
+     the results table) and its runs' summaries as they come, under a tqdm bar of runs done,
+     failures and time left; a planner-only campaign whose scenario judges columns sends its
+     chunks as arrays (``worker.ColumnTask``) and gets Arrow tables back;
   4. write results.parquet and the report (sims.campaign.report), print its table;
   5. ``--rerun-worst K``: simulate the K worst runs again, with video, into DIR/worst/.
 """
@@ -34,7 +36,9 @@ class Outcome:
     skipped: int
     table: object
     worst: list
-    engine_wall_s: float = 0.0  # from the first chunk sent to the last row written (workers' start included)
+    engine_wall_s: float = 0.0  # from the first chunk sent to the last row written (what is left of the workers' start included)
+    campaign_wall_s: float = 0.0  # from the call to the last row written: the spec's reading and checks, the
+    #                               workers' whole start, every run (the report not)
 
 
 def context_of(spec) -> worker.Context:
@@ -76,11 +80,68 @@ def tasks_of(spec, runs) -> list[worker.RunTask]:
     return out
 
 
+def columnar(spec) -> bool:
+    """Whether the campaign's chunks go to the workers as columns (``worker.ColumnTask``):
+    a planner-only campaign of a scenario with a columnar judge that takes its axes."""
+    return worker.columns_supported(spec.scenario, spec.base_params, tuple(a.column for a in spec.axes),
+                                    spec.plugins, spec.mode)
+
+
+def column_chunks(spec, done, chunk_size: int):
+    """The runs not in ``done`` (a sorted int64 array, or None), ``chunk_size`` indices at a
+    time, as ``worker.ColumnTask``s (the random draws made once)."""
+    import numpy as np
+
+    draws = spec.draws()
+    for lo in range(0, spec.size, chunk_size):
+        index = np.arange(lo, min(lo + chunk_size, spec.size), dtype=np.int64)
+        if done is not None and done.size:
+            index = index[~np.isin(index, done, assume_unique=True)]
+        if index.size:
+            yield worker.ColumnTask(spec.columns(index, draws))
+
+
+def count_status(rows) -> tuple[int, int]:
+    """(failed, errors) among ``rows`` (dicts, or an Arrow table)."""
+    if isinstance(rows, list):
+        return (sum(r["status"] == "failed" for r in rows), sum(r["status"] == "error" for r in rows))
+    import pyarrow.compute as pc
+
+    status = rows.column("status")
+    return (pc.sum(pc.equal(status, "failed")).as_py() or 0, pc.sum(pc.equal(status, "error")).as_py() or 0)
+
+
 def check_runs(spec, runs, quiet: bool, total: int | None = None) -> None:
     """Every run's parameters validated (a ParamError naming the first bad run)."""
+    if columnar(spec):
+        return check_columns(spec, quiet)
     for run in tqdm(runs, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False,
                     total=total):
         spec.resolve(run)
+
+
+def check_columns(spec, quiet: bool) -> None:
+    """``check_runs`` on columns: the runs validated on arrays a chunk at a time, and the first
+    that the columnar check finds invalid or is unsure of resolved on its own (its ParamError,
+    naming the run, is the one ``spec.resolve`` gives)."""
+    import numpy as np
+
+    from sims.campaign.spec import Run, parse_path
+
+    paths = [parse_path(a.column) for a in spec.axes]
+    bar = tqdm(total=spec.size, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False)
+    try:
+        for task in column_chunks(spec, None, PLAN_CHUNK):
+            c = task.columns
+            messages, unsure, _ = spec.scenario.plan_columns.validate(
+                spec.base_params, paths, [c[a.column] for a in spec.axes], len(task))
+            for i in np.flatnonzero(unsure | np.array([m is not None for m in messages], dtype=bool)):
+                run = Run(int(c["run"][i]), int(c["point"][i]), int(c["sample"][i]), int(c["replicate"][i]),
+                          int(c["seed"][i]), tuple(worker._plain(c[a.column][i]) for a in spec.axes))
+                spec.resolve(run)
+            bar.update(len(task))
+    finally:
+        bar.close()
 
 
 def sweep(spec_path, out, engine: str = "local", workers: int | None = None, address: str | None = None,
@@ -88,9 +149,25 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
     """Run (or resume) the campaign of ``spec_path`` into ``out``; see the module's steps."""
     from sims.params import ParamError
 
+    start = time.perf_counter()
+    # A local pool's workers start now, while the spec is read and checked; a campaign that
+    # stops before its runs (a bad spec, a held directory) ends them (``close``).
+    early = engines.started_early(engine, workers, address)
+    try:
+        return _sweep(spec_path, out, engine, workers, address, rerun_worst, quiet, echo, early, start)
+    finally:
+        if early is not None:
+            early.close()
+
+
+def _sweep(spec_path, out, engine, workers, address, rerun_worst, quiet, echo, early, campaign_start) -> Outcome:
+    from sims.params import ParamError
+
     spec = spec_module.load(spec_path)
     target = store_module.CampaignDir(out)
     runner_engine = engines.make(engine, workers, address)
+    if early is not None:
+        runner_engine = early
     if rerun_worst < 0:
         raise ParamError(f"--rerun-worst {rerun_worst} must be >= 0")
     if rerun_worst and spec.mode == "plan":
@@ -105,8 +182,11 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
         chunk_size = 1 if spec.mode == "simulate" else max(1, min(PLAN_CHUNK, math.ceil(
             pending / (4 * (runner_engine.workers or 1)))))
         # Chunks are made as the engine asks for them: a campaign of 10^6 runs is never held whole.
-        chunks = (tasks_of(spec, runs) for runs in spec_module.iter_chunks(
-            (r for r in spec.iter_runs() if r.index not in done), chunk_size))
+        if columnar(spec):
+            chunks = column_chunks(spec, target.done_array() if done else None, chunk_size)
+        else:
+            chunks = (tasks_of(spec, runs) for runs in spec_module.iter_chunks(
+                (r for r in spec.iter_runs() if r.index not in done), chunk_size))
         if done and not quiet:
             echo(f"resuming {target}: {len(done)} of {spec.size} runs done, {pending} to go")
         failed = errors = 0
@@ -116,21 +196,24 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
             for chunk, result in runner_engine.run(context_of(spec), chunks):
                 for index, files in result["files"].items():
                     target.write_run_files(index, files, spec.scenario.name)
-                target.append(result["rows"], result["checks"])
-                failed += sum(r["status"] == "failed" for r in result["rows"])
-                errors += sum(r["status"] == "error" for r in result["rows"])
+                rows = result["table"] if "table" in result else result["rows"]
+                target.append(rows, result["checks"])
+                n_failed, n_errors = count_status(rows)
+                failed += n_failed
+                errors += n_errors
                 bar.set_postfix(failed=failed, errors=errors, refresh=False)
-                bar.update(len(result["rows"]))
+                bar.update(len(rows))
         finally:
             bar.close()
         engine_wall = time.perf_counter() - start
+        campaign_wall = time.perf_counter() - campaign_start
         table = target.table()
         target.write_results(table)
         summary = report.write(target, spec, table)
         worst = []
         if rerun_worst:
             worst = rerun_worst_runs(spec, target, table, rerun_worst, quiet, echo)
-    return Outcome(summary, pending, len(done), table, worst, engine_wall)
+    return Outcome(summary, pending, len(done), table, worst, engine_wall, campaign_wall)
 
 
 def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:

@@ -26,14 +26,30 @@ ENGINES = ("local", "ray")
 
 def _lost(context, chunk, why: str) -> dict:
     """Rows of a chunk whose worker died: status "error" with the reason."""
+    if isinstance(chunk, worker.ColumnTask):
+        return worker.lost_columns(context, chunk, why)
     rows = [{**worker.row_of(context, task), "status": "error", "passed": None, "error": why, "wall_s": 0.0,
              "sim_s": None} for task in chunk]
     return {"rows": rows, "checks": {}, "files": {}}
 
 
-def _init_worker(context, parent: int | None = None):
+def _init_worker(parent: int | None = None):
     contain_worker(parent)
-    worker._context = context
+    if parent == os.getpid():  # an in-process stand-in for a pool (tests)
+        return
+    # What every run needs, imported as the worker starts (while the driver reads the spec):
+    # planbench's scenarios, the pipeline and MuJoCo. An import that fails here fails again
+    # in the first chunk, which reports it in its rows (an initializer's error would break
+    # the pool instead).
+    try:
+        import sims.pipeline  # noqa: F401
+        import sims.scenarios  # noqa: F401
+    except Exception:  # noqa: BLE001
+        pass
+
+
+def _warm() -> None:
+    """A pool's first task per worker: it makes the pool spawn its workers now."""
 
 
 #: How often a worker without PR_SET_PDEATHSIG looks whether its driver still lives, s.
@@ -93,8 +109,8 @@ def contain_worker(parent: int | None) -> None:
     threading.Thread(target=watch, name="planbench-parent-watch", daemon=True).start()
 
 
-def _run_in_worker(chunk):
-    return worker.run_chunk(worker._context, chunk)
+def _run_in_worker(context, chunk):
+    return worker.run_chunk(context, chunk)
 
 
 class LocalEngine:
@@ -104,6 +120,32 @@ class LocalEngine:
 
     def __init__(self, workers: int | None = None):
         self.workers = workers or os.cpu_count() or 1
+        self._pool = None  # started by ``start``, taken by ``run``
+
+    def _new_pool(self):
+        return cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
+                                      initializer=_init_worker, initargs=(os.getpid(),))
+
+    def start(self) -> None:
+        """Spawn the workers now: they start (import planbench and MuJoCo) while the driver
+        reads and checks the spec and opens its directory; ``run`` uses them. ``close``
+        ends them if ``run`` never does. Submitting spawns a worker per task until the pool
+        is full, with SIGINT, SIGTERM and SIGHUP held back (as ``run``'s submits)."""
+        if self._pool is not None:
+            return
+        self._pool = self._new_pool()
+        with outputs.signals_deferred():
+            for _ in range(self.workers):
+                try:
+                    self._pool.submit(_warm)
+                except cf.process.BrokenProcessPool:  # run() finds it broken and starts another
+                    break
+
+    def close(self) -> None:
+        """End the started pool that ``run`` did not take (the campaign stopped before it)."""
+        pool, self._pool = self._pool, None
+        if pool is not None:
+            _terminate(pool)
 
     def run(self, context, chunks):
         """Yield (chunk, result) as chunks finish, with at most two chunks per worker in
@@ -128,8 +170,8 @@ class LocalEngine:
             return out
 
         while True:
-            pool = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                          initializer=_init_worker, initargs=(context, os.getpid()))
+            # The pool ``start`` spawned, or a new one (the first was not started, or broke).
+            pool, self._pool = (self._pool or self._new_pool()), None
             broken, unsent = [], []
             futures = {}
 
@@ -142,7 +184,7 @@ class LocalEngine:
                 with outputs.signals_deferred():
                     for i, c in enumerate(batch):
                         try:
-                            futures[pool.submit(_run_in_worker, c)] = c
+                            futures[pool.submit(_run_in_worker, context, c)] = c
                         except cf.process.BrokenProcessPool:
                             unsent.extend(batch[i:])
                             return
@@ -172,13 +214,20 @@ class LocalEngine:
             if not broken and not unsent:
                 return
             retry.extendleft(reversed(unsent))
-            for chunk in sorted(broken, key=lambda c: c[0].index, reverse=True):
-                if chunk[0].index in broke_once:
+            for chunk in sorted(broken, key=_first_run, reverse=True):
+                if _first_run(chunk) in broke_once:
                     yield chunk, _lost(context, chunk, "its worker process died twice running it (out of memory, "
                                        "or a crash in native code)")
                 else:
-                    broke_once.add(chunk[0].index)
+                    broke_once.add(_first_run(chunk))
                     retry.appendleft(chunk)
+
+
+def _first_run(chunk) -> int:
+    """The index of a chunk's first run (a list of RunTasks, or a ColumnTask)."""
+    if isinstance(chunk, worker.ColumnTask):
+        return int(chunk.columns["run"][0])
+    return chunk[0].index
 
 
 def _terminate(pool) -> None:
@@ -307,6 +356,16 @@ def ray_available() -> bool:
     import importlib.util
 
     return importlib.util.find_spec("ray") is not None
+
+
+def started_early(engine: str, workers: int | None, address: str | None):
+    """A started LocalEngine (``LocalEngine.start``) when the options name a valid local
+    engine, else None (``make`` refuses bad options, after the spec's own checks)."""
+    if engine != "local" or address or (workers is not None and not 1 <= workers <= 4096):
+        return None
+    local = LocalEngine(workers)
+    local.start()
+    return local
 
 
 def make(engine: str, workers: int | None, address: str | None):

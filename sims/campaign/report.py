@@ -31,13 +31,28 @@ def wilson(passed: int, n: int, confidence: float = 0.95) -> tuple[float, float]
     return float(ci.low), float(ci.high)
 
 
+def _floats(column) -> np.ndarray:
+    """A numeric or boolean Arrow column as floats (True 1.0), NaN where it is null (Arrow's
+    casts, without a Python object per row); a TypeError for any other type."""
+    import pyarrow.compute as pc
+
+    kind = column.type
+    if not (pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
+            or pa.types.is_null(kind)):
+        raise TypeError(f"a column of {kind} is not numbers")
+    return pc.fill_null(pc.cast(column, pa.float64()), np.nan).to_numpy(zero_copy_only=False).astype(float)
+
+
 def _column(table: pa.Table, name: str) -> np.ndarray:
     """A numeric column as floats, NaN where it is null (or absent: a check no run of a part had)."""
     if name not in table.column_names:
         return np.full(table.num_rows, np.nan)
-    values = table.column(name).to_numpy(zero_copy_only=False)
-    return np.array([np.nan if v is None else v for v in values], dtype=float) if values.dtype == object \
-        else values.astype(float)
+    return _floats(table.column(name))
+
+
+def _status(table: pa.Table) -> np.ndarray:
+    return table.column("status").to_numpy(zero_copy_only=False).astype(object) if table.num_rows \
+        else np.array([], dtype=object)
 
 
 def _percentiles(values: np.ndarray) -> dict:
@@ -54,7 +69,7 @@ def check_names(table: pa.Table) -> list[str]:
 
 def summarize(spec, table: pa.Table, checks_meta: dict) -> dict:
     """campaign.json's content."""
-    status = np.array(table.column("status").to_pylist() if table.num_rows else [], dtype=object)
+    status = _status(table)
     point = _column(table, "point").astype(int) if table.num_rows else np.array([], int)
     counted = status != "invalid"
     names = check_names(table)
@@ -160,7 +175,7 @@ def worst_runs(table: pa.Table, k: int, checks_meta: dict) -> list[int]:
     if table.num_rows == 0 or k <= 0:
         return []
     score = np.full(table.num_rows, -np.inf)
-    status = np.array(table.column("status").to_pylist(), dtype=object)
+    status = _status(table)
     for name in check_names(table):
         value, limit = _column(table, f"check.{name}"), _column(table, f"limit.{name}")
         greater = checks_meta.get(name, {}).get("comparison", "<=").startswith(">")
@@ -179,7 +194,13 @@ def worst_runs(table: pa.Table, k: int, checks_meta: dict) -> list[int]:
 
 
 def _axis_values(table: pa.Table, column: str):
-    raw = table.column(column).to_pylist() if column in table.column_names else [None] * table.num_rows
+    if column not in table.column_names:
+        return np.full(table.num_rows, np.nan), None
+    try:
+        return _floats(table.column(column)), None
+    except TypeError:
+        pass
+    raw = table.column(column).to_pylist()
     try:
         return np.array([np.nan if v is None else float(v) for v in raw]), None
     except (TypeError, ValueError):
@@ -196,8 +217,9 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
 
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
-    counted = np.array(table.column("status").to_pylist(), dtype=object) if table.num_rows else np.array([])
+    counted = _status(table)
     keep = np.isin(counted, ["passed", "failed"])
+    axis_values = {}
     stride = max(1, int(math.ceil(keep.sum() / MAX_SCATTER)))
     axes = spec.axes or []
     for name, meta in summary["checks"].items():
@@ -209,7 +231,9 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
                 x, labels = _column(table, "run"), None
                 xlabel = "run"
             else:
-                x, labels = _axis_values(table, axis.column)
+                if axis.column not in axis_values:
+                    axis_values[axis.column] = _axis_values(table, axis.column)
+                x, labels = axis_values[axis.column]
                 xlabel = axis.column + (f" ({axis.unit})" if axis.unit else "")
             sel = np.flatnonzero(keep)[::stride]
             ax_plot.plot(x[sel], value[sel], ".", alpha=0.35 if sel.size > 200 else 0.7, ms=3, color="tab:blue",

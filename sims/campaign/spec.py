@@ -331,6 +331,36 @@ class CampaignSpec:
         """Every run, in order of its index."""
         return list(self.iter_runs())
 
+    def columns(self, index: np.ndarray, draws: list[np.ndarray] | None = None) -> dict:
+        """The runs ``index`` (an int64 array) as columns, what ``iter_runs`` gives one run at
+        a time: "run", "point", "sample", "replicate", "seed" (int64 arrays) and each axis's
+        values under its column name (a float64, bool or int64 array, or a list of values
+        that are none of those). ``draws``: ``self.draws()``, computed once by the caller."""
+        index = np.asarray(index, dtype=np.int64)
+        draws = self.draws() if draws is None else draws
+        per_point = self.samples * self.replicates
+        point, rest = np.divmod(index, per_point)
+        sample, replicate = np.divmod(rest, self.replicates)
+        if self.seeds:
+            seed = np.asarray(self.seeds, dtype=np.int64)[replicate]
+        else:
+            seed = run_seeds(self.seed, sample, replicate)
+        out = {"run": index, "point": point, "sample": sample, "replicate": replicate, "seed": seed}
+        if self.grid:
+            points, where = np.unique(point, return_inverse=True)
+            values = [self.grid_values(int(p)) for p in points]
+            for k, axis in enumerate(self.grid):
+                column = [v[k] for v in values]
+                kind = axis.leaf.kind
+                if kind in ("float", "bool", "int") and all(not isinstance(v, (tuple, dict)) for v in column):
+                    dtype = {"float": np.float64, "bool": np.bool_, "int": np.int64}[kind]
+                    out[axis.column] = np.asarray(column, dtype=dtype)[where]
+                else:
+                    out[axis.column] = [column[i] for i in where]
+        for axis, drawn in zip(self.random, draws):
+            out[axis.column] = np.asarray(drawn, dtype=np.float64)[sample]
+        return out
+
     def overrides(self, run: Run) -> tuple[dict, dict]:
         """(parameter overrides, plant overrides) of ``run``: the top-level keys its axes
         change, with the run's seed, as mappings for ``from_mapping`` on the base."""
@@ -611,3 +641,63 @@ def iter_chunks(runs: list[Run], size: int):
     it = iter(runs)
     while chunk := list(itertools.islice(it, size)):
         yield chunk
+
+
+# ------------------------------------------------------------------ columns (planner-only campaigns)
+
+_M32 = np.uint64(0xFFFFFFFF)
+_INIT_A, _MULT_A, _INIT_B, _MULT_B = 0x43B0D7E5, 0x931E8875, 0x8B51F9DD, 0x58F38DED
+_MIX_L, _MIX_R, _POOL = 0xCA01F9DD, 0x4973F715, 4
+
+
+def _words(n: int) -> list[int]:
+    """``n`` as numpy's SeedSequence takes an int: little-endian 32-bit words (0: one word)."""
+    out = [n & 0xFFFFFFFF]
+    n >>= 32
+    while n:
+        out.append(n & 0xFFFFFFFF)
+        n >>= 32
+    return out
+
+
+def run_seeds(seed: int, samples: np.ndarray, replicates: np.ndarray) -> np.ndarray:
+    """``CampaignSpec.run_seed`` of every (sample, replicate), at once: numpy's SeedSequence
+    (its entropy mixing and generate_state, in 32-bit arithmetic) on arrays, bit for bit
+    what ``np.random.SeedSequence(seed, spawn_key=(2, s, r)).generate_state(2, np.uint32)``
+    gives (tested), without a Python object per run."""
+    samples = np.asarray(samples, dtype=np.int64)
+    replicates = np.asarray(replicates, dtype=np.int64)
+    if samples.size and (samples.max(initial=0) >= 2**32 or replicates.max(initial=0) >= 2**32):
+        raise ValueError("samples and replicates above 2**32 have two words each")
+    n = samples.shape[0]
+    run = _words(seed)
+    run += [0] * max(0, _POOL - len(run))
+    entropy = [np.full(n, w, np.uint64) for w in run] + [np.full(n, 2, np.uint64),
+                                                          samples.astype(np.uint64), replicates.astype(np.uint64)]
+    const = [_INIT_A]
+
+    def hashmix(value):
+        value = value ^ np.uint64(const[0])
+        const[0] = (const[0] * _MULT_A) & 0xFFFFFFFF
+        value = (value * np.uint64(const[0])) & _M32
+        return value ^ (value >> np.uint64(16))
+
+    def mix(x, y):
+        result = (np.uint64(_MIX_L) * x - np.uint64(_MIX_R) * y) & _M32
+        return result ^ (result >> np.uint64(16))
+
+    pool = [hashmix(entropy[i]) for i in range(_POOL)]
+    for src in range(_POOL):
+        for dst in range(_POOL):
+            if src != dst:
+                pool[dst] = mix(pool[dst], hashmix(pool[src]))
+    for src in range(_POOL, len(entropy)):
+        for dst in range(_POOL):
+            pool[dst] = mix(pool[dst], hashmix(entropy[src]))
+    state, hash_const = [], _INIT_B
+    for i in range(2):
+        value = pool[i] ^ np.uint64(hash_const)
+        hash_const = (hash_const * _MULT_B) & 0xFFFFFFFF
+        value = (value * np.uint64(hash_const)) & _M32
+        state.append(value ^ (value >> np.uint64(16)))
+    return (((state[0] << np.uint64(31)) ^ state[1]) & np.uint64(2**63 - 1)).astype(np.int64)

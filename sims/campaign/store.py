@@ -86,6 +86,8 @@ class CampaignDir(outputs._Target):
             if not os.access(path, os.W_OK | os.X_OK):
                 raise OutputError(f"{self.what} {path} is not writable")
 
+    _checks: dict = {}  # checks.json as last written by this process
+
     @property
     def table_dir(self) -> Path:
         return self.path / TABLE
@@ -137,15 +139,29 @@ class CampaignDir(outputs._Target):
             out.update(pq.read_table(part, columns=["run"]).column("run").to_pylist())
         return out
 
-    def append(self, rows: list[dict], checks: dict) -> None:
-        """One part file of ``rows`` (written whole), and new checks' units."""
-        if not rows:
+    def done_array(self):
+        """Indices of the runs that have a row, a sorted int64 array."""
+        import numpy as np
+
+        parts = [pq.read_table(part, columns=["run"]).column("run").to_numpy() for part in self.part_files()]
+        return np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
+
+    def append(self, rows, checks: dict) -> None:
+        """One part file of ``rows`` (dicts, or an Arrow table: a chunk of the columnar
+        path) written whole, and new checks' units."""
+        if not len(rows):
             return
-        known = self.checks()
-        if any(name not in known for name in checks):
-            write_atomic(self.path / CHECKS, (json.dumps({**known, **checks}, indent=1, sort_keys=True) + "\n").encode())
-        first, last = rows[0]["run"], rows[-1]["run"]
-        table = pa.Table.from_pylist(rows)
+        if any(name not in self._checks for name in checks):
+            self._checks = {**self.checks(), **checks}
+            write_atomic(self.path / CHECKS, (json.dumps(self._checks, indent=1, sort_keys=True) + "\n").encode())
+        if isinstance(rows, pa.Table):
+            table = rows
+            first, last = table.column("run")[0].as_py(), table.column("run")[-1].as_py()
+        else:
+            from sims.campaign.worker import rows_table
+
+            first, last = rows[0]["run"], rows[-1]["run"]
+            table = rows_table(rows)
         sink = pa.BufferOutputStream()
         pq.write_table(table, sink)
         write_atomic(self.table_dir / f"part-{first:08d}-{last:08d}.parquet", sink.getvalue().to_pybytes())

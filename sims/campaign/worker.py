@@ -1,8 +1,9 @@
 """What a campaign's workers run: chunks of runs, rebuilt from plain data (README, "Campaigns").
 
-A worker (a process of the local pool, or a Ray task) gets a ``Context`` once (the scenario's
-name, its base parameters and plant as plain mappings, the plug-in specs, the mode) and then
-chunks of ``RunTask``s (each run's index, seed and parameter overrides). It rebuilds the models
+A worker (a process of the local pool, or a Ray task) gets with each chunk a ``Context`` (the
+scenario's name, its base parameters and plant as plain mappings, the plug-in specs, the mode)
+and the chunk: ``RunTask``s (each run's index, seed and parameter overrides), or a planner-only
+campaign's ``ColumnTask`` (its runs as arrays, ``run_columns``). It rebuilds the models
 from the typed parameters itself; no MjModel, Physics or closure is ever pickled, so a Ray
 cluster needs only planbench installed (and the plug-ins importable). A run that raises, or
 whose parameters break a limit between them, is a row with its error: the chunk never raises.
@@ -50,6 +51,18 @@ class RunTask:
     plant: dict  # overrides of the base plant
 
 
+@dataclass(frozen=True)
+class ColumnTask:
+    """A chunk of runs of a planner-only campaign as columns (``CampaignSpec.columns``:
+    "run", "point", "sample", "replicate", "seed" and each axis's values), validated and
+    judged on arrays (``run_columns``)."""
+
+    columns: dict
+
+    def __len__(self) -> int:
+        return len(self.columns["run"])
+
+
 _cache: dict = {}
 
 
@@ -89,9 +102,12 @@ def _checks_into(row: dict, checks, meta: dict) -> None:
         meta.setdefault(c.name, {"unit": c.unit, "comparison": c.comparison})
 
 
-def run_chunk(context: Context, tasks: list[RunTask]) -> dict:
+def run_chunk(context: Context, tasks) -> dict:
     """Run ``tasks``; returns {"rows": [...], "checks": {name: {unit, comparison}},
-    "files": {run index: {file name: bytes}}}. Never raises for a run's own failure."""
+    "files": {run index: {file name: bytes}}} (a ``ColumnTask``: {"table": ..., "checks":
+    ..., "files": {}}, ``run_columns``). Never raises for a run's own failure."""
+    if isinstance(tasks, ColumnTask):
+        return run_columns(context, tasks)
     scenario, base_params, base_plant, plugin_specs, plugins = _base(context)
     rows, meta, files = [], {}, {}
     resolved = []
@@ -203,3 +219,169 @@ def _simulate(scenario, context, params, plant, plugin_specs, row, meta) -> dict
     row.update(status="passed" if result.passed else "failed", passed=result.passed, error=None,
                wall_s=time.perf_counter() - start, sim_s=result.sim_time_s)
     return files
+
+
+# --------------------------------------------------------------------------- columns
+
+
+#: A row's columns besides its place, its axes and its checks, in the order of the table.
+STATUS_COLUMNS = ("status", "passed", "error", "wall_s", "sim_s")
+
+
+def _check_key(key: str) -> bool:
+    return key.startswith(("check.", "limit.", "pass."))
+
+
+def rows_table(rows: list[dict]):
+    """``rows`` (dicts) as an Arrow table: every key any row has (a row without it: null),
+    in the order they first appear, the checks' columns last; the types as Arrow infers
+    them from the values (as ``pa.Table.from_pylist``, which would keep only the first
+    row's keys)."""
+    import pyarrow as pa
+
+    keys: dict = {}
+    for row in rows:
+        for key in row:
+            keys.setdefault(key, None)
+    order = [k for k in keys if not _check_key(k)] + [k for k in keys if _check_key(k)]
+    return pa.Table.from_pydict({k: [row.get(k) for row in rows] for k in order})
+
+
+def _error_text(name: str, message: str) -> str:
+    text = " ".join(f"{name}: {message}".split())
+    return text if len(text) <= 500 else text[:497] + "..."
+
+
+def _head_arrays(context: Context, columns: dict, n: int) -> dict:
+    import numpy as np
+    import pyarrow as pa
+
+    out = {k: pa.array(np.asarray(columns[k], dtype=np.int64)) for k in ("run", "point", "sample", "replicate",
+                                                                         "seed")}
+    for column in context.axes:
+        values = columns[column]
+        if isinstance(values, np.ndarray):
+            out[column] = pa.array(values)
+        else:
+            out[column] = pa.array([v if isinstance(v, (bool, int, float, str)) else json.dumps(v) for v in values])
+    return out
+
+
+def _status_arrays(status: list, passed: list, errors: list, wall) -> dict:
+    import pyarrow as pa
+
+    n = len(status)
+    return {"status": pa.array(status), "passed": pa.array(passed), "error": pa.array(errors),
+            "wall_s": pa.array(wall, pa.float64()), "sim_s": pa.nulls(n)}
+
+
+def lost_columns(context: Context, task: ColumnTask, why: str) -> dict:
+    """The rows of a column chunk whose worker died: status "error" with the reason."""
+    import pyarrow as pa
+
+    n = len(task)
+    arrays = {**_head_arrays(context, task.columns, n),
+              **_status_arrays(["error"] * n, [None] * n, [why] * n, [0.0] * n)}
+    return {"table": pa.Table.from_pydict(arrays), "checks": {}, "files": {}}
+
+
+def columns_supported(scenario, base_params, context_axes, plugins: dict, mode: str) -> bool:
+    """Whether a campaign's chunks can be columns: planner-only, the scenario's own planner
+    (no plug-in), a scenario with a columnar judge (``plan_columns``) that takes every axis."""
+    from sims.campaign.spec import parse_path
+
+    columnar = getattr(scenario, "plan_columns", None)
+    if mode != "plan" or columnar is None or plugins.get("planner"):
+        return False
+    if any(axis.startswith("plant.") for axis in context_axes):
+        return False
+    return columnar.supports(base_params, [parse_path(axis) for axis in context_axes])
+
+
+def _overrides(base: dict, paths, values, seed: int) -> dict:
+    """A run's parameter overrides (``CampaignSpec.overrides``) from its axis values."""
+    import copy
+
+    from sims.campaign.spec import set_path
+
+    out = {"seed": seed}
+    for path, value in zip(paths, values):
+        if len(path) == 1:
+            out[path[0]] = value
+            continue
+        if path[0] not in out:
+            out[path[0]] = copy.deepcopy(base[path[0]])
+        set_path({path[0]: out[path[0]]}, path, value, str(path))
+    return out
+
+
+def _plain(value):
+    return value.item() if hasattr(value, "item") else value
+
+
+def run_columns(context: Context, task: ColumnTask) -> dict:
+    """A planner-only chunk as columns: its runs validated on arrays (the rare ones the
+    columnar check is unsure of by ``from_mapping``, one at a time), every valid run judged
+    at once (``scenario.plan_columns``), its rows an Arrow table built from arrays; the same
+    rows as ``run_chunk`` of the same runs one at a time (tested)."""
+    import numpy as np
+    import pyarrow as pa
+
+    from sims.campaign.spec import parse_path
+
+    scenario, base_params, _, _, _ = _base(context)
+    columnar = scenario.plan_columns
+    columns = task.columns
+    n = len(task)
+    paths = [parse_path(axis) for axis in context.axes]
+    values = [columns[axis] for axis in context.axes]
+    messages, unsure, poses = columnar.validate(base_params, paths, values, n)
+    errors = [None if m is None else _error_text("ParamError", m) for m in messages]
+    base_dict = None
+    for i in np.flatnonzero(unsure):
+        base_dict = base_params.to_dict() if base_dict is None else base_dict
+        mapping = _overrides(base_dict, paths, [_plain(v[i]) for v in values], int(columns["seed"][i]))
+        try:
+            type(base_params).from_mapping(mapping, base=base_params)
+            errors[i] = None
+        except ValueError as e:
+            errors[i] = _exception_text(e)
+    valid = np.array([e is None for e in errors], dtype=bool)
+    status = np.where(valid, "passed", "invalid").astype(object)
+    passed = np.full(n, None, dtype=object)
+    wall = np.zeros(n)
+    checks, meta = [], {}
+    index = np.flatnonzero(valid)
+    if index.size:
+        start = time.perf_counter()
+        try:
+            checks = columnar.judge(tuple(p[index] for p in poses))
+        except (Exception, SystemExit) as e:  # noqa: BLE001  (the chunk's rows carry it)
+            status[index] = "error"
+            text = _exception_text(e)
+            for i in index:
+                errors[i] = text
+        else:
+            wall[index] = (time.perf_counter() - start) / index.size
+            ok = np.ones(index.size, dtype=bool)
+            for name, unit, comparison, limit, value, present, good in checks:
+                ok &= ~present | good
+                meta.setdefault(name, {"unit": unit, "comparison": comparison})
+            status[index] = np.where(ok, "passed", "failed")
+            passed[index] = ok.tolist()
+    arrays = {**_head_arrays(context, columns, n),
+              **_status_arrays(status.tolist(), passed.tolist(), errors, wall)}
+    for name, unit, comparison, limit, value, present, good in checks:
+        mask = np.ones(n, dtype=bool)
+        mask[index[present]] = False
+        full = np.zeros(n)
+        full[index] = value
+        limits = np.zeros(n)
+        limits[index] = limit
+        verdict = np.zeros(n, dtype=bool)
+        verdict[index] = good
+        arrays[f"check.{name}"] = pa.array(full, mask=mask)
+        arrays[f"limit.{name}"] = pa.array(limits, mask=mask)
+        arrays[f"pass.{name}"] = pa.array(verdict, mask=mask)
+    # The checks' columns in the order the rows list them, each check's three together.
+    return {"table": pa.Table.from_pydict(arrays), "checks": meta, "files": {}}

@@ -31,6 +31,7 @@ from sims.hexapod.params import (ASYNC_TARGET_MM_DEG, CONTROL_DT, DEFAULT_WIND_M
 from sims.hexapod.physics import (DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, PLATFORM_KEY_QPOS, HexapodPhysics,
                                   _compiled, _compiled_plant, _radial, _spec, apply_plant, check_elevation,
                                   log_bytes_per_tick, magnified_qpos, top_end_rotation)
+from sims.hexapod import plan_columns
 from sims.hexapod.plan_checks import judge_plans
 from sims.hexapod.sensors import sensors
 from sims.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, ARRIVAL_TOLERANCE, ARRIVAL_ULPS, CAMERA_DRAG_COEFFICIENT,
@@ -42,7 +43,8 @@ from sims.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, ARRIVAL_TOLERANCE, ARRIVA
 from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
 from sims.wind import horizontal_direction
 
-_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT, plant=HexapodPlant(), judge_plans=judge_plans)
+_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT, plant=HexapodPlant(), judge_plans=judge_plans,
+            plan_columns=plan_columns)
 
 SCENARIOS = (
     Scenario(

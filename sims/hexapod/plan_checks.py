@@ -82,7 +82,9 @@ checks, the pose at every tick.
 Throughput (one core of the 2-core development machine, with other jobs on it; the campaign
 examples/hexapod/random_moves_campaign.toml measures it end to end): 10^5 single-move runs, start and target uniform in
 the limits, judged in 26 s of CPU (3800-4300 runs/s: 10^6 in about 4 min); building their
-``HexapodParams`` took 40 s (10^6: about 7 min), longer than judging them.
+``HexapodParams`` took 40 s (10^6: about 7 min), longer than judging them. A campaign's
+columnar path (``sims.hexapod.plan_columns``) builds none: it validates the runs' poses as
+arrays and judges them through ``judge_moves``, the same per-move quantities.
 
 Example::
 
@@ -487,7 +489,14 @@ def judge_plans(params_list: Sequence[HexapodParams], planner=None) -> list[list
     synchronous = np.array([m.synchronous for m in flat], dtype=bool)
     start = np.array([m.start_pose for m in flat], dtype=float).reshape(-1, 6)
     target = np.array([m.target_pose for m in flat], dtype=float).reshape(-1, 6)
-    per_move = {k: np.full(len(flat), np.nan) for k in _KEYS}
+    per_move, refused = judge_moves(start, target, synchronous)
+    return checks_of_runs(per_move, refused, synchronous, offsets)
+
+
+def judge_moves(start: np.ndarray, target: np.ndarray, synchronous: np.ndarray) -> tuple[dict, dict]:
+    """(per-move quantities, {move: the planner's refusal}) of the moves ``start`` -> ``target``
+    ((N, 6) SI poses, each move on its own), planned together by mode (``_plan_group``)."""
+    per_move = {k: np.full(len(synchronous), np.nan) for k in _KEYS}
     refused: dict[int, str] = {}
     for mode in (True, False):
         index = np.flatnonzero(synchronous == mode)
@@ -496,8 +505,13 @@ def judge_plans(params_list: Sequence[HexapodParams], planner=None) -> list[list
             for k in _KEYS:
                 per_move[k][index] = judged[k]
             refused.update({int(index[i]): text for i, text in failures.items()})
+    return per_move, refused
+
+
+def checks_of_runs(per_move: dict, refused: dict, synchronous: np.ndarray, offsets) -> list[list[Check]]:
+    """Each run's checks, its moves ``offsets[r]:offsets[r + 1]`` of the per-move arrays."""
     out = []
-    for r in range(len(params_list)):
+    for r in range(len(offsets) - 1):
         lo, hi = int(offsets[r]), int(offsets[r + 1])
         bad = [i for i in refused if lo <= i < hi] if refused else []
         if bad:
