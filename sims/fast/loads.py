@@ -25,6 +25,15 @@ from sims.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICI
 from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
 
 
+def contiguous(ids) -> slice | np.ndarray:
+    """``ids`` (integer indices) as a slice when they are one ascending run (indexing with it
+    gives a view, at a fraction of fancy indexing's cost), else as they are."""
+    ids = np.asarray(ids)
+    if ids.ndim == 1 and ids.size and np.array_equal(ids, np.arange(ids[0], ids[0] + ids.size)):
+        return slice(int(ids[0]), int(ids[0]) + ids.size)
+    return ids
+
+
 #: The winches' rope speed and acceleration limits, m/s and m/s^2 (models/fast/README.md "Winches
 #: as built"): 25 % above the paper's source-switching speed of the cabin (0.4 m/s, which no
 #: rope exceeds), twice its 0.025 m/s^2.
@@ -52,40 +61,63 @@ class Winches:
     def __init__(self, max_speed: float = WINCH_MAX_SPEED, max_accel: float = WINCH_MAX_ACCEL):
         self.max_speed = float(max_speed)
         self.max_accel = float(max_accel)
-        self.length = None
-        self.rate = None
+        self._length = None
+        self._rate = None
 
     def reset(self, lengths: np.ndarray, dt: float) -> None:
         """Start at rest with the ropes at ``lengths`` (m), ticks of ``dt`` s."""
-        self.length = np.array(lengths, dtype=float)
-        self.rate = np.zeros_like(self.length)
-        self._last_command = self.length.copy()
+        self._length = [float(x) for x in np.asarray(lengths, dtype=float).ravel()]
+        self._rate = [0.0] * len(self._length)
+        self._last_command = list(self._length)
         self.dt = float(dt)
         self._dv = self.max_accel * self.dt
 
+    @property
+    def length(self) -> np.ndarray:
+        """(6,) the ropes' lengths, m (a copy)."""
+        return None if self._length is None else np.array(self._length)
+
+    @property
+    def rate(self) -> np.ndarray:
+        """(6,) the ropes' speeds over the last tick, m/s (a copy)."""
+        return None if self._rate is None else np.array(self._rate)
+
     def __call__(self, command: np.ndarray) -> None:
         """Move the ropes toward ``command`` (m, (6,)) for one tick and write where they are
-        into it."""
-        rate = (command - self.length) / self.dt
-        target_rate = (command - self._last_command) / self.dt
-        self._last_command[:] = command
-        if np.all(np.abs(rate) <= self.max_speed) and np.all(np.abs(rate - self.rate) <= self._dv):
-            self.length[:] = command  # within the limits: the command, to the bit
-            self.rate = rate
+        into it.
+
+        Six ropes: Python floats, one after the other, cost a tenth of numpy's calls on
+        6-vectors; each rope's arithmetic is the vectorized form's, operation for operation
+        (tests/test_fast_winches.py compares them bit for bit)."""
+        dt, dv, max_speed = self.dt, self._dv, self.max_speed
+        wanted = command.tolist()
+        length, last, old = self._length, self._last_command, self._rate
+        rate = [(c - x) / dt for c, x in zip(wanted, length)]
+        self._last_command = wanted
+        if all(-max_speed <= r <= max_speed for r in rate) and \
+                all(-dv <= r - q <= dv for r, q in zip(rate, old)):
+            self._length = wanted  # within the limits: the command, to the bit
+            self._rate = rate
             return
         # Toward the command moving at its own rate: the gap closes at most at the speed from
         # which ticks slowing by a dt each still close it within |e|, v = (n + f) a dt for
         # a dt^2 (n + 1) (n / 2 + f) = |e|, n whole, 0 <= f < 1.
-        error = command - self.length
-        ticks = np.abs(error) / (self._dv * self.dt)
-        n = np.floor((np.sqrt(1.0 + 8.0 * ticks) - 1.0) / 2.0)
-        closing = np.minimum(self._dv * (n + np.clip(ticks / (n + 1.0) - n / 2.0, 0.0, 1.0)),
-                             np.abs(error) / self.dt)
-        rate = np.clip(target_rate + np.sign(error) * closing, -self.max_speed, self.max_speed)
-        rate = np.clip(rate, self.rate - self._dv, self.rate + self._dv)
-        self.length += rate * self.dt
-        self.rate = rate
-        command[:] = self.length
+        step = dv * dt
+        new_rate = []
+        for c, x, p, q in zip(wanted, length, last, old):
+            error = c - x
+            size = abs(error)
+            ticks = size / step
+            n = (math.sqrt(1.0 + 8.0 * ticks) - 1.0) / 2.0
+            n = float(math.floor(n)) if n < math.inf else n  # (a command that is not finite: NaN on)
+            f = min(max(ticks / (n + 1.0) - n / 2.0, 0.0), 1.0)
+            closing = min(dv * (n + f), size / dt)
+            r = (c - p) / dt + (closing if error > 0.0 else -closing if error < 0.0 else 0.0 * closing)
+            r = min(max(r, -max_speed), max_speed)
+            new_rate.append(min(max(r, q - dv), q + dv))
+        self._length = length = [x + r * dt for x, r in zip(length, new_rate)]
+        self._rate = new_rate
+        command[:] = length
 
 
 class CableLoads:
@@ -151,6 +183,7 @@ class CableLoads:
         self._towers = physics.tower_tops
         self._cabin = physics.cabin_body
         self._xfrc = data.xfrc_applied[self._cabin]
+        self._ropes = contiguous(self._cables)  # the winches' commands in ctrl
         if self.winches is not None:
             self.winches.reset(data.ctrl[self._cables], times[1] - times[0] if times.size > 1 else CONTROL_DT)
         mujoco.mj_forward(model, data)
@@ -216,9 +249,9 @@ class CableLoads:
         if self._directions is not None:
             self.direction = self._directions[tick]
         if self.winches is not None:
-            ropes = self._data.ctrl[self._cables]
+            ropes = self._data.ctrl[self._ropes]  # a view where the cables' actuators are a run
             self.winches(ropes)
-            self._data.ctrl[self._cables] = ropes
+            self._data.ctrl[self._ropes] = ropes
         self.apply(physics, tick)
 
 
@@ -259,6 +292,19 @@ class ChainCableLoads(CableLoads):
         self.settling_damping = np.zeros(self._node_dofs.shape)  # N s/m on the nodes (static_equilibrium's)
         tick = float(times[1] - times[0]) if times.size > 1 else self.GEOMETRY_S
         self.geometry_ticks = max(1, int(round(self.GEOMETRY_S / tick)))
+        # Per tick, views where the indices allow (they do in FastPhysics' models: the
+        # segments of each cable in a run, the nodes in a run): the winch segments' lengths,
+        # the passive segments' rest lengths (both ends of the spring's dead band) and the
+        # nodes' applied forces.
+        tendons = self._segments.ravel()
+        first, count = int(tendons[0]), tendons.size
+        if np.array_equal(tendons, np.arange(first, first + count)):
+            self._first_lengths = data.ten_length[first:first + count:n]
+            self._passive_rest = model.tendon_lengthspring[first:first + count].reshape(6, n, 2)[:, 1:]
+        else:
+            self._first_lengths = self._passive_rest = None
+        nodes = contiguous(self._node_ids)
+        self._node_xfrc = data.xfrc_applied[nodes, :3] if isinstance(nodes, slice) else None
         super().reset(physics, times, rng)
 
     def _set_masses(self, rest: np.ndarray) -> None:
@@ -288,23 +334,29 @@ class ChainCableLoads(CableLoads):
 
     def apply(self, physics, tick: int | None = None) -> None:
         model, data = self._model, self._data
-        ids = self._cables
-        self._rest = rest = data.ctrl[ids] * (1.0 / self._n)  # (6,) every segment's unstretched length
+        self._rest = rest = data.ctrl[self._ropes] * (1.0 / self._n)  # (6,) every segment's unstretched length
         refresh = tick is None or tick % self.geometry_ticks == 0 or self._directions is not None
         if refresh:
             self._refresh(rest)
         # The winch's segment: force = (k / n) L0 - k L1 - beta k L1' (k frozen between
         # refreshes, so L0 itself moves its rest length); the others: springs of rest l.
-        model.tendon_lengthspring[self._passive] = rest[self._passive_cable, None]
-        self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
+        if self._passive_rest is not None:
+            self._passive_rest[...] = rest[:, None, None]
+            self.tension = np.maximum(self._k * (self._first_lengths - rest), 0.0)
+        else:
+            model.tendon_lengthspring[self._passive] = rest[self._passive_cable, None]
+            self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
         if tick is not None:
             self.tension_log[tick] = self.tension
         u = 0.0 if tick is None else float(self.speed[tick])
         scale = u * abs(u)  # drag goes with u |u|
         if u != 0.0:
-            np.multiply(self._node_drag, scale, out=self._node_force)
-            data.xfrc_applied[self._node_ids, :3] = self._node_force
-            self.force[tick] = scale * self._total_drag
+            if self._node_xfrc is not None:
+                np.multiply(self._node_drag, scale, out=self._node_xfrc)
+            else:
+                np.multiply(self._node_drag, scale, out=self._node_force)
+                data.xfrc_applied[self._node_ids, :3] = self._node_force
+            np.multiply(self._total_drag, scale, out=self.force[tick])
         np.add(self._static_wrench, scale * self._drag_wrench, out=self._xfrc)
 
     def _refresh(self, rest: np.ndarray) -> None:
