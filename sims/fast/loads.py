@@ -20,18 +20,10 @@ from planners import fast
 from planners.errors import LimitError
 from sims.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICIENT, CABIN_HEIGHT, CABLE_DAMPING_S,
                                CABLE_EA, CONTROL_DT, NODE_DAMPING_RATIO, SEGMENT_OMEGA_DT_LIMIT, STRING_MODE_HZ, FastPhysics,
-                               cable_drag_force, catenary_tension, chord_factor, end_fraction, max_cable_segments,
+                               cable_drag_force, catenary_tension, chord_factor, end_fraction, index_view,
+                               max_cable_segments,
                                moment_sum, node_mass_factor, tangent_stiffness)
 from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
-
-
-def contiguous(ids) -> slice | np.ndarray:
-    """``ids`` (integer indices) as a slice when they are one ascending run (indexing with it
-    gives a view, at a fraction of fancy indexing's cost), else as they are."""
-    ids = np.asarray(ids)
-    if ids.ndim == 1 and ids.size and np.array_equal(ids, np.arange(ids[0], ids[0] + ids.size)):
-        return slice(int(ids[0]), int(ids[0]) + ids.size)
-    return ids
 
 
 #: The winches' rope speed and acceleration limits, m/s and m/s^2 (models/fast/README.md "Winches
@@ -183,7 +175,7 @@ class CableLoads:
         self._towers = physics.tower_tops
         self._cabin = physics.cabin_body
         self._xfrc = data.xfrc_applied[self._cabin]
-        self._ropes = contiguous(self._cables)  # the winches' commands in ctrl
+        self._ropes = index_view(self._cables)  # the winches' commands in ctrl
         if self.winches is not None:
             self.winches.reset(data.ctrl[self._cables], times[1] - times[0] if times.size > 1 else CONTROL_DT)
         mujoco.mj_forward(model, data)
@@ -303,7 +295,7 @@ class ChainCableLoads(CableLoads):
             self._passive_rest = model.tendon_lengthspring[first:first + count].reshape(6, n, 2)[:, 1:]
         else:
             self._first_lengths = self._passive_rest = None
-        nodes = contiguous(self._node_ids)
+        nodes = index_view(self._node_ids)
         self._node_xfrc = data.xfrc_applied[nodes, :3] if isinstance(nodes, slice) else None
         super().reset(physics, times, rng)
 
