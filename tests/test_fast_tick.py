@@ -11,6 +11,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
+from planners.legs import cross, leg_vectors, structure_matrix
 from sims.fast import FastTrackingParams, build_scenario
 from sims.fast.measurement import FusedPoses
 from sims.fast.physics import _LEVI_CIVITA, index_view
@@ -145,3 +146,31 @@ def test_an_index_view_indexes_the_elements_of_its_indices(scattered, start, ste
     assert not isinstance(index_view(np.array([5, 4, 3])), slice)
     assert not isinstance(index_view(np.array([-1, 0, 1])), slice)  # -1: the last element
 
+
+
+def _structure_matrix_with_np_cross(anchors, points, position, rotation):
+    """planners.legs.structure_matrix as it was written first: np.cross, leg_vectors."""
+    vectors = leg_vectors(anchors, points, position, rotation)
+    units = vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+    arms = np.einsum("...jk,nk->...nj", np.asarray(rotation, dtype=float), np.asarray(points, dtype=float))
+    return np.swapaxes(np.concatenate([-units, -np.cross(arms, units)], axis=-1), -1, -2)
+
+
+@settings(max_examples=100, deadline=None)
+@given(arrays(float, (6, 3), elements=st.floats(-300.0, 300.0)), arrays(float, (6, 3), elements=st.floats(-10.0, 10.0)),
+       st.integers(0, 3), arrays(float, (3, 3), elements=st.floats(-1.0, 1.0)), st.floats(-1.0, 1.0))
+def test_the_structure_matrix_and_cross_are_np_cross_s_arithmetic(anchors, points, batch, angles, scale):
+    """structure_matrix with planners.legs.cross: the same matrix, to the bit and in the same
+    memory layout (its transpose feeds matmul), for one pose and for a batch; cross itself
+    against np.cross."""
+    from scipy.spatial.transform import Rotation
+
+    rotations = Rotation.from_rotvec(angles * scale).as_matrix()
+    positions = anchors[:3] * 0.5 + 1.0 + angles
+    for position, rotation in ((positions[0], rotations[0]), (positions[:batch], rotations[:batch])):
+        ours = structure_matrix(anchors, points, position, rotation)
+        theirs = _structure_matrix_with_np_cross(anchors, points, position, rotation)
+        np.testing.assert_array_equal(ours, theirs)
+        assert ours.strides == theirs.strides and ours.shape == theirs.shape
+    np.testing.assert_array_equal(cross(anchors, points), np.cross(anchors, points))
+    np.testing.assert_array_equal(cross(anchors[None], points[:1]), np.cross(anchors[None], points[:1]))

@@ -102,11 +102,18 @@ class Winches:
             ticks = size / step
             n = (math.sqrt(1.0 + 8.0 * ticks) - 1.0) / 2.0
             n = float(math.floor(n)) if n < math.inf else n  # (a command that is not finite: NaN on)
-            f = min(max(ticks / (n + 1.0) - n / 2.0, 0.0), 1.0)
-            closing = min(dv * (n + f), size / dt)
+            # (conditional expressions: what min and max return, without their calls)
+            f = ticks / (n + 1.0) - n / 2.0
+            f = 0.0 if 0.0 > f else f
+            f = 1.0 if 1.0 < f else f
+            closing = dv * (n + f)
+            closing = size / dt if size / dt < closing else closing
             r = (c - p) / dt + (closing if error > 0.0 else -closing if error < 0.0 else 0.0 * closing)
-            r = min(max(r, -max_speed), max_speed)
-            new_rate.append(min(max(r, q - dv), q + dv))
+            r = -max_speed if -max_speed > r else r
+            r = max_speed if max_speed < r else r
+            low, high = q - dv, q + dv
+            r = low if low > r else r
+            new_rate.append(high if high < r else r)
         self._length = length = [x + r * dt for x, r in zip(length, new_rate)]
         self._rate = new_rate
         command[:] = length
