@@ -7,6 +7,7 @@ another order they agree to round-off (1e-15 of the terms)."""
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
@@ -174,3 +175,38 @@ def test_the_structure_matrix_and_cross_are_np_cross_s_arithmetic(anchors, point
         assert ours.strides == theirs.strides and ours.shape == theirs.shape
     np.testing.assert_array_equal(cross(anchors, points), np.cross(anchors, points))
     np.testing.assert_array_equal(cross(anchors[None], points[:1]), np.cross(anchors[None], points[:1]))
+
+
+def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
+    """ChainCableLoads with its views (the runs of FastPhysics' indices) and with them off
+    (indexing, as before): after ticks of winch commands moving and wind, the same actuator
+    laws, spring rest lengths, stiffnesses and dampings, node and anchor masses, node damping,
+    applied forces and tensions, to the bit."""
+    from sims.fast import ChainCableLoads, FastPhysics
+
+    times = np.arange(40) * 0.02
+    runs = []
+    for views in (True, False):
+        physics = FastPhysics.load(2)
+        loads = ChainCableLoads(wind_speed=6.0)
+        data, model = physics.data.ptr, physics.model.ptr
+        loads.reset(physics, times, np.random.default_rng(3))
+        if not views:
+            loads._passive_rest = loads._first_lengths = loads._node_xfrc = None
+            loads._node_force = np.empty_like(loads._node_drag)
+            loads._node_mass_view = loads._node_damping_view = loads._anchor_mass_view = loads._law_views = None
+            loads._ropes = physics.cable_ids
+        else:
+            assert loads._law_views is not None and loads._node_xfrc is not None
+            assert loads._passive_rest is not None and loads._node_mass_view is not None
+        start = data.ctrl[physics.cable_ids].copy()
+        for tick in range(times.size):
+            data.ctrl[physics.cable_ids] = start + 1e-3 * tick * np.arange(1, 7)
+            loads(tick, physics)
+            mujoco.mj_step(model, data, nstep=10)
+        runs.append([model.actuator_gainprm[:, :3].copy(), model.actuator_biasprm[:, :3].copy(),
+                     model.tendon_lengthspring.copy(), model.tendon_stiffness.copy(), model.tendon_damping.copy(),
+                     model.body_mass.copy(), model.dof_damping.copy(), data.xfrc_applied.copy(),
+                     loads.tension_log.copy(), loads.force.copy(), data.qpos.copy()])
+    for ours, theirs in zip(*runs):
+        np.testing.assert_array_equal(ours, theirs)

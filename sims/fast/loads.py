@@ -119,6 +119,18 @@ class Winches:
         command[:] = length
 
 
+def _run_view(array: np.ndarray, ids) -> np.ndarray | None:
+    """``array[ids]`` ((m, ...) indices) as a view when the indices, flattened, are one
+    ascending run (writing into it writes into ``array``); None otherwise."""
+    ids = np.asarray(ids)
+    run = index_view(ids.ravel())
+    if not isinstance(run, slice) or run.step != 1:
+        return None
+    view = array[run]
+    view.shape = ids.shape + array.shape[1:]  # in place: a view of a contiguous run always reshapes
+    return view
+
+
 class CableLoads:
     """The cables' physics and the wind, per control tick (the runner's disturbance).
 
@@ -304,6 +316,23 @@ class ChainCableLoads(CableLoads):
             self._first_lengths = self._passive_rest = None
         nodes = index_view(self._node_ids)
         self._node_xfrc = data.xfrc_applied[nodes, :3] if isinstance(nodes, slice) else None
+        # The refresh's writes into the model, as views where the indices are runs (None: by
+        # index), and its constant factors (each the product the expressions take first).
+        self._node_mass_view = _run_view(model.body_mass, self._nodes)
+        self._node_damping_view = _run_view(model.dof_damping, self._node_dofs)
+        self._anchor_mass_view = _run_view(model.body_mass, self._anchor_masses)
+        self._law_views = None
+        ropes, passive = index_view(physics.cable_ids), _run_view(np.arange(model.ntendon), self._segments)
+        if isinstance(ropes, slice) and ropes.step == 1 and passive is not None:
+            segments = slice(int(self._segments[0, 0]), int(self._segments[-1, -1]) + 1)
+            self._law_views = (model.actuator_gainprm[ropes, 0], model.actuator_biasprm[ropes, 0],
+                               model.actuator_biasprm[ropes, 1], model.actuator_biasprm[ropes, 2],
+                               model.tendon_stiffness[segments].reshape(6, n)[:, 1:],
+                               model.tendon_damping[segments].reshape(6, n)[:, 1:])
+        self._node_mass_factor = node_mass_factor(n) * self.mass_per_length
+        self._node_damping_factor = 2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ
+        self._end_mass_factor = end_fraction(n, load=False) * self.mass_per_length
+        self._end_weight_factor = -end_fraction(n, load=True) * self.weight
         super().reset(physics, times, rng)
 
     def _set_masses(self, rest: np.ndarray) -> None:
@@ -315,11 +344,17 @@ class ChainCableLoads(CableLoads):
         read body_mass every step (body_subtreemass stays the compiled one: it only moves the
         reference point of the trees' spatial quantities, which the dynamics do not depend on)."""
         model, n = self._model, self._n
-        mass = node_mass_factor(n) * self.mass_per_length * rest  # (6,)
+        mass = self._node_mass_factor * rest  # (6,): node_mass_factor(n) mu l
+        damping = (self._node_damping_factor * mass)[:, None, None] + self.settling_damping  # 2 zeta omega m
+        ends = self._end_mass_factor * rest * n  # end_fraction(n, load=False) mu L0
+        if self._node_mass_view is not None and self._node_damping_view is not None and \
+                self._anchor_mass_view is not None:
+            self._node_mass_view[...] = mass[:, None]
+            self._node_damping_view[...] = damping
+            self._anchor_mass_view[...] = ends[0::2] + ends[1::2]
+            return
         model.body_mass[self._nodes] = mass[:, None]
-        model.dof_damping[self._node_dofs] = ((2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[:, None, None]
-                                              + self.settling_damping)
-        ends = end_fraction(n, load=False) * self.mass_per_length * rest * n
+        model.dof_damping[self._node_dofs] = damping
         model.body_mass[self._anchor_masses] = ends[0::2] + ends[1::2]
 
     #: Seconds between refreshes of what changes slowly: the springs' stiffness EA / l (l =
@@ -366,16 +401,25 @@ class ChainCableLoads(CableLoads):
         ids, n = self._cables, self._n
         self._k = k = self.ea / np.maximum(rest, 1e-3)
         self._set_masses(rest)
-        model.actuator_gainprm[ids, 0] = k / n
-        model.actuator_biasprm[ids, 0] = 0.0
-        model.actuator_biasprm[ids, 1] = -k
-        model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
-        model.tendon_stiffness[self._passive] = k[self._passive_cable]
-        model.tendon_damping[self._passive] = CABLE_DAMPING_S * k[self._passive_cable]
+        if self._law_views is not None:
+            gain, bias0, bias1, bias2, stiffness, damping = self._law_views
+            gain[:] = k / n
+            bias0[:] = 0.0
+            bias1[:] = -k
+            bias2[:] = -CABLE_DAMPING_S * k
+            stiffness[...] = k[:, None]
+            damping[...] = (CABLE_DAMPING_S * k)[:, None]
+        else:
+            model.actuator_gainprm[ids, 0] = k / n
+            model.actuator_biasprm[ids, 0] = 0.0
+            model.actuator_biasprm[ids, 1] = -k
+            model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
+            model.tendon_stiffness[self._passive] = k[self._passive_cable]
+            model.tendon_damping[self._passive] = CABLE_DAMPING_S * k[self._passive_cable]
         anchors = data.site_xpos[self._sites]
         arms = anchors - data.xipos[self._cabin]
         weight = np.zeros((6, 3))
-        weight[:, 2] = -end_fraction(n, load=True) * self.weight * rest * n
+        weight[:, 2] = self._end_weight_factor * rest * n  # -end_fraction(n, load=True) w L0
         self._static_wrench = np.concatenate([weight.sum(axis=0), moment_sum(arms, weight)])
         if self.still_air:
             self._drag_wrench = np.zeros(6)
@@ -385,7 +429,8 @@ class ChainCableLoads(CableLoads):
         pieces = np.diff(points, axis=1)  # (6, n, 3) segment vectors
         drag = cable_drag_force(self.direction, pieces.reshape(-1, 3), np.repeat(rest, n)).reshape(6, n, 3)
         self._node_drag = (0.5 * (drag[:, :-1] + drag[:, 1:])).reshape(-1, 3)  # half of each neighbour
-        self._node_force = np.empty_like(self._node_drag)
+        if self._node_xfrc is None:
+            self._node_force = np.empty_like(self._node_drag)
         anchor = 0.5 * drag[:, -1]
         cabin_force, cabin_torque = self._cabin_drag(1.0)
         self._drag_wrench = np.concatenate([anchor.sum(axis=0) + cabin_force, moment_sum(arms, anchor) + cabin_torque])
