@@ -210,3 +210,14 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
                      loads.tension_log.copy(), loads.force.copy(), data.qpos.copy()])
     for ours, theirs in zip(*runs):
         np.testing.assert_array_equal(ours, theirs)
+
+
+@settings(max_examples=100, deadline=None)
+@given(arrays(float, 3, elements=st.floats(-1.0, 1.0)), arrays(float, (3, 3), elements=st.floats(-2.0, 2.0)))
+def test_eye_plus_skew_is_the_sum_it_replaces(v, m):
+    """The fix's I + [v]x, written at once, is np.eye(3) + skew(v), and turns a matrix as it."""
+    from planners.rotations import skew
+    from sims.fast.measurement import _eye_plus_skew
+
+    np.testing.assert_array_equal(_eye_plus_skew(v), np.eye(3) + skew(v))
+    np.testing.assert_array_equal(_eye_plus_skew(v) @ m, (np.eye(3) + skew(v)) @ m)
