@@ -24,7 +24,7 @@ from planners import fast
 from planners.fast import plan as fast_plan
 from planners.legs import leg_lengths, structure_matrix
 from planners.rotations import rot_y, rot_z, skew, vee
-from sims.fast.physics import PHYSICS_DT, FastPhysics, unstretched_length
+from sims.fast.physics import PHYSICS_DT, FastPhysics, index_view, unstretched_length
 from sims.params import ParamError, Params, param
 
 
@@ -187,6 +187,10 @@ class FastController:
         if fused:
             self._setup_fused(specs, control_dt)
         self.command = command = context.command
+        # The tick's writes through views where the actuators are runs (FastPhysics' are).
+        self._cables, self._ab, self._legs = index_view(self.cable_ids), index_view(self.ab_ids), index_view(self.leg_ids)
+        self._last_row = self.l0_ff.shape[0] - 1
+        self._count_key = "cabin_rtk_count" if fused else "cabin_pose_ts_count"
         command[self.cable_ids] = self.l0_ff[0]
         command[self.ab_ids] = self.ab_setpoint[0]
         command[self.leg_ids] = 0.0
@@ -260,12 +264,12 @@ class FastController:
             self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (-obs["leg_positions"]),
                                         -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
             setpoint = self.leg_integral
-        self.command[self.leg_ids] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
+        self.command[self._legs] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
 
     def __call__(self, tick: int, obs) -> None:
         s, command = self.state, self.command
-        nxt = min(tick + 1, self.l0_ff.shape[0] - 1)
-        count = int(obs["cabin_rtk_count" if self.fused else "cabin_pose_ts_count"][0])
+        nxt = tick + 1 if tick < self._last_row else self._last_row
+        count = int(obs[self._count_key][0])
         if count != self.seen:
             self.seen = count
             if self.fused:
@@ -277,10 +281,10 @@ class FastController:
             a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[tick],
                                  s.cabin_rotation[tick])
             self.length_correction = -a.T @ self.correction
-        command[self.cable_ids] = self.l0_ff[nxt] + self.length_correction
+        command[self._cables] = self.l0_ff[nxt] + self.length_correction
         # A-B rotator: position servo with integral action on the encoder error.
         self.ab_integral += self._ab_gain * (self.ab_reference[tick] - obs["ab_angles"])
-        command[self.ab_ids] = self.ab_setpoint[nxt] + self.ab_integral
+        command[self._ab] = self.ab_setpoint[nxt] + self.ab_integral
         command[self.multifeed_id] = s.multifeed[nxt]
         if self.fused:
             return self._fused_legs(obs, nxt)
@@ -291,7 +295,7 @@ class FastController:
                                     -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
         self._leg_target = legs
         setpoint = legs + self.leg_integral
-        command[self.leg_ids] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
+        command[self._legs] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
 
     def _stewart_legs(self, obs, nxt: int) -> np.ndarray:
         """Leg length changes (6,) that put the feed platform at its planned pose for the end of

@@ -20,7 +20,8 @@ from planners import fast
 from planners.errors import LimitError
 from sims.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICIENT, CABIN_HEIGHT, CABLE_DAMPING_S,
                                CABLE_EA, CONTROL_DT, NODE_DAMPING_RATIO, SEGMENT_OMEGA_DT_LIMIT, STRING_MODE_HZ, FastPhysics,
-                               cable_drag_force, catenary_tension, chord_factor, end_fraction, max_cable_segments,
+                               cable_drag_force, catenary_tension, chord_factor, end_fraction, index_view,
+                               max_cable_segments,
                                moment_sum, node_mass_factor, tangent_stiffness)
 from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
 
@@ -52,40 +53,82 @@ class Winches:
     def __init__(self, max_speed: float = WINCH_MAX_SPEED, max_accel: float = WINCH_MAX_ACCEL):
         self.max_speed = float(max_speed)
         self.max_accel = float(max_accel)
-        self.length = None
-        self.rate = None
+        self._length = None
+        self._rate = None
 
     def reset(self, lengths: np.ndarray, dt: float) -> None:
         """Start at rest with the ropes at ``lengths`` (m), ticks of ``dt`` s."""
-        self.length = np.array(lengths, dtype=float)
-        self.rate = np.zeros_like(self.length)
-        self._last_command = self.length.copy()
+        self._length = [float(x) for x in np.asarray(lengths, dtype=float).ravel()]
+        self._rate = [0.0] * len(self._length)
+        self._last_command = list(self._length)
         self.dt = float(dt)
         self._dv = self.max_accel * self.dt
 
+    @property
+    def length(self) -> np.ndarray:
+        """(6,) the ropes' lengths, m (a copy)."""
+        return None if self._length is None else np.array(self._length)
+
+    @property
+    def rate(self) -> np.ndarray:
+        """(6,) the ropes' speeds over the last tick, m/s (a copy)."""
+        return None if self._rate is None else np.array(self._rate)
+
     def __call__(self, command: np.ndarray) -> None:
         """Move the ropes toward ``command`` (m, (6,)) for one tick and write where they are
-        into it."""
-        rate = (command - self.length) / self.dt
-        target_rate = (command - self._last_command) / self.dt
-        self._last_command[:] = command
-        if np.all(np.abs(rate) <= self.max_speed) and np.all(np.abs(rate - self.rate) <= self._dv):
-            self.length[:] = command  # within the limits: the command, to the bit
-            self.rate = rate
+        into it.
+
+        Six ropes: Python floats, one after the other, cost a tenth of numpy's calls on
+        6-vectors; each rope's arithmetic is the vectorized form's, operation for operation
+        (tests/test_fast_winches.py compares them bit for bit)."""
+        dt, dv, max_speed = self.dt, self._dv, self.max_speed
+        wanted = command.tolist()
+        length, last, old = self._length, self._last_command, self._rate
+        rate = [(c - x) / dt for c, x in zip(wanted, length)]
+        self._last_command = wanted
+        if all(-max_speed <= r <= max_speed for r in rate) and \
+                all(-dv <= r - q <= dv for r, q in zip(rate, old)):
+            self._length = wanted  # within the limits: the command, to the bit
+            self._rate = rate
             return
         # Toward the command moving at its own rate: the gap closes at most at the speed from
         # which ticks slowing by a dt each still close it within |e|, v = (n + f) a dt for
         # a dt^2 (n + 1) (n / 2 + f) = |e|, n whole, 0 <= f < 1.
-        error = command - self.length
-        ticks = np.abs(error) / (self._dv * self.dt)
-        n = np.floor((np.sqrt(1.0 + 8.0 * ticks) - 1.0) / 2.0)
-        closing = np.minimum(self._dv * (n + np.clip(ticks / (n + 1.0) - n / 2.0, 0.0, 1.0)),
-                             np.abs(error) / self.dt)
-        rate = np.clip(target_rate + np.sign(error) * closing, -self.max_speed, self.max_speed)
-        rate = np.clip(rate, self.rate - self._dv, self.rate + self._dv)
-        self.length += rate * self.dt
-        self.rate = rate
-        command[:] = self.length
+        step = dv * dt
+        new_rate = []
+        for c, x, p, q in zip(wanted, length, last, old):
+            error = c - x
+            size = abs(error)
+            ticks = size / step
+            n = (math.sqrt(1.0 + 8.0 * ticks) - 1.0) / 2.0
+            n = float(math.floor(n)) if n < math.inf else n  # (a command that is not finite: NaN on)
+            # (conditional expressions: what min and max return, without their calls)
+            f = ticks / (n + 1.0) - n / 2.0
+            f = 0.0 if 0.0 > f else f
+            f = 1.0 if 1.0 < f else f
+            closing = dv * (n + f)
+            closing = size / dt if size / dt < closing else closing
+            r = (c - p) / dt + (closing if error > 0.0 else -closing if error < 0.0 else 0.0 * closing)
+            r = -max_speed if -max_speed > r else r
+            r = max_speed if max_speed < r else r
+            low, high = q - dv, q + dv
+            r = low if low > r else r
+            new_rate.append(high if high < r else r)
+        self._length = length = [x + r * dt for x, r in zip(length, new_rate)]
+        self._rate = new_rate
+        command[:] = length
+
+
+def _run_view(array: np.ndarray, ids) -> np.ndarray | None:
+    """``array[ids]`` ((m, ...) indices) as a view when the indices, flattened, are one
+    ascending run (writing into it writes into ``array``); None otherwise."""
+    ids = np.asarray(ids)
+    run = index_view(ids.ravel())
+    if not isinstance(run, slice) or run.step != 1:
+        return None
+    view = array[run]
+    view.shape = ids.shape + array.shape[1:]  # in place: a view of a contiguous run always reshapes
+    return view
 
 
 class CableLoads:
@@ -151,6 +194,7 @@ class CableLoads:
         self._towers = physics.tower_tops
         self._cabin = physics.cabin_body
         self._xfrc = data.xfrc_applied[self._cabin]
+        self._ropes = index_view(self._cables)  # the winches' commands in ctrl
         if self.winches is not None:
             self.winches.reset(data.ctrl[self._cables], times[1] - times[0] if times.size > 1 else CONTROL_DT)
         mujoco.mj_forward(model, data)
@@ -216,9 +260,9 @@ class CableLoads:
         if self._directions is not None:
             self.direction = self._directions[tick]
         if self.winches is not None:
-            ropes = self._data.ctrl[self._cables]
+            ropes = self._data.ctrl[self._ropes]  # a view where the cables' actuators are a run
             self.winches(ropes)
-            self._data.ctrl[self._cables] = ropes
+            self._data.ctrl[self._ropes] = ropes
         self.apply(physics, tick)
 
 
@@ -259,6 +303,36 @@ class ChainCableLoads(CableLoads):
         self.settling_damping = np.zeros(self._node_dofs.shape)  # N s/m on the nodes (static_equilibrium's)
         tick = float(times[1] - times[0]) if times.size > 1 else self.GEOMETRY_S
         self.geometry_ticks = max(1, int(round(self.GEOMETRY_S / tick)))
+        # Per tick, views where the indices allow (they do in FastPhysics' models: the
+        # segments of each cable in a run, the nodes in a run): the winch segments' lengths,
+        # the passive segments' rest lengths (both ends of the spring's dead band) and the
+        # nodes' applied forces.
+        tendons = self._segments.ravel()
+        first, count = int(tendons[0]), tendons.size
+        if np.array_equal(tendons, np.arange(first, first + count)):
+            self._first_lengths = data.ten_length[first:first + count:n]
+            self._passive_rest = model.tendon_lengthspring[first:first + count].reshape(6, n, 2)[:, 1:]
+        else:
+            self._first_lengths = self._passive_rest = None
+        nodes = index_view(self._node_ids)
+        self._node_xfrc = data.xfrc_applied[nodes, :3] if isinstance(nodes, slice) else None
+        # The refresh's writes into the model, as views where the indices are runs (None: by
+        # index), and its constant factors (each the product the expressions take first).
+        self._node_mass_view = _run_view(model.body_mass, self._nodes)
+        self._node_damping_view = _run_view(model.dof_damping, self._node_dofs)
+        self._anchor_mass_view = _run_view(model.body_mass, self._anchor_masses)
+        self._law_views = None
+        ropes, passive = index_view(physics.cable_ids), _run_view(np.arange(model.ntendon), self._segments)
+        if isinstance(ropes, slice) and ropes.step == 1 and passive is not None:
+            segments = slice(int(self._segments[0, 0]), int(self._segments[-1, -1]) + 1)
+            self._law_views = (model.actuator_gainprm[ropes, 0], model.actuator_biasprm[ropes, 0],
+                               model.actuator_biasprm[ropes, 1], model.actuator_biasprm[ropes, 2],
+                               model.tendon_stiffness[segments].reshape(6, n)[:, 1:],
+                               model.tendon_damping[segments].reshape(6, n)[:, 1:])
+        self._node_mass_factor = node_mass_factor(n) * self.mass_per_length
+        self._node_damping_factor = 2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ
+        self._end_mass_factor = end_fraction(n, load=False) * self.mass_per_length
+        self._end_weight_factor = -end_fraction(n, load=True) * self.weight
         super().reset(physics, times, rng)
 
     def _set_masses(self, rest: np.ndarray) -> None:
@@ -270,11 +344,17 @@ class ChainCableLoads(CableLoads):
         read body_mass every step (body_subtreemass stays the compiled one: it only moves the
         reference point of the trees' spatial quantities, which the dynamics do not depend on)."""
         model, n = self._model, self._n
-        mass = node_mass_factor(n) * self.mass_per_length * rest  # (6,)
+        mass = self._node_mass_factor * rest  # (6,): node_mass_factor(n) mu l
+        damping = (self._node_damping_factor * mass)[:, None, None] + self.settling_damping  # 2 zeta omega m
+        ends = self._end_mass_factor * rest * n  # end_fraction(n, load=False) mu L0
+        if self._node_mass_view is not None and self._node_damping_view is not None and \
+                self._anchor_mass_view is not None:
+            self._node_mass_view[...] = mass[:, None]
+            self._node_damping_view[...] = damping
+            self._anchor_mass_view[...] = ends[0::2] + ends[1::2]
+            return
         model.body_mass[self._nodes] = mass[:, None]
-        model.dof_damping[self._node_dofs] = ((2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)[:, None, None]
-                                              + self.settling_damping)
-        ends = end_fraction(n, load=False) * self.mass_per_length * rest * n
+        model.dof_damping[self._node_dofs] = damping
         model.body_mass[self._anchor_masses] = ends[0::2] + ends[1::2]
 
     #: Seconds between refreshes of what changes slowly: the springs' stiffness EA / l (l =
@@ -288,23 +368,29 @@ class ChainCableLoads(CableLoads):
 
     def apply(self, physics, tick: int | None = None) -> None:
         model, data = self._model, self._data
-        ids = self._cables
-        self._rest = rest = data.ctrl[ids] * (1.0 / self._n)  # (6,) every segment's unstretched length
+        self._rest = rest = data.ctrl[self._ropes] * (1.0 / self._n)  # (6,) every segment's unstretched length
         refresh = tick is None or tick % self.geometry_ticks == 0 or self._directions is not None
         if refresh:
             self._refresh(rest)
         # The winch's segment: force = (k / n) L0 - k L1 - beta k L1' (k frozen between
         # refreshes, so L0 itself moves its rest length); the others: springs of rest l.
-        model.tendon_lengthspring[self._passive] = rest[self._passive_cable, None]
-        self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
+        if self._passive_rest is not None:
+            self._passive_rest[...] = rest[:, None, None]
+            self.tension = np.maximum(self._k * (self._first_lengths - rest), 0.0)
+        else:
+            model.tendon_lengthspring[self._passive] = rest[self._passive_cable, None]
+            self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
         if tick is not None:
             self.tension_log[tick] = self.tension
         u = 0.0 if tick is None else float(self.speed[tick])
         scale = u * abs(u)  # drag goes with u |u|
         if u != 0.0:
-            np.multiply(self._node_drag, scale, out=self._node_force)
-            data.xfrc_applied[self._node_ids, :3] = self._node_force
-            self.force[tick] = scale * self._total_drag
+            if self._node_xfrc is not None:
+                np.multiply(self._node_drag, scale, out=self._node_xfrc)
+            else:
+                np.multiply(self._node_drag, scale, out=self._node_force)
+                data.xfrc_applied[self._node_ids, :3] = self._node_force
+            np.multiply(self._total_drag, scale, out=self.force[tick])
         np.add(self._static_wrench, scale * self._drag_wrench, out=self._xfrc)
 
     def _refresh(self, rest: np.ndarray) -> None:
@@ -315,16 +401,25 @@ class ChainCableLoads(CableLoads):
         ids, n = self._cables, self._n
         self._k = k = self.ea / np.maximum(rest, 1e-3)
         self._set_masses(rest)
-        model.actuator_gainprm[ids, 0] = k / n
-        model.actuator_biasprm[ids, 0] = 0.0
-        model.actuator_biasprm[ids, 1] = -k
-        model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
-        model.tendon_stiffness[self._passive] = k[self._passive_cable]
-        model.tendon_damping[self._passive] = CABLE_DAMPING_S * k[self._passive_cable]
+        if self._law_views is not None:
+            gain, bias0, bias1, bias2, stiffness, damping = self._law_views
+            gain[:] = k / n
+            bias0[:] = 0.0
+            bias1[:] = -k
+            bias2[:] = -CABLE_DAMPING_S * k
+            stiffness[...] = k[:, None]
+            damping[...] = (CABLE_DAMPING_S * k)[:, None]
+        else:
+            model.actuator_gainprm[ids, 0] = k / n
+            model.actuator_biasprm[ids, 0] = 0.0
+            model.actuator_biasprm[ids, 1] = -k
+            model.actuator_biasprm[ids, 2] = -CABLE_DAMPING_S * k
+            model.tendon_stiffness[self._passive] = k[self._passive_cable]
+            model.tendon_damping[self._passive] = CABLE_DAMPING_S * k[self._passive_cable]
         anchors = data.site_xpos[self._sites]
         arms = anchors - data.xipos[self._cabin]
         weight = np.zeros((6, 3))
-        weight[:, 2] = -end_fraction(n, load=True) * self.weight * rest * n
+        weight[:, 2] = self._end_weight_factor * rest * n  # -end_fraction(n, load=True) w L0
         self._static_wrench = np.concatenate([weight.sum(axis=0), moment_sum(arms, weight)])
         if self.still_air:
             self._drag_wrench = np.zeros(6)
@@ -334,7 +429,8 @@ class ChainCableLoads(CableLoads):
         pieces = np.diff(points, axis=1)  # (6, n, 3) segment vectors
         drag = cable_drag_force(self.direction, pieces.reshape(-1, 3), np.repeat(rest, n)).reshape(6, n, 3)
         self._node_drag = (0.5 * (drag[:, :-1] + drag[:, 1:])).reshape(-1, 3)  # half of each neighbour
-        self._node_force = np.empty_like(self._node_drag)
+        if self._node_xfrc is None:
+            self._node_force = np.empty_like(self._node_drag)
         anchor = 0.5 * drag[:, -1]
         cabin_force, cabin_torque = self._cabin_drag(1.0)
         self._drag_wrench = np.concatenate([anchor.sum(axis=0) + cabin_force, moment_sum(arms, anchor) + cabin_torque])

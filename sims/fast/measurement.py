@@ -41,7 +41,7 @@ import scipy.linalg
 import scipy.signal
 
 from planners.rotations import skew, vee
-from sims.fast.physics import _LEVI_CIVITA, CONTROL_DT, PHYSICS_DT, moment_sum
+from sims.fast.physics import CONTROL_DT, PHYSICS_DT, index_view, moment_sum
 from sims.params import ParamError, Params, param
 from sims.task import Sensors, SensorSpec
 
@@ -356,6 +356,9 @@ class FusedPoses:
                 np.repeat([noise["accel_walk"], noise["gyro_walk"]], 3), noise["every"],
                 np.repeat([position_var, attitude_var], 3)))
             self._inverse_inertia.append(inverse_point_inertia(pts))
+        # Per body, its points and its IMU about their centroid, body frame (per fix, else).
+        self._local_points = [p - c for p, c in zip(self.points, self.centroids)]
+        self._local_imu = [o - c for o, c in zip(self.imu_offsets, self.centroids)]
         # Phi^k for k = 0 .. history - 1, to carry a correction at a past tick to the present.
         powers = [np.eye(15)]
         for _ in range(history - 1):
@@ -365,32 +368,87 @@ class FusedPoses:
     def reset(self, positions, rotations) -> None:
         """Start every body at a known pose (the operator's survey of the parked machine),
         at rest: ``positions`` (B, 3), ``rotations`` (B, 3, 3) of the bodies' frames."""
-        self.rotation = np.array(rotations, float)
-        self.position = np.array(positions, float) + np.einsum("bij,bj->bi", self.rotation, self.imu_offsets)
-        self.velocity = np.zeros_like(self.position)
-        self.accel_bias = np.zeros_like(self.position)  # IMU frame
-        self.gyro_bias = np.zeros_like(self.position)
+        rotation = np.array(rotations, float)
+        position = np.array(positions, float) + np.einsum("bij,bj->bi", rotation, self.imu_offsets)
+        # The state per body in Python floats (the IMU's position and velocity, world; its
+        # rotation's rows, 9; the biases, IMU frame): the tick's arithmetic on them costs a
+        # fraction of numpy's calls on (B, 3) arrays (``propagate``).
+        self._position = position.tolist()
+        self._velocity = np.zeros_like(position).tolist()
+        self._rotation = rotation.reshape(-1, 9).tolist()
+        self._accel_bias = np.zeros_like(position).tolist()
+        self._gyro_bias = np.zeros_like(position).tolist()
+        self._gravity = self.gravity.tolist()
+        self._offsets = self.imu_offsets.tolist()
         # Per body, the estimates at the ticks of the fixes still on their way: (tick,
         # position, velocity, rotation), oldest first.
         self._samples = [deque() for _ in self.points]
         self.tick = 0
 
-    def propagate(self, specific_force: np.ndarray, rate: np.ndarray) -> None:
+    @property
+    def position(self) -> np.ndarray:
+        """(B, 3) the IMUs' estimated positions, world, m."""
+        return np.array(self._position)
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """(B, 3) their velocities, world, m/s."""
+        return np.array(self._velocity)
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """(B, 3, 3) the bodies' estimated rotations, world."""
+        return np.array(self._rotation).reshape(-1, 3, 3)
+
+    @property
+    def accel_bias(self) -> np.ndarray:
+        """(B, 3) the accelerometers' estimated biases, IMU frame, m/s^2."""
+        return np.array(self._accel_bias)
+
+    @property
+    def gyro_bias(self) -> np.ndarray:
+        """(B, 3) the gyros' estimated biases, IMU frame, rad/s."""
+        return np.array(self._gyro_bias)
+
+    def propagate(self, specific_force, rate) -> None:
         """One tick of strapdown navigation of every body from its IMU's readings (B, 3), its
         frame, of the tick that ends: attitude by the rate (first order; re-orthonormalized at
-        each fix), acceleration = R (f - b_a) + g."""
+        each fix), acceleration = R (f - b_a) + g.
+
+        In Python floats (a fraction of numpy's cost on (B, 3) arrays), each element's
+        arithmetic that of the vectorized form, R (f - b_a) by einsum and R - R_ik eps_kjl w_l
+        dt (tests/test_fast_measurement.py compares them): R v sums its products as numpy's
+        einsum does for (B, 3, 3) by (B, 3), (R_i0 v_0 + R_i2 v_2) + R_i1 v_1,
+        and each element of R [w dt]x is a difference of two products."""
+        if isinstance(specific_force, np.ndarray):
+            specific_force = specific_force.tolist()
+        if isinstance(rate, np.ndarray):
+            rate = rate.tolist()
         dt = self.dt
-        r = self.rotation
-        acceleration = np.einsum("bij,bj->bi", r, specific_force - self.accel_bias) + self.gravity
-        self.position += (self.velocity + (0.5 * dt) * acceleration) * dt
-        self.velocity += acceleration * dt
-        # R + R [w dt]x, with R [w]x = -R_ik eps_kjl w_l in one call.
-        self.rotation = r - np.einsum("bik,kjl,bl->bij", r, _LEVI_CIVITA, (rate - self.gyro_bias) * dt)
+        half = 0.5 * dt
+        gx, gy, gz = self._gravity
+        positions, velocities, rotations = self._position, self._velocity, self._rotation
+        for b, ((fx, fy, fz), (cx, cy, cz), (wx, wy, wz), (bx, by, bz)) in enumerate(zip(
+                specific_force, self._accel_bias, rate, self._gyro_bias)):
+            r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotations[b]
+            ux, uy, uz = fx - cx, fy - cy, fz - cz
+            ax = (r0 * ux + r2 * uz) + r1 * uy + gx
+            ay = (r3 * ux + r5 * uz) + r4 * uy + gy
+            az = (r6 * ux + r8 * uz) + r7 * uy + gz
+            px, py, pz = positions[b]
+            vx, vy, vz = velocities[b]
+            positions[b] = [px + (vx + half * ax) * dt, py + (vy + half * ay) * dt, pz + (vz + half * az) * dt]
+            velocities[b] = [vx + ax * dt, vy + ay * dt, vz + az * dt]
+            w0, w1, w2 = (wx - bx) * dt, (wy - by) * dt, (wz - bz) * dt
+            rotations[b] = [r0 - (r2 * w1 - r1 * w2), r1 - (r0 * w2 - r2 * w0), r2 - (r1 * w0 - r0 * w1),
+                            r3 - (r5 * w1 - r4 * w2), r4 - (r3 * w2 - r5 * w0), r5 - (r4 * w0 - r3 * w1),
+                            r6 - (r8 * w1 - r7 * w2), r7 - (r6 * w2 - r8 * w0), r8 - (r7 * w0 - r6 * w1)]
         self.tick += 1
 
     def sample(self, body: int) -> None:
         """Keep ``body``'s estimate of the present tick: a fix taken now will be compared with it."""
-        self._samples[body].append((self.tick, self.position[body].copy(), self.rotation[body].copy()))
+        self._samples[body].append((self.tick, np.array(self._position[body]),
+                                    np.array(self._rotation[body]).reshape(3, 3)))
 
     def correct(self, body: int, measured_points: np.ndarray, at_tick: int) -> None:
         """A fix of body ``body``'s points (k, 3) world, m, taken at tick ``at_tick`` (at most
@@ -404,34 +462,50 @@ class FusedPoses:
         sampled, position, estimated = samples.popleft()
         if sampled != at_tick:  # fixes arrive in the order they were taken, each sampled once
             raise ValueError(f"a fix of tick {at_tick} where the filter kept tick {sampled}")
-        centroid = self.centroids[body]
         centre = measured_points.sum(axis=0) / len(measured_points)  # np.mean's arithmetic, at a third of its cost
-        theta = small_rotation_fit(measured_points - centre, (self.points[body] - centroid) @ estimated.T,
+        theta = small_rotation_fit(measured_points - centre, self._local_points[body] @ estimated.T,
                                    estimated @ self._inverse_inertia[body] @ estimated.T)
-        imu_fix = centre + (_EYE3 + skew(theta)) @ (estimated @ (self.imu_offsets[body] - centroid))
+        imu_fix = centre + _eye_plus_skew(theta) @ (estimated @ self._local_imu[body])
         dx = self.gains[body] @ np.concatenate([imu_fix - position, theta])
         for k, (tick, later_position, later_rotation) in enumerate(samples):
             later = self._powers[tick - at_tick] @ dx
             later_position += later[P]
-            samples[k] = (tick, later_position, (_EYE3 + skew(later[TH])) @ later_rotation)
+            samples[k] = (tick, later_position, _eye_plus_skew(later[TH]) @ later_rotation)
         now = self._powers[age] @ dx
-        self.position[body] += now[P]
-        self.velocity[body] += now[V]
-        self.rotation[body] = _orthonormal((_EYE3 + skew(now[TH])) @ self.rotation[body])
+        self._position[body] = (np.array(self._position[body]) + now[P]).tolist()
+        self._velocity[body] = (np.array(self._velocity[body]) + now[V]).tolist()
+        rotation = _orthonormal(_eye_plus_skew(now[TH]) @ np.array(self._rotation[body]).reshape(3, 3))
+        self._rotation[body] = rotation.ravel().tolist()
         # The biases' corrections (world frame) in the IMU's frame: the error is the true
         # bias less the estimate, so the estimate grows by it.
-        self.accel_bias[body] += self.rotation[body].T @ now[BA]
-        self.gyro_bias[body] += self.rotation[body].T @ now[BG]
+        self._accel_bias[body] = (np.array(self._accel_bias[body]) + rotation.T @ now[BA]).tolist()
+        self._gyro_bias[body] = (np.array(self._gyro_bias[body]) + rotation.T @ now[BG]).tolist()
 
     def body_poses(self):
         """(origins (B, 3), rotations (B, 3, 3), velocities (B, 3)) of the bodies' frames, world."""
-        return (self.position - np.einsum("bij,bj->bi", self.rotation, self.imu_offsets), self.rotation,
-                self.velocity)
+        return np.array(self.body_origins()), self.rotation, self.velocity
+
+    def body_origins(self) -> list:
+        """Per body, its frame's origin [x, y, z] (world, m): the IMU's position less its
+        offset turned by the rotation (R o summed as ``propagate`` sums R v)."""
+        out = []
+        for (px, py, pz), (r0, r1, r2, r3, r4, r5, r6, r7, r8), (ox, oy, oz) in zip(
+                self._position, self._rotation, self._offsets):
+            out.append([px - ((r0 * ox + r2 * oz) + r1 * oy), py - ((r3 * ox + r5 * oz) + r4 * oy),
+                        pz - ((r6 * ox + r8 * oz) + r7 * oy)])
+        return out
 
 
 #: Constants of the per-fix arithmetic (an allocation each, otherwise).
 _EYE3 = np.eye(3)
 _EYE3_15 = 1.5 * np.eye(3)
+
+
+def _eye_plus_skew(v: np.ndarray) -> np.ndarray:
+    """I + [v]x (3, 3) of one vector (3,): the sum's elements (a one or a component) written
+    at once, a fraction of the sum's cost."""
+    x, y, z = v.tolist()
+    return np.array([[1.0, -z, y], [z, 1.0, -x], [-y, x, 1.0]])
 
 
 def small_rotation_fit(measured: np.ndarray, predicted: np.ndarray, inverse_inertia: np.ndarray) -> np.ndarray:
@@ -570,45 +644,89 @@ class FusedSensors(Sensors):
         obs.update(ab_angles=np.zeros(2), ab_rotation=np.eye(3), leg_positions=np.zeros(6), leg_setpoints=np.zeros(6))
         self.observation = obs
         self._fix_key = {"cabin": "cabin_rtk", "platform": "platform_ts"}
+        # What the tick reads, looked up once: the IMUs' sites and their readings' places in
+        # one block of sensordata; per body its fix's period, latency, points, errors, queue
+        # and observation arrays; the encoders' views.
+        self._imu_site_ids = [int(i) for i in self._imu_sites]
+        columns = np.concatenate([self._vel_columns.ravel(), self._gyro_columns.ravel()])
+        low = int(columns.min())
+        self._imu_block = slice(low, int(columns.max()) + 1)
+        self._imu_places = [(int(v[0]) - low, int(g[0]) - low) for v, g in zip(self._vel_columns, self._gyro_columns)]
+        if not all(np.array_equal(c, c[0] + np.arange(3)) for c in (*self._vel_columns, *self._gyro_columns)):
+            raise ValueError("the IMUs' readings must be 3 consecutive sensordata columns each")
+        self._gravity_list = self.gravity.tolist()
+        self._fixes = []
+        for b in self.BODIES:
+            key = self._fix_key[b]
+            self._fixes.append((self.fix_every[b], self.fix_lag[b], index_view(self.point_sites[b]),
+                                self.fix_error[b], self.pending[b], obs[f"{key}_points"], obs[f"{key}_time"],
+                                obs[f"{key}_count"]))
+        self._encoders = (obs["ab_angles"], index_view(physics.ab_qpos), obs["leg_positions"],
+                          index_view(physics.leg_qpos), obs["leg_setpoints"], index_view(physics.leg_act),
+                          physics.cabin_body, physics.ab_b_body, obs["ab_rotation"])
+        self._rotation_rows = self._rotation.reshape(2, 9)
+        self._accel_flat, self._gyro_flat = self._accel.reshape(6), self._gyro.reshape(6)
+        self._velocity_flat = self._velocity.reshape(6)
         self(0, physics)
         return obs
 
     def __call__(self, tick: int, physics) -> None:
-        data, obs = self._data, self.observation
-        sd = data.sensordata
+        data, dt = self._data, self.dt
         # The IMUs: the tick's specific force from the velocity increment, and the rate, in
-        # their frames, with their errors.
-        rotation = data.site_xmat[self._imu_sites].reshape(2, 3, 3)
-        velocity = np.einsum("kij,kj->ki", rotation, sd[self._vel_columns])
-        if tick > 0:
-            force = (velocity - self._last_velocity) / self.dt - self.gravity
-        else:
-            force = np.broadcast_to(-self.gravity, (2, 3))
-        np.add(np.einsum("kji,kj->ki", rotation, force), self.accel_error[tick], out=self._accel)
-        np.add(sd[self._gyro_columns], self.gyro_error[tick], out=self._gyro)
-        self._last_velocity = velocity
+        # their frames, with their errors. In Python floats, each element's arithmetic that
+        # of the vectorized form (tests/test_fast_measurement.py): the world velocity R v
+        # summed as numpy's einsum sums it (FusedPoses.propagate), R^T f in order.
+        block = data.sensordata[self._imu_block].tolist()
+        accel_error, gyro_error = self.accel_error[tick].tolist(), self.gyro_error[tick].tolist()
+        gx, gy, gz = self._gravity_list
+        xmat = data.site_xmat
+        velocities, accels, gyros = [], [], []
+        for k, site in enumerate(self._imu_site_ids):
+            r0, r1, r2, r3, r4, r5, r6, r7, r8 = xmat[site].tolist()
+            at, gt = self._imu_places[k]
+            v0, v1, v2 = block[at:at + 3]
+            w0, w1, w2 = (r0 * v0 + r2 * v2) + r1 * v1, (r3 * v0 + r5 * v2) + r4 * v1, (r6 * v0 + r8 * v2) + r7 * v1
+            if tick > 0:
+                l0, l1, l2 = self._last_velocity[k]
+                f0, f1, f2 = (w0 - l0) / dt - gx, (w1 - l1) / dt - gy, (w2 - l2) / dt - gz
+            else:
+                f0, f1, f2 = -gx, -gy, -gz
+            e0, e1, e2 = accel_error[k]
+            accels.append([((r0 * f0 + r3 * f1) + r6 * f2) + e0, ((r1 * f0 + r4 * f1) + r7 * f2) + e1,
+                           ((r2 * f0 + r5 * f1) + r8 * f2) + e2])
+            e0, e1, e2 = gyro_error[k]
+            gyros.append([block[gt] + e0, block[gt + 1] + e1, block[gt + 2] + e2])
+            velocities.append([w0, w1, w2])
+        self._last_velocity = velocities
+        self._accel_flat[:] = accels[0] + accels[1]  # (flat lists: a third cheaper to write)
+        self._gyro_flat[:] = gyros[0] + gyros[1]
         f = self.filters
         if tick > 0:
-            f.propagate(self._accel, self._gyro)
-        for k, b in enumerate(self.BODIES):
-            every = self.fix_every[b]
+            f.propagate(accels, gyros)
+        for k, (every, lag, sites, errors, queue, points_obs, time_obs, count_obs) in enumerate(self._fixes):
             if tick % every == 0:  # a fix taken now, delivered after its latency
                 f.sample(k)
-                points = data.site_xpos[self.point_sites[b]] + self.fix_error[b][tick // every]
-                self.pending[b].append((tick + self.fix_lag[b], points, tick))
-            queue = self.pending[b]
+                queue.append((tick + lag, data.site_xpos[sites] + errors[tick // every], tick))
             while queue and queue[0][0] <= tick:
                 _, points, taken = queue.popleft()
                 f.correct(k, points, taken)
-                key = self._fix_key[b]
-                obs[f"{key}_points"][:] = points
-                obs[f"{key}_time"][0] = taken * self.dt
-                obs[f"{key}_count"][0] += 1
-        self._position[:], self._rotation[:], self._velocity[:] = f.body_poses()
-        self._time[0] = tick * self.dt
-        self.estimate_log[tick, :, :3] = self._position
-        self.estimate_log[tick, :, 3:] = self._rotation.reshape(2, 9)
-        read_encoders(self._physics, data, obs)
+                points_obs[:] = points
+                time_obs[0] = taken * dt
+                count_obs[0] += 1
+        row = self.estimate_log[tick]
+        (cabin, platform), (cabin_rotation, platform_rotation) = f.body_origins(), f._rotation
+        row.reshape(24)[:] = cabin + cabin_rotation + platform + platform_rotation
+        self._position[:] = row[:, :3]
+        self._rotation_rows[:] = row[:, 3:]
+        cabin, platform = f._velocity
+        self._velocity_flat[:] = cabin + platform
+        self._time[0] = tick * dt
+        ab_angles, ab_qpos, legs, leg_qpos, setpoints, leg_act, cabin, ab_b, ab_rotation = self._encoders
+        qpos, xmat = data.qpos, data.xmat
+        ab_angles[:] = qpos[ab_qpos]
+        legs[:] = qpos[leg_qpos]
+        setpoints[:] = data.act[leg_act]
+        np.matmul(xmat[cabin].reshape(3, 3).T, xmat[ab_b].reshape(3, 3), out=ab_rotation)
 
 
 def _ticks(seconds: float, dt: float, least: int) -> int:
