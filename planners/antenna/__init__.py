@@ -481,19 +481,22 @@ def _log_floats(r) -> tuple:
 
 
 def _gram_floats(jac, w_inv) -> tuple:
-    """(J W^-1 (4 columns of 3), J W^-1 J^T as its 6 distinct entries g00 g01 g02 g11 g12 g22)."""
-    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3) = jac
+    """(J W^-1 (3 rows of 4), J W^-1 J^T as its 6 distinct entries g00 g01 g02 g11 g12 g22).
+
+    J's structural zeros (the azimuth axis is Z: J[0][0] = J[1][0] = 0; the elevation axis
+    is horizontal: J[2][1] = 0) are left out of the sums (their terms are zeros)."""
+    (_, a1, a2, a3), (_, b1, b2, b3), (c0, _, c2, c3) = jac
     w0, w1, w2, w3 = w_inv
-    ja = (a0 * w0, a1 * w1, a2 * w2, a3 * w3)
-    jb = (b0 * w0, b1 * w1, b2 * w2, b3 * w3)
-    jc = (c0 * w0, c1 * w1, c2 * w2, c3 * w3)
-    gram = (ja[0] * a0 + ja[1] * a1 + ja[2] * a2 + ja[3] * a3,
-            ja[0] * b0 + ja[1] * b1 + ja[2] * b2 + ja[3] * b3,
-            ja[0] * c0 + ja[1] * c1 + ja[2] * c2 + ja[3] * c3,
-            jb[0] * b0 + jb[1] * b1 + jb[2] * b2 + jb[3] * b3,
-            jb[0] * c0 + jb[1] * c1 + jb[2] * c2 + jb[3] * c3,
-            jc[0] * c0 + jc[1] * c1 + jc[2] * c2 + jc[3] * c3)
-    return (ja, jb, jc), gram
+    ja1, ja2, ja3 = a1 * w1, a2 * w2, a3 * w3
+    jb1, jb2, jb3 = b1 * w1, b2 * w2, b3 * w3
+    jc0, jc2, jc3 = c0 * w0, c2 * w2, c3 * w3
+    gram = (ja1 * a1 + ja2 * a2 + ja3 * a3,
+            ja1 * b1 + ja2 * b2 + ja3 * b3,
+            ja2 * c2 + ja3 * c3,
+            jb1 * b1 + jb2 * b2 + jb3 * b3,
+            jb2 * c2 + jb3 * c3,
+            jc0 * c0 + jc2 * c2 + jc3 * c3)
+    return ((0.0, ja1, ja2, ja3), (0.0, jb1, jb2, jb3), (jc0, 0.0, jc2, jc3)), gram
 
 
 def _det_floats(g) -> float:
@@ -519,9 +522,8 @@ def _solve_floats(jw, g, omega, damping: float = 0.0) -> list:
     x0 = (k00 * o0 + k01 * o1 + k02 * o2) / det
     x1 = (k01 * o0 + k11 * o1 + k12 * o2) / det
     x2 = (k02 * o0 + k12 * o1 + k22 * o2) / det
-    ja, jb, jc = jw
-    return [ja[0] * x0 + jb[0] * x1 + jc[0] * x2, ja[1] * x0 + jb[1] * x1 + jc[1] * x2,
-            ja[2] * x0 + jb[2] * x1 + jc[2] * x2, ja[3] * x0 + jb[3] * x1 + jc[3] * x2]
+    (_, ja1, ja2, ja3), (_, jb1, jb2, jb3), (jc0, _, jc2, jc3) = jw
+    return [jc0 * x2, ja1 * x0 + jb1 * x1, ja2 * x0 + jb2 * x1 + jc2 * x2, ja3 * x0 + jb3 * x1 + jc3 * x2]
 
 
 def _damping_floats(g, limits: AntennaLimits) -> float:
@@ -557,18 +559,23 @@ def _joint_rates_floats(theta, omega, w_inv, limits: AntennaLimits | None, rate_
     if damping:
         rates = _solve_floats(jw, gram, omega, damping)
     limited = False
+    l0, l1, l2, l3 = rate_limits
     for _ in range(4):
-        ratio = [abs(r) / lim for r, lim in zip(rates, rate_limits)]
-        if max(ratio) <= 1.0:
-            break
+        r0, r1, r2, r3 = rates
+        q0, q1, q2, q3 = abs(r0) / l0, abs(r1) / l1, abs(r2) / l2, abs(r3) / l3
+        if max(q0, q1, q2, q3) <= 1.0:
+            return rates, damping > 0.0, limited
         limited = True
-        w_inv = [w / (max(q, 1.0) * max(q, 1.0)) for w, q in zip(w_inv, ratio)]
+        q0, q1, q2, q3 = max(q0, 1.0), max(q1, 1.0), max(q2, 1.0), max(q3, 1.0)
+        w0, w1, w2, w3 = w_inv
+        w_inv = (w0 / (q0 * q0), w1 / (q1 * q1), w2 / (q2 * q2), w3 / (q3 * q3))
         jw, weighted = _gram_floats(jac, w_inv)
         rates = _solve_floats(jw, weighted, omega, damping)
-    ratio = max(abs(r) / lim for r, lim in zip(rates, rate_limits))
+    r0, r1, r2, r3 = rates
+    ratio = max(abs(r0) / l0, abs(r1) / l1, abs(r2) / l2, abs(r3) / l3)
     if ratio > 1.0:
         limited = True
-        rates = [r / ratio for r in rates]
+        rates = [r0 / ratio, r1 / ratio, r2 / ratio, r3 / ratio]
     return rates, damping > 0.0, limited
 
 
@@ -593,7 +600,7 @@ def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
     (3, 3). Returns (Theta_{n+1} (4,), StepInfo)."""
     if omega_method not in ("eq6", "log"):
         raise PlanningError(f"angular velocity method {omega_method!r} is not 'eq6' or 'log'")
-    th = [float(v) for v in np.asarray(theta, dtype=float).reshape(4)]
+    th = tuple(np.asarray(theta, dtype=float).reshape(4).tolist())
     target = np.asarray(n_next, dtype=float).reshape(9).tolist()
     relative = _relative_floats(target, np.asarray(n_now, dtype=float).reshape(9).tolist())
     if omega_method == "log":
@@ -613,37 +620,42 @@ def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
         return r
 
     half = 0.5 * dt
-    k1 = rate(th)
-    k2 = rate([t + half * k for t, k in zip(th, k1)])
-    k3 = rate([t + half * k for t, k in zip(th, k2)])
-    k4 = rate([t + dt * k for t, k in zip(th, k3)])
-    average = [(a + 2.0 * b + 2.0 * c + d) / 6.0 for a, b, c, d in zip(k1, k2, k3, k4)]  # eq. (11)
-    speed = math.sqrt(sum(a * a for a in average))
+    t0, t1, t2, t3 = th
+    a0, a1, a2, a3 = rate(th)
+    b0, b1, b2, b3 = rate((t0 + half * a0, t1 + half * a1, t2 + half * a2, t3 + half * a3))
+    c0, c1, c2, c3 = rate((t0 + half * b0, t1 + half * b1, t2 + half * b2, t3 + half * b3))
+    d0, d1, d2, d3 = rate((t0 + dt * c0, t1 + dt * c1, t2 + dt * c2, t3 + dt * c3))
+    # eq. (11)
+    m0, m1 = (a0 + 2.0 * b0 + 2.0 * c0 + d0) / 6.0, (a1 + 2.0 * b1 + 2.0 * c1 + d1) / 6.0
+    m2, m3 = (a2 + 2.0 * b2 + 2.0 * c2 + d2) / 6.0, (a3 + 2.0 * b3 + 2.0 * c3 + d3) / 6.0
+    speed = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2 + m3 * m3)
     new = th
     if speed > 0.0:
-        ratio = [a / speed for a in average]  # k of eq. (12)-(14)
+        q0, q1, q2, q3 = m0 / speed, m1 / speed, m2 / speed, m3 / speed  # k of eq. (12)-(14)
         xi = speed
         for iteration in range(1, max_iter + 1):
             h = xi * dt
-            new = [t + q * h for t, q in zip(th, ratio)]
-            residual = _log_floats(_relative_floats(target, _fk_floats(*new)))
-            jac = _jacobian_rows(new[0], new[1], new[2])
-            # d(rotation)/d(xi) = J k dt
-            slope = [(row[0] * ratio[0] + row[1] * ratio[1] + row[2] * ratio[2] + row[3] * ratio[3]) * dt
-                     for row in jac]
-            step = ((slope[0] * residual[0] + slope[1] * residual[1] + slope[2] * residual[2])
-                    / (slope[0] * slope[0] + slope[1] * slope[1] + slope[2] * slope[2]))
+            new = (t0 + q0 * h, t1 + q1 * h, t2 + q2 * h, t3 + q3 * h)
+            e0, e1, e2 = _log_floats(_relative_floats(target, _fk_floats(*new)))
+            (_, j01, j02, j03), (_, j11, j12, j13), (j20, _, j22, j23) = _jacobian_rows(new[0], new[1], new[2])
+            # d(rotation)/d(xi) = J k dt (J's structural zeros left out)
+            s0 = (j01 * q1 + j02 * q2 + j03 * q3) * dt
+            s1 = (j11 * q1 + j12 * q2 + j13 * q3) * dt
+            s2 = (j20 * q0 + j22 * q2 + j23 * q3) * dt
+            step = (s0 * e0 + s1 * e1 + s2 * e2) / (s0 * s0 + s1 * s1 + s2 * s2)
             xi += step
             info.iterations = iteration
             if abs(step) * dt < tol:
                 break
         if limits is not None:
-            cap = min(lim / max(abs(q), 1e-300) for lim, q in zip(rate_limits, ratio))
+            l0, l1, l2, l3 = rate_limits
+            cap = min(l0 / max(abs(q0), 1e-300), l1 / max(abs(q1), 1e-300), l2 / max(abs(q2), 1e-300),
+                      l3 / max(abs(q3), 1e-300))
             if abs(xi) > cap:
-                xi = math.copysign(cap, xi) if xi != 0.0 else 0.0
+                xi = math.copysign(cap, xi)
                 info.rate_limited = True
         h = xi * dt
-        new = [t + q * h for t, q in zip(th, ratio)]
+        new = (t0 + q0 * h, t1 + q1 * h, t2 + q2 * h, t3 + q3 * h)
     if full_correction:
         w_corr = [1.0 / float(w) for w in weights]
         for _ in range(max_iter):
@@ -654,7 +666,7 @@ def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
             jw, gram = _gram_floats(jac, w_corr)
             damping = 0.0 if limits is None else _damping_floats(gram, limits)
             delta = _solve_floats(jw, gram, residual, damping)
-            new = [t + d for t, d in zip(new, delta)]
+            new = (new[0] + delta[0], new[1] + delta[1], new[2] + delta[2], new[3] + delta[3])
             info.iterations += 1
     f = _fk_floats(*new)
     info.error_fro = math.sqrt(sum((a - b) * (a - b) for a, b in zip(f, target)))
@@ -692,11 +704,12 @@ class JointPath:
 
 def solve_joint_path(attitudes, dt: float, theta0, method: str = "crr",
                      weights=PAPER_WEIGHTS, limits: AntennaLimits | None = None,
-                     omega_method: str = "eq6", t0: float = 0.0) -> JointPath:
+                     omega_method: str = "eq6", t0: float = 0.0, scalar: bool = False) -> JointPath:
     """Joint angles that hold the attitudes N(t0 + n dt) (n, 3, 3), from Theta0.
 
     method: "pinv" (the paper's baseline, section 5.2), "crr" (section 4.2) or "crr-full"
-    (CRR then a full weighted Newton correction).
+    (CRR then a full weighted Newton correction). ``scalar``: the CRR updates by
+    ``crr_step_scalar`` (the online planner's one-pose path in floats; equal to round-off).
     """
     if method not in METHODS:
         raise PlanningError(f"joint-position method {method!r} is not one of {', '.join(METHODS)}")
@@ -723,9 +736,9 @@ def solve_joint_path(attitudes, dt: float, theta0, method: str = "crr",
             theta[i + 1], info = pinv_integration_step(theta[i], attitudes[i], attitudes[i + 1],
                                                        dt, weights, omega_method)
         else:
-            theta[i + 1], info = crr_step(theta[i], attitudes[i], attitudes[i + 1], dt, weights,
-                                          limits=limits, omega_method=omega_method,
-                                          full_correction=method == "crr-full")
+            theta[i + 1], info = (crr_step_scalar if scalar else crr_step)(
+                theta[i], attitudes[i], attitudes[i + 1], dt, weights, limits=limits, omega_method=omega_method,
+                full_correction=method == "crr-full")
         error[i + 1] = info.error_fro
         iterations[i + 1] = info.iterations
         damped[i + 1] = info.damped
