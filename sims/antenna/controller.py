@@ -56,6 +56,7 @@ class AntennaController:
         self.theta_from, self.theta_to = theta, theta + rate * first * self.dt
         self.ff_from, self.ff_to = rate, rate.copy()
         self.tick_from, self.tick_to = 0, first
+        self._fractions = {}  # span -> (span + 1, 1) fractions of the ramp
         self._tables()
         self.last_gyro = None
         self.command = context.command
@@ -93,10 +94,13 @@ class AntennaController:
         tick_to they stay at the last row) and the set-point targets from them, computed
         once per update with the same arithmetic as a tick-by-tick evaluation."""
         span = self.tick_to - self.tick_from
-        if span <= 0:
-            fraction = np.ones((1, 1))
-        else:
-            fraction = np.minimum(np.maximum(np.arange(span + 1) / span, 0.0), 1.0)[:, None]
+        fraction = self._fractions.get(span)
+        if fraction is None:  # the span is the IMU's period but for the first
+            if span <= 0:
+                fraction = np.ones((1, 1))
+            else:
+                fraction = np.minimum(np.maximum(np.arange(span + 1) / span, 0.0), 1.0)[:, None]
+            self._fractions[span] = fraction
         self._ramps = self.theta_from + fraction * (self.theta_to - self.theta_from)
         self._feedforwards = self.ff_from + fraction * (self.ff_to - self.ff_from)
         self._targets = self._ramps + self.lead * self._feedforwards
