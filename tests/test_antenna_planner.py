@@ -451,7 +451,9 @@ def test_scalar_joint_rates_equal_joint_rates(theta, omega, weights, limits):
     scale = np.abs(expected).max() + np.linalg.norm(omega)
     tolerance = 1e-14 * _worst_condition(theta, omega, weights, limits)
     np.testing.assert_allclose(rates, expected, rtol=0, atol=tolerance * scale + 1e-300)
-    assert (damped_f, limited_f) == (damped, limited)
+    assert damped_f == damped
+    if limited_f != limited:  # only where a rate is at its limit to round-off (ratio 1 +- 1e-12)
+        assert np.abs(np.abs(expected) / limits.rate - 1.0).min() < 1e-12
 
 
 @settings(max_examples=150, deadline=None)
