@@ -145,15 +145,18 @@ class ServoFeedforwardController:
                 self.force_limit * (1.0 / self.kp + self.compliance)
         self._inv_dt = 1.0 / context.control_dt
         self._command = context.command  # written in place every tick
+        self._last_tick = self.setpoints.shape[0] - 1
+        self._difference = np.empty(nu)
         context.setpoint[:] = self.setpoints[0]
 
     def __call__(self, tick: int, observation) -> None:
-        target = self.setpoints[min(tick + 1, self.setpoints.shape[0] - 1)]
+        target = self.setpoints[min(tick + 1, self._last_tick)]
         if self._gain:
             z = self.z + self._gain * (self.reference[tick] - observation["joint_positions"])
             self.z = np.clip(z, -self._bound, self._bound)
             target = target + self.z
-        self._command[:] = (target - observation["setpoints"]) * self._inv_dt
+        np.multiply(np.subtract(target, observation["setpoints"], out=self._difference), self._inv_dt,
+                    out=self._command)
 
 
 def demanded_force(kp, kv, act, qpos, qvel) -> np.ndarray:

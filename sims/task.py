@@ -165,7 +165,8 @@ class JointEncoders(Sensors):
         self._all_counted = bool(self._counted.all())
         self._counts_per_unit = np.divide(1.0, self.resolution, out=np.zeros_like(self.resolution),
                                           where=self._counted)
-        self._copies = []  # (buffer getter, index, out) read by __call__ every tick
+        self._copies = []  # (live buffer, index, out) read by __call__ every tick
+        self._counted_run = None  # (live view, out): counted positions read in one pass
 
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
         data = physics.data.ptr
@@ -176,13 +177,20 @@ class JointEncoders(Sensors):
         sources = [("joint_positions", lambda d: d.qpos, self.qpos),
                    ("joint_velocities", lambda d: d.qvel, self.dofs),
                    ("setpoints", lambda d: d.act, self.acts)]
+        self._counted_run = None
         for name, getter, index in sources:
             buffer = getter(data)
             if _is_run(index) and (self._ideal or name != "joint_positions"):
                 obs[name] = readonly_view(buffer, index)
+            elif _is_run(index) and self._all_counted and not self._noisy:
+                # Counted, noiseless positions of a run of joints: floor(x (1/r)) r straight
+                # from the live buffer (the same arithmetic as copying first).
+                out = np.empty(index.size)
+                self._counted_run = (readonly_view(buffer, index), out)
+                obs[name] = out
             else:
                 out = np.empty(index.size)
-                self._copies.append((getter, index, out))
+                self._copies.append((buffer, index, out))
                 obs[name] = out
         self._positions = obs["joint_positions"]
         self.observation = obs
@@ -190,10 +198,14 @@ class JointEncoders(Sensors):
         return obs
 
     def __call__(self, tick: int, physics) -> None:
-        data = self._data
-        for getter, index, out in self._copies:
-            np.take(getter(data), index, out=out)
-        if not self._ideal:
+        for buffer, index, out in self._copies:
+            np.take(buffer, index, out=out)
+        if self._counted_run is not None:
+            source, positions = self._counted_run
+            np.multiply(source, self._counts_per_unit, out=positions)
+            np.floor(positions, out=positions)
+            np.multiply(positions, self.resolution, out=positions)
+        elif not self._ideal:
             if self._noisy:
                 self._positions += self.bias + self.noise * self._rng.standard_normal(self.noise.size)
             if self._all_counted:  # in place: a tick's reading costs no new arrays

@@ -376,3 +376,144 @@ def test_crr_step_properties(theta, omega, dt):
     assert full.error_fro < 1e-13
     # Without an update the error would be the whole step: ||R - I||_F = 2 sqrt(2) sin(a / 2).
     assert log.error_fro < 2e-3 * 2 * np.sqrt(2) * np.sin(step / 2) + 1e-14
+
+
+# ------------------------------------------------------- the one-pose fast path (floats)
+
+rotvecs = st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array)
+limit_sets = st.one_of(st.none(), st.lists(st.floats(0.05, 2.0), min_size=4, max_size=4).map(
+    lambda r: ant.AntennaLimits(rate=np.array(r))))
+weight_sets = st.lists(st.floats(0.5, 20.0), min_size=4, max_size=4).map(np.array)
+
+
+@given(joint_angles)
+def test_scalar_kinematics_are_those_of_the_vectorized_functions(theta):
+    """Eq. (2) and (4) in floats: the same arithmetic as the (4,) path, to the bit."""
+    np.testing.assert_array_equal(np.reshape(ant._fk_floats(*theta), (3, 3)), ant.forward_kinematics(theta))
+    np.testing.assert_array_equal(np.array(ant._jacobian_rows(*theta[:3])), ant.jacobian(theta))
+    a, b = ant.forward_kinematics(theta), ant.forward_kinematics(theta[::-1])
+    np.testing.assert_allclose(np.reshape(ant._relative_floats(a.ravel(), b.ravel()), (3, 3)), a @ b.T,
+                               rtol=0, atol=1e-15)
+
+
+@given(st.one_of(rotvecs, rotvecs.map(lambda v: v * 1e-5), rotvecs.map(lambda v: v * 1.8)))
+def test_scalar_rotation_log_equals_rotation_log(rotvec):
+    r = Rotation.from_rotvec(rotvec).as_matrix()
+    expected = ant.rotation_log(r)
+    np.testing.assert_allclose(ant._log_floats(r.ravel().tolist()), expected, rtol=0,
+                               atol=1e-14 * np.linalg.norm(expected) + 1e-300)
+
+
+def test_scalar_rotation_log_refuses_a_half_turn():
+    r = Rotation.from_rotvec([0.0, np.pi - 1e-7, 0.0]).as_matrix()
+    with pytest.raises(PlanningError, match="too close to 180 deg"):
+        ant._log_floats(r.ravel().tolist())
+
+
+def _worst_condition(theta, omega, weights, limits) -> float:
+    """How much ``joint_rates`` may amplify round-off: the condition number of J W^-1 J^T,
+    or with the safeguards, the product of those of the systems solved (damped, and with
+    each round of rate-aware weights: a round's weights come from the last round's rates, so
+    their errors compound)."""
+    jac = ant.jacobian(theta)
+    w_inv = 1.0 / weights
+    gram = (jac * w_inv) @ jac.T
+    conditions = [np.linalg.cond(gram)]
+    if limits is not None:
+        damping = ant._damping(gram, limits)
+        for _ in range(5):
+            system = (jac * w_inv) @ jac.T + damping**2 * np.eye(3)
+            conditions.append(np.linalg.cond(system))
+            rates = (jac * w_inv).T @ np.linalg.solve(system, omega)
+            ratio = np.abs(rates) / limits.rate
+            if ratio.max() <= 1.0:
+                break
+            w_inv = w_inv / np.maximum(ratio, 1.0) ** 2
+    return conditions[0] if limits is None else float(np.prod(conditions[1:]))
+
+
+@settings(max_examples=300, deadline=None)
+@given(joint_angles, rotvecs, weight_sets, limit_sets)
+def test_scalar_joint_rates_equal_joint_rates(theta, omega, weights, limits):
+    """Eq. (7)/(9) with the safeguards (damping, rate-aware weights, scaling) in floats:
+    the rates to round-off (relative to the system's condition) and the same flags."""
+    jac = ant.jacobian(theta)
+    gram = (jac / weights) @ jac.T
+    if limits is None and ant.weighted_singular_value(jac, weights) < 1e-3:
+        return  # undamped near the singular set the solution itself is ill-conditioned
+    try:
+        expected, damped, limited = ant.joint_rates(theta, omega, weights, limits)
+    except ant.SingularityError:
+        with pytest.raises(ant.SingularityError):
+            ant.joint_rates_scalar(theta, omega, weights, limits)
+        return
+    rates, damped_f, limited_f = ant.joint_rates_scalar(theta, omega, weights, limits)
+    scale = np.abs(expected).max() + np.linalg.norm(omega)
+    tolerance = 1e-14 * _worst_condition(theta, omega, weights, limits)
+    np.testing.assert_allclose(rates, expected, rtol=0, atol=tolerance * scale + 1e-300)
+    assert damped_f == damped
+    if limited_f != limited:  # only where a rate is at its limit to round-off (ratio 1 +- 1e-12)
+        assert np.abs(np.abs(expected) / limits.rate - 1.0).min() < 1e-12
+
+
+@settings(max_examples=150, deadline=None)
+@given(joint_angles, rotvecs, st.floats(0.005, 0.05), st.sampled_from(["eq6", "log"]), st.booleans(),
+       st.booleans())
+def test_scalar_crr_step_equals_crr_step(theta, omega, dt, omega_method, full_correction, limited):
+    """One CRR update (eq. 6, 9, 11-14, 10, the cap and the full correction) in floats: the
+    same angles to round-off, the same flags and residual."""
+    if ant.weighted_singular_value(ant.jacobian(theta)) < 0.05:
+        return  # near the singular set round-off is amplified by the solution itself
+    limits = ant.AntennaLimits(rate=np.radians([60.0, 60.0, 60.0, 90.0])) if limited else None
+    n0 = ant.forward_kinematics(theta)
+    n1 = Rotation.from_rotvec(omega * dt).as_matrix() @ n0
+    kwargs = dict(limits=limits, omega_method=omega_method, full_correction=full_correction)
+    expected, info = ant.crr_step(theta, n0, n1, dt, **kwargs)
+    new, info_f = ant.crr_step_scalar(theta, n0, n1, dt, **kwargs)
+    np.testing.assert_allclose(new, expected, rtol=0, atol=1e-12)
+    assert (info_f.damped, info_f.rate_limited) == (info.damped, info.rate_limited)
+    # (Newton's stop rule, |step| dt < 1e-15, is a test at round-off: its count of
+    # iterations may differ where the steps end in round-off; the paper path's test below
+    # counts them.)
+    assert info_f.error_fro == pytest.approx(info.error_fro, rel=1e-12, abs=1e-14)
+
+
+@pytest.mark.parametrize("omega_method", ["eq6", "log"])
+@pytest.mark.parametrize("limited", [False, True])
+def test_scalar_crr_follows_the_paper_path(omega_method, limited):
+    """Section 5.1 (eq. 15-16, dT = 0.01 s), 10 s: each update of the fast path from the
+    vectorized path's angles, and the whole path from Theta0, agree to round-off."""
+    t, attitudes = paper_attitudes(10.0)
+    theta0 = np.radians(ant.PAPER_THETA0_DEG)
+    limits = ant.AntennaLimits(rate=np.radians([60.0, 60.0, 60.0, 90.0])) if limited else None
+    path = ant.solve_joint_path(attitudes, ant.PAPER_DT, theta0, "crr", limits=limits, omega_method=omega_method)
+    iterations = []
+    for i in range(t.size - 1):
+        new, info = ant.crr_step_scalar(path.theta[i], attitudes[i], attitudes[i + 1], ant.PAPER_DT, limits=limits,
+                                        omega_method=omega_method)
+        np.testing.assert_allclose(new, path.theta[i + 1], rtol=0, atol=1e-14)
+        iterations.append(info.iterations)
+    assert np.mean(np.array(iterations) == path.iterations[1:]) > 0.99
+    planner = ant.CrrPlanner(omega_method=omega_method)
+    problem = ant.AntennaProblem(attitudes[0], 0.0, 0.0, 0.0, theta0,
+                                 limits if limits is not None else ant.AntennaLimits(), update_dt=ant.PAPER_DT)
+    planner.reset(problem)
+    planner.attitude = attitudes[0]
+    online = np.array([planner.step(ti, n) for ti, n in zip(t[1:], attitudes[1:])])
+    reference = ant.solve_joint_path(attitudes, ant.PAPER_DT, theta0, "crr", limits=problem.limits,
+                                     omega_method=omega_method)
+    np.testing.assert_allclose(online, reference.theta[1:], rtol=0, atol=1e-12)
+
+
+def test_scalar_joint_rates_at_the_exact_singularity():
+    """theta2 = 0, theta3 = 90 deg (rank 2): damped in both paths, the same rates."""
+    theta = np.array([0.3, 0.0, np.pi / 2, 0.2])
+    omega = np.array([0.05, -0.2, 0.1])
+    limits = ant.AntennaLimits(rate=np.full(4, np.radians(60.0)))
+    expected = ant.joint_rates(theta, omega, limits=limits)
+    rates, damped, limited = ant.joint_rates_scalar(theta, omega, limits=limits)
+    assert damped and expected[1]
+    assert limited == expected[2]
+    np.testing.assert_allclose(rates, expected[0], rtol=0, atol=1e-12)
+    with pytest.raises(ant.SingularityError):
+        ant.joint_rates_scalar(theta, omega)

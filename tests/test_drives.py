@@ -152,6 +152,28 @@ def test_an_encoder_reads_whole_counts(position, resolution):
     assert 0.0 <= position - reading < resolution * (1 + 1e-9)
 
 
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3), st.sampled_from([1e-6, 2 * math.pi / 2**17]))
+def test_counted_encoders_read_straight_from_the_buffer_as_from_a_copy(positions, resolution):
+    """Noiseless counted encoders on a run of joints read floor(x (1/r)) r from the live
+    buffer; on other joints (not a run) from a copy: the same numbers, tick after tick."""
+    data = type("D", (), {"qpos": np.zeros(4), "qvel": np.zeros(4), "act": np.zeros(4)})()
+    physics = type("P", (), {"data": type("Ptr", (), {"ptr": data})()})()
+    resolutions = [resolution, 2 * resolution, 3 * resolution]
+    run = JointEncoders([1, 2, 3], [1, 2, 3], [1, 2, 3], "axes", "rad", 0.005, resolution=resolutions)
+    scattered = JointEncoders([3, 1, 2], [3, 1, 2], [3, 1, 2], "axes", "rad", 0.005,
+                              resolution=[resolutions[2], resolutions[0], resolutions[1]])
+    a, b = run.reset(physics, np.zeros(3), 0), scattered.reset(physics, np.zeros(3), 0)
+    assert run._counted_run is not None and scattered._counted_run is None
+    for tick, shift in enumerate([0.0, 1e-7, -0.3]):
+        data.qpos[1:] = np.array(positions) + shift
+        run(tick, physics)
+        scattered(tick, physics)
+        np.testing.assert_array_equal(a["joint_positions"], b["joint_positions"][[1, 2, 0]])
+        counts = a["joint_positions"] / resolutions
+        np.testing.assert_allclose(counts, np.round(counts), rtol=0, atol=1e-6)
+
+
 def test_the_servo_feedforward_through_a_drive_train_is_the_load_s_plus_the_rotor_s():
     """Inverse dynamics on a model with a drive train as built: the motor moves with its load,
     so the feed-forward is (M + J N^2) a, not a force stretching the transmission."""

@@ -423,6 +423,256 @@ def crr_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
     return new, info
 
 
+# --------------------------------------------------------------------------------------
+# One pose in plain floats: the online planner's fast path
+#
+# The same equations as the functions above, written out for a single pose in Python floats
+# (the math module), because numpy's per-call cost dominates on 3 x 3 and 3 x 4 matrices. The
+# results agree with the vectorized functions to round-off (tested): the 3 x 3 solve is
+# Cramer's rule, the sums run in another order than LAPACK's and BLAS's.
+
+
+def _fk_floats(t1: float, t2: float, t3: float, t4: float) -> tuple:
+    """f(Theta) of eq. (2) as 9 floats, row by row (``forward_kinematics``'s arithmetic)."""
+    c1, s1 = math.cos(t1), math.sin(t1)
+    c2, s2 = math.cos(t2), math.sin(t2)
+    c3, s3 = math.cos(t3), math.sin(t3)
+    c4, s4 = math.cos(t4), math.sin(t4)
+    m20, m21, m22 = -s1 * s2, c1 * s2, c2  # column 2 of M = Rz(t1) Rx(-t2) Rz(t3)
+    m00, m01, m02 = c1 * c3 - s1 * c2 * s3, s1 * c3 + c1 * c2 * s3, -s2 * s3  # column 0
+    m10, m11, m12 = -c1 * s3 - s1 * c2 * c3, -s1 * s3 + c1 * c2 * c3, -s2 * c3  # column 1
+    return (c4 * m20 + s4 * m00, -s4 * m20 + c4 * m00, m10,
+            c4 * m21 + s4 * m01, -s4 * m21 + c4 * m01, m11,
+            c4 * m22 + s4 * m02, -s4 * m22 + c4 * m02, m12)
+
+
+def _jacobian_rows(t1: float, t2: float, t3: float) -> tuple:
+    """J(Theta) of eq. (4) as three rows of 4 floats (``jacobian``'s arithmetic); the
+    polarization axis is the boresight, column 2 of f, which does not depend on t4."""
+    c1, s1 = math.cos(t1), math.sin(t1)
+    c2, s2 = math.cos(t2), math.sin(t2)
+    c3, s3 = math.cos(t3), math.sin(t3)
+    return ((0.0, -c1, -s1 * s2, -c1 * s3 - s1 * c2 * c3),
+            (0.0, -s1, c1 * s2, -s1 * s3 + c1 * c2 * c3),
+            (1.0, 0.0, c2, -s2 * c3))
+
+
+def _relative_floats(a, b) -> tuple:
+    """A B^T of two 3 x 3 matrices given as 9 floats each, row by row."""
+    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
+    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
+    return (a0 * b0 + a1 * b1 + a2 * b2, a0 * b3 + a1 * b4 + a2 * b5, a0 * b6 + a1 * b7 + a2 * b8,
+            a3 * b0 + a4 * b1 + a5 * b2, a3 * b3 + a4 * b4 + a5 * b5, a3 * b6 + a4 * b7 + a5 * b8,
+            a6 * b0 + a7 * b1 + a8 * b2, a6 * b3 + a7 * b4 + a8 * b5, a6 * b6 + a7 * b7 + a8 * b8)
+
+
+def _log_floats(r) -> tuple:
+    """``rotation_log`` of one rotation given as 9 floats: its rotation vector."""
+    cos_angle = min(max((r[0] + r[4] + r[8] - 1.0) / 2.0, -1.0), 1.0)
+    angle = math.acos(cos_angle)
+    if angle > math.pi - 1e-6:
+        raise PlanningError(f"rotation of {math.degrees(angle):.4f} deg is too close to 180 deg for its logarithm")
+    if angle < 1e-4:
+        a2 = angle * angle
+        scale = 1.0 + a2 / 6.0 + 7.0 * (a2 * a2) / 360.0
+    else:
+        scale = angle / math.sin(angle)
+    return (0.5 * (r[7] - r[5]) * scale, 0.5 * (r[2] - r[6]) * scale, 0.5 * (r[3] - r[1]) * scale)
+
+
+def _gram_floats(jac, w_inv) -> tuple:
+    """(J W^-1 (3 rows of 4), J W^-1 J^T as its 6 distinct entries g00 g01 g02 g11 g12 g22).
+
+    J's structural zeros (the azimuth axis is Z: J[0][0] = J[1][0] = 0; the elevation axis
+    is horizontal: J[2][1] = 0) are left out of the sums (their terms are zeros)."""
+    (_, a1, a2, a3), (_, b1, b2, b3), (c0, _, c2, c3) = jac
+    w0, w1, w2, w3 = w_inv
+    ja1, ja2, ja3 = a1 * w1, a2 * w2, a3 * w3
+    jb1, jb2, jb3 = b1 * w1, b2 * w2, b3 * w3
+    jc0, jc2, jc3 = c0 * w0, c2 * w2, c3 * w3
+    gram = (ja1 * a1 + ja2 * a2 + ja3 * a3,
+            ja1 * b1 + ja2 * b2 + ja3 * b3,
+            ja2 * c2 + ja3 * c3,
+            jb1 * b1 + jb2 * b2 + jb3 * b3,
+            jb2 * c2 + jb3 * c3,
+            jc0 * c0 + jc2 * c2 + jc3 * c3)
+    return ((0.0, ja1, ja2, ja3), (0.0, jb1, jb2, jb3), (jc0, 0.0, jc2, jc3)), gram
+
+
+def _det_floats(g) -> float:
+    """det of the symmetric 3 x 3 matrix with distinct entries g (``_gram_floats``)."""
+    g00, g01, g02, g11, g12, g22 = g
+    return g00 * (g11 * g22 - g12 * g12) - g01 * (g01 * g22 - g12 * g02) + g02 * (g01 * g12 - g11 * g02)
+
+
+def _solve_floats(jw, g, omega, damping: float = 0.0) -> list:
+    """``_solve_rates`` for one pose: W^-1 J^T (J W^-1 J^T + damping^2 I)^-1 omega, with the
+    symmetric 3 x 3 system solved by Cramer's rule. Raises LinAlgError when it is singular."""
+    g00, g01, g02, g11, g12, g22 = g
+    if damping:
+        d2 = damping * damping
+        g00, g11, g22 = g00 + d2, g11 + d2, g22 + d2
+    # The adjugate (symmetric) and the determinant.
+    k00, k01, k02 = g11 * g22 - g12 * g12, g02 * g12 - g01 * g22, g01 * g12 - g02 * g11
+    k11, k12, k22 = g00 * g22 - g02 * g02, g01 * g02 - g00 * g12, g00 * g11 - g01 * g01
+    det = g00 * k00 + g01 * k01 + g02 * k02
+    if det == 0.0 or not math.isfinite(det):
+        raise np.linalg.LinAlgError("Singular matrix")
+    o0, o1, o2 = omega
+    x0 = (k00 * o0 + k01 * o1 + k02 * o2) / det
+    x1 = (k01 * o0 + k11 * o1 + k12 * o2) / det
+    x2 = (k02 * o0 + k12 * o1 + k22 * o2) / det
+    (_, ja1, ja2, ja3), (_, jb1, jb2, jb3), (jc0, _, jc2, jc3) = jw
+    return [jc0 * x2, ja1 * x0 + jb1 * x1, ja2 * x0 + jb2 * x1 + jc2 * x2, ja3 * x0 + jb3 * x1 + jc3 * x2]
+
+
+def _damping_floats(g, limits: AntennaLimits) -> float:
+    """``_damping`` of the gram given as its 6 distinct entries."""
+    threshold2 = limits.singular_threshold**2
+    trace = g[0] + g[3] + g[5]
+    if 4.0 * _det_floats(g) >= threshold2 * trace * trace:
+        return 0.0
+    g00, g01, g02, g11, g12, g22 = g
+    matrix = np.array([[g00, g01, g02], [g01, g11, g12], [g02, g12, g22]])
+    sigma2 = max(float(np.linalg.eigvalsh(matrix)[0]), 0.0)
+    if sigma2 >= threshold2:
+        return 0.0
+    return limits.max_damping * math.sqrt(1.0 - sigma2 / threshold2)
+
+
+def _joint_rates_floats(theta, omega, w_inv, limits: AntennaLimits | None, rate_limits=None):
+    """``joint_rates`` for one pose in floats: (rates [4], damped, rate_limited); ``w_inv``
+    the inverse weights (4 floats), ``rate_limits`` those of ``limits`` as floats."""
+    jac = _jacobian_rows(theta[0], theta[1], theta[2])
+    jw, gram = _gram_floats(jac, w_inv)
+    try:
+        rates = _solve_floats(jw, gram, omega)
+    except np.linalg.LinAlgError:
+        if limits is None:
+            raise SingularityError("J W^-1 J^T is singular: the four axes span less than 3 dimensions") from None
+        rates = None
+    if limits is None:
+        return rates, False, False
+    if rate_limits is None:
+        rate_limits = [float(v) for v in limits.rate]
+    damping = _damping_floats(gram, limits)
+    if damping:
+        rates = _solve_floats(jw, gram, omega, damping)
+    limited = False
+    l0, l1, l2, l3 = rate_limits
+    for _ in range(4):
+        r0, r1, r2, r3 = rates
+        q0, q1, q2, q3 = abs(r0) / l0, abs(r1) / l1, abs(r2) / l2, abs(r3) / l3
+        if max(q0, q1, q2, q3) <= 1.0:
+            return rates, damping > 0.0, limited
+        limited = True
+        q0, q1, q2, q3 = max(q0, 1.0), max(q1, 1.0), max(q2, 1.0), max(q3, 1.0)
+        w0, w1, w2, w3 = w_inv
+        w_inv = (w0 / (q0 * q0), w1 / (q1 * q1), w2 / (q2 * q2), w3 / (q3 * q3))
+        jw, weighted = _gram_floats(jac, w_inv)
+        rates = _solve_floats(jw, weighted, omega, damping)
+    r0, r1, r2, r3 = rates
+    ratio = max(abs(r0) / l0, abs(r1) / l1, abs(r2) / l2, abs(r3) / l3)
+    if ratio > 1.0:
+        limited = True
+        rates = [r0 / ratio, r1 / ratio, r2 / ratio, r3 / ratio]
+    return rates, damping > 0.0, limited
+
+
+def joint_rates_scalar(theta, omega, weights=PAPER_WEIGHTS, limits: AntennaLimits | None = None):
+    """``joint_rates`` (eq. 7/9 with the same safeguards) for one pose, in plain floats: the
+    online path's fast version. theta (4,), omega (3,); returns (rates (4,), damped,
+    rate_limited), equal to ``joint_rates`` to round-off (tested)."""
+    w_inv = [1.0 / float(w) for w in weights]
+    rates, damped, limited = _joint_rates_floats([float(v) for v in theta], [float(v) for v in omega],
+                                                 w_inv, limits)
+    return np.array(rates), damped, limited
+
+
+def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
+                    limits: AntennaLimits | None = None, omega_method: str = "eq6",
+                    full_correction: bool = False, tol: float = 1e-15, max_iter: int = 20):
+    """``crr_step`` for one pose in plain floats: the same update (section 4.2, steps 3-7:
+    the angular velocity of eq. 6 or its exact log, the weighted pseudo-inverse of eq. 9 with
+    the safeguards of ``joint_rates``, RK4 of eq. 11, the rotation ratio of eq. 12-14, Newton
+    on eq. 10 with the same stop rule, the cap at the rate limits and the optional full
+    correction), equal to ``crr_step`` to round-off (tested). theta (4,), n_now and n_next
+    (3, 3). Returns (Theta_{n+1} (4,), StepInfo)."""
+    if omega_method not in ("eq6", "log"):
+        raise PlanningError(f"angular velocity method {omega_method!r} is not 'eq6' or 'log'")
+    th = tuple(np.asarray(theta, dtype=float).reshape(4).tolist())
+    target = np.asarray(n_next, dtype=float).reshape(9).tolist()
+    relative = _relative_floats(target, np.asarray(n_now, dtype=float).reshape(9).tolist())
+    if omega_method == "log":
+        rotvec = _log_floats(relative)
+        omega = (rotvec[0] / dt, rotvec[1] / dt, rotvec[2] / dt)
+    else:  # vee(N(t + dt) N(t)^T) / dt
+        omega = (0.5 * (relative[7] - relative[5]) / dt, 0.5 * (relative[2] - relative[6]) / dt,
+                 0.5 * (relative[3] - relative[1]) / dt)
+    w_inv = [1.0 / float(w) for w in weights]
+    rate_limits = None if limits is None else [float(v) for v in limits.rate]
+    info = StepInfo()
+
+    def rate(t):
+        r, damped, limited = _joint_rates_floats(t, omega, w_inv, limits, rate_limits)
+        info.damped |= damped
+        info.rate_limited |= limited
+        return r
+
+    half = 0.5 * dt
+    t0, t1, t2, t3 = th
+    a0, a1, a2, a3 = rate(th)
+    b0, b1, b2, b3 = rate((t0 + half * a0, t1 + half * a1, t2 + half * a2, t3 + half * a3))
+    c0, c1, c2, c3 = rate((t0 + half * b0, t1 + half * b1, t2 + half * b2, t3 + half * b3))
+    d0, d1, d2, d3 = rate((t0 + dt * c0, t1 + dt * c1, t2 + dt * c2, t3 + dt * c3))
+    # eq. (11)
+    m0, m1 = (a0 + 2.0 * b0 + 2.0 * c0 + d0) / 6.0, (a1 + 2.0 * b1 + 2.0 * c1 + d1) / 6.0
+    m2, m3 = (a2 + 2.0 * b2 + 2.0 * c2 + d2) / 6.0, (a3 + 2.0 * b3 + 2.0 * c3 + d3) / 6.0
+    speed = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2 + m3 * m3)
+    new = th
+    if speed > 0.0:
+        q0, q1, q2, q3 = m0 / speed, m1 / speed, m2 / speed, m3 / speed  # k of eq. (12)-(14)
+        xi = speed
+        for iteration in range(1, max_iter + 1):
+            h = xi * dt
+            new = (t0 + q0 * h, t1 + q1 * h, t2 + q2 * h, t3 + q3 * h)
+            e0, e1, e2 = _log_floats(_relative_floats(target, _fk_floats(*new)))
+            (_, j01, j02, j03), (_, j11, j12, j13), (j20, _, j22, j23) = _jacobian_rows(new[0], new[1], new[2])
+            # d(rotation)/d(xi) = J k dt (J's structural zeros left out)
+            s0 = (j01 * q1 + j02 * q2 + j03 * q3) * dt
+            s1 = (j11 * q1 + j12 * q2 + j13 * q3) * dt
+            s2 = (j20 * q0 + j22 * q2 + j23 * q3) * dt
+            step = (s0 * e0 + s1 * e1 + s2 * e2) / (s0 * s0 + s1 * s1 + s2 * s2)
+            xi += step
+            info.iterations = iteration
+            if abs(step) * dt < tol:
+                break
+        if limits is not None:
+            l0, l1, l2, l3 = rate_limits
+            cap = min(l0 / max(abs(q0), 1e-300), l1 / max(abs(q1), 1e-300), l2 / max(abs(q2), 1e-300),
+                      l3 / max(abs(q3), 1e-300))
+            if abs(xi) > cap:
+                xi = math.copysign(cap, xi)
+                info.rate_limited = True
+        h = xi * dt
+        new = (t0 + q0 * h, t1 + q1 * h, t2 + q2 * h, t3 + q3 * h)
+    if full_correction:
+        w_corr = [1.0 / float(w) for w in weights]
+        for _ in range(max_iter):
+            residual = _log_floats(_relative_floats(target, _fk_floats(*new)))
+            if max(abs(residual[0]), abs(residual[1]), abs(residual[2])) < 1e-15:
+                break
+            jac = _jacobian_rows(new[0], new[1], new[2])
+            jw, gram = _gram_floats(jac, w_corr)
+            damping = 0.0 if limits is None else _damping_floats(gram, limits)
+            delta = _solve_floats(jw, gram, residual, damping)
+            new = (new[0] + delta[0], new[1] + delta[1], new[2] + delta[2], new[3] + delta[3])
+            info.iterations += 1
+    f = _fk_floats(*new)
+    info.error_fro = math.sqrt(sum((a - b) * (a - b) for a, b in zip(f, target)))
+    return np.array(new), info
+
+
 METHODS = ("pinv", "crr", "crr-full")
 
 
@@ -454,11 +704,12 @@ class JointPath:
 
 def solve_joint_path(attitudes, dt: float, theta0, method: str = "crr",
                      weights=PAPER_WEIGHTS, limits: AntennaLimits | None = None,
-                     omega_method: str = "eq6", t0: float = 0.0) -> JointPath:
+                     omega_method: str = "eq6", t0: float = 0.0, scalar: bool = False) -> JointPath:
     """Joint angles that hold the attitudes N(t0 + n dt) (n, 3, 3), from Theta0.
 
     method: "pinv" (the paper's baseline, section 5.2), "crr" (section 4.2) or "crr-full"
-    (CRR then a full weighted Newton correction).
+    (CRR then a full weighted Newton correction). ``scalar``: the CRR updates by
+    ``crr_step_scalar`` (the online planner's one-pose path in floats; equal to round-off).
     """
     if method not in METHODS:
         raise PlanningError(f"joint-position method {method!r} is not one of {', '.join(METHODS)}")
@@ -485,9 +736,9 @@ def solve_joint_path(attitudes, dt: float, theta0, method: str = "crr",
             theta[i + 1], info = pinv_integration_step(theta[i], attitudes[i], attitudes[i + 1],
                                                        dt, weights, omega_method)
         else:
-            theta[i + 1], info = crr_step(theta[i], attitudes[i], attitudes[i + 1], dt, weights,
-                                          limits=limits, omega_method=omega_method,
-                                          full_correction=method == "crr-full")
+            theta[i + 1], info = (crr_step_scalar if scalar else crr_step)(
+                theta[i], attitudes[i], attitudes[i + 1], dt, weights, limits=limits, omega_method=omega_method,
+                full_correction=method == "crr-full")
         error[i + 1] = info.error_fro
         iterations[i + 1] = info.iterations
         damped[i + 1] = info.damped
@@ -557,7 +808,8 @@ class CrrPlanner:
     """The paper's online planner: one CRR update per attitude sample (section 4.2).
 
     ``step(t, N)`` runs ``crr_step`` from the last solution to N over t - t_last (the first
-    from the problem's theta0 and its attitude at t = 0).
+    from the problem's theta0 and its attitude at t = 0), in its one-pose form in plain floats
+    (``crr_step_scalar``: the same update to round-off, about ten times faster).
 
     Args:
       method: "crr" (the paper's) or "crr-full" (CRR with Newton steps on the whole attitude).
@@ -586,7 +838,7 @@ class CrrPlanner:
             raise PlanningError(f"CRR step at t = {t:.6g} s does not come after the previous one at {self.t:.6g} s: "
                                 "the angular velocity (eq. 6) needs an interval > 0")
         p = self.problem
-        theta, info = crr_step(self.theta, self.attitude, attitude, t - self.t, p.weights, limits=p.limits,
-                               omega_method=self.omega_method, full_correction=self.method == "crr-full")
+        theta, info = crr_step_scalar(self.theta, self.attitude, attitude, t - self.t, p.weights, limits=p.limits,
+                                      omega_method=self.omega_method, full_correction=self.method == "crr-full")
         self.theta, self.attitude, self.t, self.last_info = theta, attitude, t, info
         return theta

@@ -11,8 +11,9 @@ def antenna_update_rate(duration: float = 60.0) -> list[dict]:
 
     The paper's section 5.1: 60 s of eq. (15)-(16) ship motion at dT = 0.01 s (6000 updates),
     for the pseudo-inverse integration (section 5.2), CRR (section 4.2) and CRR with the full
-    correction; also CRR with the controller's safeguards (damping, rate-aware weights).
-    Best of REPEATS. The paper's IMU delivers 20-50 attitudes per second.
+    correction; also CRR with the controller's safeguards (damping, rate-aware weights), and
+    both CRR rows again by the online planner's one-pose path in plain floats
+    (``crr_step_scalar``). Best of REPEATS. The paper's IMU delivers 20-50 attitudes per second.
     """
     from planners import antenna
     from sims.antenna.ship_motion import PaperShipMotion
@@ -24,11 +25,13 @@ def antenna_update_rate(duration: float = 60.0) -> list[dict]:
     theta0 = np.radians(antenna.PAPER_THETA0_DEG)
     limits = antenna.AntennaLimits(rate=np.radians([60.0, 60.0, 60.0, 90.0]))
     rows = []
-    for label, method, lim in (("pinv integration", "pinv", None), ("crr", "crr", None),
-                               ("crr + full correction", "crr-full", None),
-                               ("crr, safeguards on", "crr", limits)):
+    for label, method, lim, scalar in (("pinv integration", "pinv", None, False), ("crr", "crr", None, False),
+                                       ("crr + full correction", "crr-full", None, False),
+                                       ("crr, safeguards on", "crr", limits, False),
+                                       ("crr, floats", "crr", None, True),
+                                       ("crr, safeguards on, floats", "crr", limits, True)):
         best, path = best_time(lambda: antenna.solve_joint_path(attitudes, antenna.PAPER_DT, theta0, method,
-                                                                 limits=lim))
+                                                                 limits=lim, scalar=scalar))
         updates = t.size - 1
         rows.append({"method": label, "updates": updates, "wall_s": best,
                      "updates_per_s": updates / best, "error_fro_max": float(path.error_fro.max())})

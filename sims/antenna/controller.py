@@ -56,8 +56,14 @@ class AntennaController:
         self.theta_from, self.theta_to = theta, theta + rate * first * self.dt
         self.ff_from, self.ff_to = rate, rate.copy()
         self.tick_from, self.tick_to = 0, first
+        self._fractions = {}  # span -> (span + 1, 1) fractions of the ramp
+        self._tables()
         self.last_gyro = None
         self.command = context.command
+        # The command's channels in the controller's order: written in place when they are
+        # the command itself, in order.
+        self._in_place = bool(np.array_equal(self.actuators, np.arange(self.command.size)))
+        self._difference = np.empty(len(JOINTS))
         self.seen = int(obs["imu_count"][0])
         if self.seen:  # no latency: the first sample is here, the first update is planned now
             self._update(0, obs)
@@ -75,26 +81,49 @@ class AntennaController:
         attitude = rotation.T @ self.satellite
         theta = self.planner.step(target_tick * self.dt, attitude)
         # N = R^T eTs turns at -w_body in the ship frame: the joint rates that hold it, from
-        # the gyro (its noise is far smaller than that of differenced attitudes).
-        feedforward = ant.joint_rates(theta, -rate, self.weights, self.limits)[0]
+        # the gyro (its noise is far smaller than that of differenced attitudes); eq. (7/9)
+        # for one pose in plain floats.
+        feedforward = ant.joint_rates_scalar(theta, -rate, self.weights, self.limits)[0]
         self.theta_from, self.ff_from = self._ramp(tick), self._feedforward(tick)
         self.tick_from, self.tick_to = tick, target_tick
         self.theta_to, self.ff_to = theta, feedforward
+        self._tables()
 
-    def _fraction(self, tick: int) -> float:
+    def _tables(self) -> None:
+        """The ramps at every tick from tick_from to tick_to (row k: tick_from + k; after
+        tick_to they stay at the last row) and the set-point targets from them, computed
+        once per update with the same arithmetic as a tick-by-tick evaluation."""
         span = self.tick_to - self.tick_from
-        return 1.0 if span <= 0 else min(max((tick - self.tick_from) / span, 0.0), 1.0)
+        fraction = self._fractions.get(span)
+        if fraction is None:  # the span is the IMU's period but for the first
+            if span <= 0:
+                fraction = np.ones((1, 1))
+            else:
+                fraction = np.minimum(np.maximum(np.arange(span + 1) / span, 0.0), 1.0)[:, None]
+            self._fractions[span] = fraction
+        self._ramps = self.theta_from + fraction * (self.theta_to - self.theta_from)
+        self._feedforwards = self.ff_from + fraction * (self.ff_to - self.ff_from)
+        self._targets = self._ramps + self.lead * self._feedforwards
+        self._last_row = self._targets.shape[0] - 1
+
+    def _row(self, tick: int) -> int:
+        return min(max(tick - self.tick_from, 0), self._last_row)
 
     def _feedforward(self, tick: int) -> np.ndarray:
-        return self.ff_from + self._fraction(tick) * (self.ff_to - self.ff_from)
+        return self._feedforwards[self._row(tick)]
 
     def _ramp(self, tick: int) -> np.ndarray:
-        return self.theta_from + self._fraction(tick) * (self.theta_to - self.theta_from)
+        return self._ramps[self._row(tick)]
 
     def __call__(self, tick: int, observation) -> None:
         count = int(observation["imu_count"][0])
         if count != self.seen:
             self.seen = count
             self._update(tick, observation)
-        target = self._ramp(tick + 1) + self.lead * self._feedforward(tick + 1)
-        self.command[self.actuators] = (target - observation["setpoints"]) / self.dt
+        # The set-point for the end of the tick: the ramp plus kv/kp times the feed-forward.
+        target = self._targets[min(max(tick + 1 - self.tick_from, 0), self._last_row)]
+        if self._in_place:
+            np.divide(np.subtract(target, observation["setpoints"], out=self._difference), self.dt,
+                      out=self.command)
+        else:
+            self.command[self.actuators] = (target - observation["setpoints"]) / self.dt

@@ -81,6 +81,12 @@ class AntennaImu(Sensors):
         self.att_decay = math.exp(-h / corr) if corr > 0 else 0.0
         self.att_error = self.rng.normal(0.0, self.att_sigma, 3)  # stationary start
         self.gyro_sigma = math.radians(imu.gyro_noise_deg_s)
+        self.att_drive = self.att_sigma * math.sqrt(1.0 - self.att_decay**2)
+        # The samples' noise for the whole run, drawn at once: the same standard normals in
+        # the same order (per sample the attitude's drive, then the gyro's; the first sample
+        # has no drive) and scaled as Generator.normal(0, sigma) scales them (0 + sigma z).
+        self._noise_rows = 0
+        self._draw_noise((times.size - 1) // self.period + 1)
         self.physics_dt = physics.model.ptr.opt.timestep
         self.quat_slice = physics.sensor_slice("imu_quat")
         self.gyro_slice = physics.sensor_slice("imu_gyro")
@@ -95,6 +101,25 @@ class AntennaImu(Sensors):
             self._deliver(self.queue.popleft()[1])
         return obs
 
+    def _draw_noise(self, samples: int) -> None:
+        """Noise rows (attitude drive, gyro) for the next ``samples`` samples, drawn in order
+        (when the rows of the last draw are used up)."""
+        att, gyro = self.att_sigma > 0, self.gyro_sigma > 0
+        noise = np.zeros((samples, 6))
+        first = self._noise_rows == 0  # the sample at t = 0 has no drive
+        self._noise_rows += samples
+        if first and gyro:
+            noise[0, 3:] = 0.0 + self.gyro_sigma * self.rng.standard_normal(3)
+        rest = noise[1:] if first else noise
+        width = 3 * (att + gyro)
+        if width and rest.shape[0]:
+            z = self.rng.standard_normal((rest.shape[0], width))  # row by row, as drawn per sample
+            if att:
+                rest[:, :3] = 0.0 + self.att_drive * z[:, :3]
+            if gyro:
+                rest[:, 3:] = 0.0 + self.gyro_sigma * z[:, width - 3:]
+        self._noise, self._next_noise = noise, 0
+
     def _measure(self, tick: int, lag: float | None = None) -> None:
         sd = self._data.sensordata
         rotation = np.empty(9)
@@ -102,14 +127,17 @@ class AntennaImu(Sensors):
         rotation = rotation.reshape(3, 3)
         if self.bias_rotation is not None:
             rotation = rotation @ self.bias_rotation
+        if self._next_noise == self._noise.shape[0]:  # a longer run than reset prepared
+            self._draw_noise(64)
+        noise = self._noise[self._next_noise]
+        self._next_noise += 1
         if self.att_sigma > 0:
             if tick > 0:
-                drive = self.att_sigma * math.sqrt(1.0 - self.att_decay**2)
-                self.att_error = self.att_decay * self.att_error + self.rng.normal(0.0, drive, 3)
+                self.att_error = self.att_decay * self.att_error + noise[:3]
             rotation = rotation @ _exp_so3(self.att_error)
         gyro = sd[self.gyro_slice].copy()
         if self.gyro_sigma > 0:
-            gyro = gyro + self.rng.normal(0.0, self.gyro_sigma, 3)
+            gyro = gyro + noise[3:]
         # After mj_step the sensors hold the state at the start of its last physics step.
         lag = self.physics_dt if lag is None else lag
         self.queue.append((tick + self.latency, (tick * self.dt - lag, rotation, gyro)))
