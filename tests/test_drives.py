@@ -9,7 +9,7 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 from sims import drives
 from sims.task import JointEncoders
@@ -140,7 +140,10 @@ def test_the_position_loop_has_its_design_bandwidth():
 
 @settings(max_examples=50, deadline=None)
 @given(st.floats(-0.02, 0.02), st.sampled_from([1e-9, 5e-8, 1e-6]))
+@example(-1e-5, 1e-6)  # a whole count: (-10) x 1e-6 rounds to one ulp above -1e-5
 def test_an_encoder_reads_whole_counts(position, resolution):
+    """The reading is floor(x (1/r)) r: a whole count, at most one count below the position,
+    and above it by no more than the product's round-off (a few ulps of x)."""
     model = mujoco.MjModel.from_xml_string(AXIS.format(dt=DT, mass=LOAD_MASS))
     data = mujoco.MjData(model)
     data.qpos[0] = position
@@ -149,7 +152,8 @@ def test_an_encoder_reads_whole_counts(position, resolution):
     reading = encoders.reset(physics, np.zeros(1), 0)["joint_positions"][0]
     count = reading / resolution
     assert count == pytest.approx(round(count), abs=1e-6)
-    assert 0.0 <= position - reading < resolution * (1 + 1e-9)
+    assert reading == math.floor(position * (1.0 / resolution)) * resolution
+    assert -4 * np.spacing(abs(position)) <= position - reading < resolution * (1 + 1e-9)
 
 
 @settings(max_examples=30, deadline=None)
