@@ -16,7 +16,7 @@ the last tick. A log without it (the run was killed, or is still running) reads 
 incomplete: ``read_log`` returns the chunks written so far, with ``complete`` False.
 
 Reading (``read_log(path)``): ``log.column("qpos")`` is a whole array (n, nq);
-``log.chunks()`` yields one dict of arrays per chunk (memory-mapped, no copy) for
+``log.chunks()`` yields one dict of arrays per chunk, read from the file one at a time, for
 computations that need not hold the whole run at once.
 """
 
@@ -134,22 +134,36 @@ class ChunkWriter:
 
 @dataclass
 class LogFile:
-    """A log read back (``read_log``): its chunks (Arrow record batches, memory-mapped),
-    whether it is complete, and each array's per-tick shape."""
+    """A log read back (``read_log``): where each chunk (an Arrow record batch) starts in the
+    file, its rows, whether the log is complete, and each array's per-tick shape. Chunks are
+    read from the file when asked for (the file stays open: a log removed from the file
+    system meanwhile still reads)."""
 
     path: Path
     complete: bool
     shapes: dict
-    batches: list = field(repr=False)
+    schema: pa.Schema = field(repr=False)
+    source: object = field(repr=False)
+    offsets: list = field(repr=False)
+    rows: list = field(repr=False)
 
     @property
     def n(self) -> int:
         """Ticks in the log."""
-        return sum(b.num_rows for b in self.batches)
+        return sum(self.rows)
+
+    @property
+    def num_chunks(self) -> int:
+        return len(self.rows)
 
     @property
     def names(self) -> tuple:
         return ("t", *self.shapes)
+
+    def batch(self, k: int) -> pa.RecordBatch:
+        """Chunk ``k`` as an Arrow record batch (read from the file now)."""
+        self.source.seek(self.offsets[k])
+        return pa.ipc.read_record_batch(pa.ipc.read_message(self.source), self.schema)
 
     def _array(self, batch: pa.RecordBatch, name: str) -> np.ndarray:
         if name == "t":
@@ -161,23 +175,32 @@ class LogFile:
         return values.reshape(batch.num_rows, *shape)
 
     def chunk(self, k: int, names=None) -> dict[str, np.ndarray]:
-        """Chunk ``k``'s arrays (all, or ``names``), read-only views of the file."""
-        batch = self.batches[k]
+        """Chunk ``k``'s arrays (all, or ``names``), read-only."""
+        for name in names or ():
+            self._known(name)
+        batch = self.batch(k)
         return {name: self._array(batch, name) for name in (names or self.names)}
 
     def chunks(self, names=None):
         """Each chunk's arrays in turn (``chunk``): the whole run, one chunk in memory."""
-        for k in range(len(self.batches)):
+        for k in range(self.num_chunks):
             yield self.chunk(k, names)
+
+    def _known(self, name: str) -> None:
+        if name != "t" and name not in self.shapes:
+            raise KeyError(f"no array {name!r} in {self.path}; it has {', '.join(self.names)}")
 
     def column(self, name: str) -> np.ndarray:
         """The whole array ``name`` (a copy in memory, writable)."""
-        if name != "t" and name not in self.shapes:
-            raise KeyError(f"no array {name!r} in {self.path}; it has {', '.join(self.names)}")
+        self._known(name)
         shape = () if name == "t" else tuple(self.shapes[name])
-        if not self.batches:
-            return np.zeros((0, *shape))
-        return np.concatenate([self._array(b, name) for b in self.batches])
+        out = np.empty((self.n, *shape))
+        row = 0
+        for k in range(self.num_chunks):
+            part = self._array(self.batch(k), name)
+            out[row:row + part.shape[0]] = part
+            row += part.shape[0]
+        return out
 
     def to_dict(self) -> dict[str, np.ndarray]:
         """Every array, whole."""
@@ -188,35 +211,40 @@ def read_log(path) -> LogFile:
     """Read a run's log (``log.arrow``, or the output directory that holds it).
 
     A complete log has the Arrow file's footer; one without (the run was killed or is still
-    running) is read as a stream up to its last whole chunk and has ``complete`` False."""
+    running) holds its chunks up to the last whole one and has ``complete`` False. This
+    reads the file once through (one chunk in memory at a time) to find its chunks."""
     path = Path(path)
     if path.is_dir():
         path = path / LOG_FILE
-    source = pa.memory_map(str(path))
+    source = pa.OSFile(str(path), "rb")
     try:
-        reader = pa.ipc.open_file(source)
-        batches = [reader.get_batch(k) for k in range(reader.num_record_batches)]
-        schema, complete = reader.schema, True
+        pa.ipc.open_file(source)  # its footer: written only after the last chunk
+        complete = True
     except (pa.ArrowInvalid, OSError):
-        source.seek(_MAGIC_BYTES)
+        complete = False
+    source.seek(_MAGIC_BYTES)
+    try:
+        stream = pa.ipc.open_stream(source)
+    except (pa.ArrowInvalid, OSError) as e:
+        raise ValueError(f"{path} is not a planbench log (not even its schema could be read: {e})") from None
+    schema, offsets, rows = stream.schema, [], []
+    while True:
+        at = source.tell()
         try:
-            stream = pa.ipc.open_stream(source)
-        except (pa.ArrowInvalid, OSError) as e:
-            raise ValueError(f"{path} is not a planbench log (not even its schema could be read: {e})") from None
-        schema, complete, batches = stream.schema, False, []
-        while True:
-            try:
-                batches.append(stream.read_next_batch())
-            except StopIteration:
-                break
-            except (pa.ArrowInvalid, OSError):  # a chunk cut short by the kill
-                break
+            batch = stream.read_next_batch()
+        except StopIteration:
+            break
+        except (pa.ArrowInvalid, OSError):  # a chunk cut short by the kill
+            break
+        if batch.num_rows:
+            offsets.append(at)
+            rows.append(batch.num_rows)
     try:
         meta = json.loads(schema.metadata[_META])
     except (KeyError, TypeError, ValueError):
         raise ValueError(f"{path} is an Arrow file but not a planbench log (no {_META.decode()} metadata)") from None
     shapes = {name: tuple(shape) for name, shape in meta["shapes"].items()}
-    return LogFile(path, complete, shapes, [b for b in batches if b.num_rows])
+    return LogFile(path, complete, shapes, schema, source, offsets, rows)
 
 
 def remove_quietly(path) -> None:

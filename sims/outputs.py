@@ -739,6 +739,13 @@ def software_versions() -> dict:
             "numpy": np.__version__, "scipy": scipy.__version__}
 
 
+def read_log(path):
+    """A run's log (``DIR/log.arrow`` or DIR): ``sims.logfile.read_log``."""
+    from sims.logfile import read_log as read
+
+    return read(path)
+
+
 def summary_dict(result) -> dict:
     return {
         "scenario": result.scenario,
@@ -796,7 +803,7 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                 log_file = getattr(result.log, "file", None)
                 if log_file is not None and (tmp / "log.arrow").exists():
                     summary["log"] = {"path": "log.arrow", "ticks": log_file.n, "complete": log_file.complete,
-                                      "chunks": len(log_file.batches)}
+                                      "chunks": log_file.num_chunks}
                 log = result.log
                 arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl,
                           "act": log.act, "actuator_force": log.actuator_force,

@@ -307,7 +307,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
 
     The log streams to ``log_path`` (``sims.logfile``: a chunk of ``chunk_ticks`` ticks at a
     time; complete, with its footer, when this returns). None: to a temporary file, removed
-    from the file system once the run is over (the returned log keeps it mapped)."""
+    from the file system once the run is over (the returned log keeps it open)."""
     physics = setup.physics
     model, data = physics.model.ptr, physics.data.ptr
     episode = start_episode(setup)
@@ -416,7 +416,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     log.physics_steps = last * k
     writer.close(last + 1)  # the rows up to ``last`` and the footer: the log is complete
     log.file = read_log(log_path)
-    if temporary:  # the mapping keeps the data until the log is dropped
+    if temporary:  # the open file keeps the data until the log is dropped
         remove_quietly(log_path)
     if last < n - 1:
         r = log.reference

@@ -54,7 +54,7 @@ def test_every_row_arrives_at_every_chunk_boundary(tmp_path_factory, n, chunk, h
     _write(path, n, chunk, history)
     log = read_log(path)
     assert log.complete and log.n == n
-    assert [b.num_rows for b in log.batches] == [chunk] * (n // chunk) + ([n % chunk] if n % chunk else [])
+    assert log.rows == [chunk] * (n // chunk) + ([n % chunk] if n % chunk else [])
     np.testing.assert_array_equal(log.column("t"), np.arange(n) * 0.01)
     np.testing.assert_array_equal(log.column("qpos")[:, 0], np.arange(n))
     np.testing.assert_array_equal(log.column("qpos")[:, 2], 0.5 * np.arange(n))
@@ -68,7 +68,7 @@ def test_every_row_arrives_at_every_chunk_boundary(tmp_path_factory, n, chunk, h
 def test_one_tick_one_chunk_and_chunk_multiples(tmp_path, n, chunk):
     _write(tmp_path / "log.arrow", n, chunk, 2)
     log = read_log(tmp_path)
-    assert log.complete and log.n == n and len(log.batches) == -(-n // chunk)
+    assert log.complete and log.n == n and log.num_chunks == -(-n // chunk)
 
 
 KILLED = textwrap.dedent("""
@@ -174,7 +174,7 @@ def test_a_run_without_outputs_leaves_no_log_behind(tmp_path, monkeypatch):
     monkeypatch.setattr(tempfile, "tempdir", None)
     log = runner.simulate(_setup(duration=0.3))
     assert log.qpos.shape[0] == 61
-    assert list(tmp_path.iterdir()) == []  # removed once written; the log keeps it mapped
+    assert list(tmp_path.iterdir()) == []  # removed once written; the log keeps it open
 
 
 # ---------------------------------------------------------------- a killed run, end to end
