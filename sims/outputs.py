@@ -805,15 +805,20 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                     summary["log"] = {"path": "log.arrow", "ticks": log_file.n, "complete": log_file.complete,
                                       "chunks": log_file.num_chunks}
                 log = result.log
-                arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl,
-                          "act": log.act, "actuator_force": log.actuator_force,
-                          "sensordata": log.sensordata}
-                arrays.update(setup.task.evaluation.timeseries(log))
                 stride = setup.output.output_stride
+                names = ("t", "qpos", "qvel", "ctrl", "act", "actuator_force", "sensordata")
+                if hasattr(log, "every"):  # read from the log file a chunk at a time
+                    arrays = {name: log.every(name, stride) for name in names}
+                else:
+                    arrays = {name: getattr(log, name)[::stride] for name in names}
+                n = log.n if hasattr(log, "every") else log.t.size
+                # (an evaluation may return its series at every tick, strided here, or already
+                # at every stride-th tick)
+                series = setup.task.evaluation.timeseries(log)
                 if stride > 1:  # every stride-th tick of the per-tick arrays
-                    n = log.t.size
-                    arrays = {k: v[::stride] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in arrays.items()}
-                    summary["timeseries_every_s"] = float(log.t[stride] - log.t[0]) if n > stride else None
+                    series = {k: v[::stride] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in series.items()}
+                    summary["timeseries_every_s"] = float(arrays["t"][1] - arrays["t"][0]) if n > stride else None
+                arrays.update(series)
                 np.savez_compressed(tmp / "timeseries.npz", **arrays)
                 setup.task.evaluation.report(log, result.checks, tmp / "report.png")
                 render = dict(speed=setup.output.video_speed, quiet=quiet, frame_qpos=setup.output.video_qpos)

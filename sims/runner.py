@@ -127,6 +127,29 @@ class RunLog:
         """Ticks logged."""
         return self.file.n if self.file is not None and "t" not in self.__dict__ else len(self.t)
 
+    def chunks(self, names, size: int = CHUNK_TICKS):
+        """(first row, {name: rows}) for each chunk of the log in turn: the file's chunks
+        (read one at a time), or, for a log held in memory, slices of ``size`` rows."""
+        if self.file is not None and not any(name in self.__dict__ for name in names):
+            start = 0
+            for part in self.file.chunks(list(names)):
+                yield start, part
+                start += part[names[0]].shape[0]
+            return
+        n = self.n
+        for start in range(0, n, size):
+            yield start, {name: getattr(self, name)[start:start + size] for name in names}
+
+    def every(self, name: str, stride: int) -> np.ndarray:
+        """Rows 0, stride, 2 stride, ... of the array ``name`` (``array[::stride]``), read a
+        chunk at a time."""
+        if self.file is None or name in self.__dict__:
+            value = getattr(self, name)
+            return value if value is None else value[::stride]
+        parts = [part[name][-start % stride::stride] for start, part in self.chunks([name])]
+        shape = () if name == "t" else tuple(self.file.shapes[name])
+        return np.concatenate(parts) if parts else np.zeros((0, *shape))
+
 
 @dataclass
 class RunResult:
