@@ -122,15 +122,19 @@ class RunLog:
     physics_wall_s: float | None = None
     file: LogFile | None = field(default=None, repr=False, compare=False)
 
+    def held(self, name: str) -> bool:
+        """Whether the array ``name`` is in memory (given, or read whole already)."""
+        return self.__dict__.get(name) is not None
+
     @property
     def n(self) -> int:
         """Ticks logged."""
-        return self.file.n if self.file is not None and "t" not in self.__dict__ else len(self.t)
+        return self.file.n if self.file is not None and not self.held("t") else len(self.t)
 
     def chunks(self, names, size: int = CHUNK_TICKS):
         """(first row, {name: rows}) for each chunk of the log in turn: the file's chunks
         (read one at a time), or, for a log held in memory, slices of ``size`` rows."""
-        if self.file is not None and not any(name in self.__dict__ for name in names):
+        if self.file is not None and not any(self.held(name) for name in names):
             start = 0
             for part in self.file.chunks(list(names)):
                 yield start, part
@@ -143,7 +147,7 @@ class RunLog:
     def every(self, name: str, stride: int) -> np.ndarray:
         """Rows 0, stride, 2 stride, ... of the array ``name`` (``array[::stride]``), read a
         chunk at a time."""
-        if self.file is None or name in self.__dict__:
+        if self.file is None or self.held(name):
             value = getattr(self, name)
             return value if value is None else value[::stride]
         parts = [part[name][-start % stride::stride] for start, part in self.chunks([name])]

@@ -250,3 +250,35 @@ def test_the_output_location_is_checked_before_the_first_step(tmp_path, monkeypa
                                                         rf"system of {small}\)"):
         api.run("loader-supply", params={"duration": 20}, out=small / "out")
     assert list(small.iterdir()) == []
+
+
+# ---------------------------------------------------------------- evaluation by chunks
+
+def test_fast_checks_do_not_depend_on_the_chunks(tmp_path):
+    """FAST's evaluation reads the log a chunk at a time: with 7-tick chunks and every 3rd row
+    kept it gives the very check values, metrics and timeseries that the same log held
+    whole (one chunk) gives, and the values the whole arrays give directly."""
+    scenario = scenarios.get("fast-source-switch")
+    setup = scenario.build(scenario.resolve(duration=1.0))
+    evaluation = setup.task.evaluation
+    evaluation.stride = 3
+    log = runner.simulate(setup, log_path=tmp_path / "log.arrow", chunk_ticks=7)
+    assert log.file.num_chunks == 8  # 51 ticks
+    chunked = evaluation.evaluate(log)
+    series = evaluation.timeseries(log)
+    assert not any(log.held(name) for name in logfile.ARRAYS)  # never read whole
+    whole = runner.RunLog(**{name: log.file.column(name) for name in ("t", *logfile.ARRAYS)},
+                          reference=log.reference)
+    held = evaluation.evaluate(whole)
+    assert [c.to_json() for c in chunked[0]] == [c.to_json() for c in held[0]]
+    assert json.dumps(chunked[1], sort_keys=True) == json.dumps(held[1], sort_keys=True)
+    for key, value in evaluation.timeseries(whole).items():
+        np.testing.assert_array_equal(series[key], value, err_msg=key)
+    p = evaluation.physics
+    tension = -whole.actuator_force[:, p.cable_ids]
+    row, cable = np.unravel_index(np.argmin(tension), tension.shape)
+    check = {c.name: c for c in chunked[0]}["cable_tension_min"]
+    assert check.value == float(tension.min()) / 1e3
+    assert f"cable{cable + 1} at t = {whole.t[row]:.2f} s" in check.note
+    np.testing.assert_array_equal(series["cable_tension"], tension[::3])
+    np.testing.assert_array_equal(series["stewart_leg"], whole.qpos[::3, p.leg_qpos])

@@ -410,7 +410,7 @@ class FastEvaluation:
             "stewart_leg_max_mm": 1e3 * float(ext["leg_abs"][0]),
         })
         if isinstance(self.sensors, FusedSensors):  # (qpos read whole for this, then let go)
-            qpos = log.file.column("qpos") if log.file is not None and "qpos" not in vars(log) else log.qpos
+            qpos = log.file.column("qpos") if log.file is not None and not log.held("qpos") else log.qpos
             metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, qpos)
             del qpos
         if self.loads.mean_speed > 0:
