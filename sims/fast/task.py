@@ -327,7 +327,8 @@ class FastEvaluation:
             for key in scalars:
                 scalars[key].append(s[key])
             for key, value in s.items():
-                rows_kept.setdefault(key, []).append(value[-start % self.stride::self.stride])
+                # (a copy: a view would keep the whole chunk it was read with)
+                rows_kept.setdefault(key, []).append(value[-start % self.stride::self.stride].copy())
             tension, law = s["cable_tension"], s["cable_tension_law"]
             low = np.unravel_index(np.argmin(tension), tension.shape)
             high = np.unravel_index(np.argmax(law), law.shape)
