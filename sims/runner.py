@@ -3,9 +3,10 @@
 Per control tick it updates the task's sensors (``sims.task.Sensors``: the observation),
 calls the controller once with that observation (it writes or returns the actuator commands;
 it never gets the physics, ``sims.task``), applies the disturbance, lets MuJoCo take ``k``
-physics steps with ``mj_step(model, data, nstep=k)`` and copies the state into preallocated
-logs. Everything else (the planned motion, checks,
-rendering) works on whole arrays before or after the loop.
+physics steps with ``mj_step(model, data, nstep=k)`` and copies the state into the log's
+chunk buffer, which streams to disk a chunk at a time (``sims.logfile``). Everything else (the
+planned motion, checks, rendering) works before or after the loop, on whole arrays or on the
+log's chunks (``RunLog.chunks``).
 
 Divergence (a NaN in the state, or any MuJoCo warning such as the bad-qacc reset) ends the
 run early; the ``simulation_warnings`` check then fails with a message that says when and why.
