@@ -202,6 +202,18 @@ class LogFile:
             row += part.shape[0]
         return out
 
+    def copy_to(self, path) -> None:
+        """Write this log to ``path``, a chunk at a time; with the footer only if this log
+        has one (complete)."""
+        sink = pa.OSFile(str(path), "wb")
+        writer = pa.ipc.new_file(sink, self.schema)
+        writer.write_batch(pa.record_batch([pa.array([], f.type) for f in self.schema], schema=self.schema))
+        for k in range(self.num_chunks):
+            writer.write_batch(self.batch(k))
+        if self.complete:
+            writer.close()
+        sink.close()
+
     def to_dict(self) -> dict[str, np.ndarray]:
         """Every array, whole."""
         return {name: self.column(name) for name in self.names}

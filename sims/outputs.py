@@ -776,7 +776,7 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
     ``staging``: the staging directory of ``out_dir`` the caller holds (``sims.pipeline``
     opens it before the run, whose log streams into it: ``log.arrow``); the caller's
     ``out_dir.staging()`` swaps it in. None: a staging directory is made and swapped in here,
-    and the log, if the run streamed it elsewhere, is not part of the output.
+    and the log, streamed elsewhere, is copied into it a chunk at a time.
 
     ``out_dir``: an OutputDir (validated and reserved by the caller before simulating, as
     the CLI does) or a path, validated here. ``video``: a VideoFile or a path. A video inside
@@ -801,7 +801,9 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
             with held as tmp:
                 summary = summary_dict(result)
                 log_file = getattr(result.log, "file", None)
-                if log_file is not None and (tmp / "log.arrow").exists():
+                if log_file is not None and not (tmp / "log.arrow").exists():
+                    log_file.copy_to(tmp / "log.arrow")  # streamed elsewhere (a run not staged here)
+                if log_file is not None:
                     summary["log"] = {"path": "log.arrow", "ticks": log_file.n, "complete": log_file.complete,
                                       "chunks": log_file.num_chunks}
                 log = result.log

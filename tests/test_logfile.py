@@ -282,3 +282,14 @@ def test_fast_checks_do_not_depend_on_the_chunks(tmp_path):
     assert f"cable{cable + 1} at t = {whole.t[row]:.2f} s" in check.note
     np.testing.assert_array_equal(series["cable_tension"], tension[::3])
     np.testing.assert_array_equal(series["stewart_leg"], whole.qpos[::3, p.leg_qpos])
+
+
+def test_a_run_written_after_the_fact_gets_a_copy_of_its_log(tmp_path):
+    """write_run of a result whose log streamed to a temporary file (no staging directory
+    given) copies it in, chunk by chunk, complete."""
+    setup = _setup(duration=0.3)
+    result = runner.run("loader-supply", setup)
+    outputs.write_run(result, setup, tmp_path / "out")
+    log = read_log(tmp_path / "out")
+    assert log.complete and log.n == result.log.n == 61
+    np.testing.assert_array_equal(log.column("sensordata"), result.log.sensordata)
