@@ -53,7 +53,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser("run", help="simulate a scenario and check it (planbench run NAME --help: its parameters)",
                    add_help=False)
     sub.add_parser("plan", help="write a scenario's planned motion, no physics", add_help=False)
-    sub.add_parser("bench", help="benchmark table: realtime factors and loop/bare-mj_step ratios")
+    bench = sub.add_parser("bench", help="benchmark table: realtime factors and loop/bare-mj_step ratios")
+    bench.add_argument("--six-hours", action="store_true",
+                       help="also measure the peak memory of a 6 h fast-tracking run (minutes of wall time)")
     sweep = sub.add_parser("sweep", help="a campaign: many runs from a spec (grids, draws, seeds, plant "
                            "uncertainty), a results table and a report")
     sweep.add_argument("spec", metavar="SPEC.toml", help="the campaign spec (README, \"Campaigns\")")
@@ -232,17 +234,31 @@ def _plugin_names(plugins: dict) -> str:
     return ", ".join(f"--{role} {spec}" for role, spec in plugins.items()) or "planbench's own components"
 
 
-def _write_unfinished(out, scenario, params, plugins: dict, check) -> None:
+def _write_unfinished(out, scenario, params, plugins: dict, check, partial=None) -> None:
     """summary.json of a run that did not complete (it hung or its process ended): passed
-    false, the one check that says why; no timeseries (the log died with the process)."""
+    false, the one check that says why; no timeseries. ``partial``: the log the run had
+    streamed when it ended (``sims.outputs.partial_log``), moved in as log.arrow: it has
+    no footer and reads as incomplete (``sims.logfile.read_log``)."""
     import json
 
+    from sims.logfile import LOG_FILE, read_log
     from sims.outputs import software_versions
 
     summary = {"scenario": scenario.name, "passed": False, "seed": getattr(params, "seed", None),
                "completed": False, "parameters": params.to_dict(), "versions": software_versions(),
                "plugins": plugins, "checks": [check.to_json()], "metrics": {}}
+    log = None
+    if partial is not None:
+        try:
+            log = read_log(partial)
+        except (OSError, ValueError):  # killed before its first bytes: nothing to keep
+            partial = None
+    if log is not None:
+        summary["log"] = {"path": LOG_FILE, "ticks": log.n, "complete": log.complete, "chunks": log.num_chunks}
+        del log  # (closed before it moves)
     with out.staging({"scenario": scenario.name}) as tmp:
+        if partial is not None:
+            os.rename(partial, tmp / LOG_FILE)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
 
 
@@ -287,11 +303,12 @@ def cmd_run(argv: list[str]) -> int:
             rows, passed, sim_time_s, wall_time_s = supervise.run_supervised(work, timeout)
         except supervise.Fault as fault:
             ended = fault.ended
-            outputs.remove_leftovers(out.path)  # the child's staging directory, if any
+            partial = outputs.partial_log(out.path)  # the log the child streamed, if any
             if video is not None:
                 outputs.remove_leftovers(video.path)
             who = _plugin_names(plugins)
             if not ended.timed_out and not ended.phase.startswith(supervise.AFTER_FIRST_STEP):
+                outputs.remove_leftovers(out.path)  # the child's staging directory, if any
                 raise BadInput(f"the run ended in {ended.phase} ({who}) before any physics step, without "
                                f"completing: {ended.how}; nothing was written") from None
             if ended.timed_out:
@@ -300,7 +317,8 @@ def cmd_run(argv: list[str]) -> int:
             else:
                 check = Check("run_completed", 0.0, 1.0, "count", "==",
                               note=f"the run ended in {ended.phase} ({who}): {ended.how}")
-            _write_unfinished(out, scenario, params, plugins, check)
+            _write_unfinished(out, scenario, params, plugins, check, partial)
+            outputs.remove_leftovers(out.path)  # the rest of the child's staging directory
             print(format_checks([(scenario.name, check)]))
             print(f"planbench: error: {scenario.name}: {check.note}", file=sys.stderr)
             print(f"FAILED: {scenario.name} did not complete; summary in {out}")
@@ -336,7 +354,7 @@ def cmd_bench(args) -> int:
     print(bench.format_campaign(bench.campaign_throughput()))
     print(bench.format_planner_only(bench.planner_only_throughput()))
     print()
-    print(bench.format_memory(bench.memory_by_run_length()))
+    print(bench.format_memory(bench.memory_by_run_length(six_hours=args.six_hours)))
     return EXIT_OK
 
 

@@ -53,7 +53,7 @@ VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv")
 #: The ``comment`` tag of every video planbench writes: the proof that it may replace it.
 VIDEO_TAG = "written by planbench"
 #: Files of a run directory, and of a plan directory (more may follow, e.g. videos).
-RUN_FILES = ("summary.json", "timeseries.npz", "report.png", MANIFEST)
+RUN_FILES = ("summary.json", "timeseries.npz", "report.png", "log.arrow", MANIFEST)
 PLAN_FILES = ("plan.npz", "plan.png", MANIFEST)
 #: Longest name planbench writes inside an output directory besides a video's.
 _LONGEST_INNER = max(len(n) for n in (*RUN_FILES, *PLAN_FILES, "segments.json", "figures.png",
@@ -561,6 +561,21 @@ def remove_leftovers(target: Path) -> list[Path]:
     return removed
 
 
+def partial_log(target: Path, name: str = "log.arrow") -> Path | None:
+    """The log a run into ``target`` that ended without completing streamed, in its staging
+    directory beside ``target`` (the newest such, its marker naming ``target``), or None.
+    Call with the target's lock held (no live run owns a staging directory then)."""
+    found = []
+    with contextlib.suppress(OSError):
+        for entry in target.parent.iterdir():
+            if entry.name.startswith(STAGING_PREFIX) and not entry.is_symlink() and entry.is_dir() \
+                    and (entry / STAGING_MARKER).is_file() and _owned_leftover(entry, target.name):
+                log = entry / name
+                if log.is_file() and not log.is_symlink():
+                    found.append((log.stat().st_mtime, log))
+    return max(found)[1] if found else None
+
+
 def _lock_path(target: Path) -> Path:
     digest = hashlib.sha256(os.fsencode(target.name)).hexdigest()[:16]
     return target.parent / f"{LOCK_PREFIX}{digest}"
@@ -724,6 +739,13 @@ def software_versions() -> dict:
             "numpy": np.__version__, "scipy": scipy.__version__}
 
 
+def read_log(path):
+    """A run's log (``DIR/log.arrow`` or DIR): ``sims.logfile.read_log``."""
+    from sims.logfile import read_log as read
+
+    return read(path)
+
+
 def summary_dict(result) -> dict:
     return {
         "scenario": result.scenario,
@@ -748,8 +770,13 @@ def _as_output_dir(out_dir, kind: str) -> OutputDir:
 
 
 def write_run(result, setup, out_dir, video=None, camera: str = "overview",
-              quiet: bool = True, more_videos: tuple = ()) -> dict:
+              quiet: bool = True, more_videos: tuple = (), staging: Path | None = None) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
+
+    ``staging``: the staging directory of ``out_dir`` the caller holds (``sims.pipeline``
+    opens it before the run, whose log streams into it: ``log.arrow``); the caller's
+    ``out_dir.staging()`` swaps it in. None: a staging directory is made and swapped in here,
+    and the log, streamed elsewhere, is copied into it a chunk at a time.
 
     ``out_dir``: an OutputDir (validated and reserved by the caller before simulating, as
     the CLI does) or a path, validated here. ``video``: a VideoFile or a path. A video inside
@@ -769,18 +796,31 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
         if video is not None and not video.is_reserved:
             stack.enter_context(video.reserved())
         try:
-            with target.staging({"scenario": result.scenario}) as tmp:
+            held = contextlib.nullcontext(staging) if staging is not None else \
+                target.staging({"scenario": result.scenario})
+            with held as tmp:
                 summary = summary_dict(result)
+                log_file = getattr(result.log, "file", None)
+                if log_file is not None and not (tmp / "log.arrow").exists():
+                    log_file.copy_to(tmp / "log.arrow")  # streamed elsewhere (a run not staged here)
+                if log_file is not None:
+                    summary["log"] = {"path": "log.arrow", "ticks": log_file.n, "complete": log_file.complete,
+                                      "chunks": log_file.num_chunks}
                 log = result.log
-                arrays = {"t": log.t, "qpos": log.qpos, "qvel": log.qvel, "ctrl": log.ctrl,
-                          "act": log.act, "actuator_force": log.actuator_force,
-                          "sensordata": log.sensordata}
-                arrays.update(setup.task.evaluation.timeseries(log))
                 stride = setup.output.output_stride
+                names = ("t", "qpos", "qvel", "ctrl", "act", "actuator_force", "sensordata")
+                if hasattr(log, "every"):  # read from the log file a chunk at a time
+                    arrays = {name: log.every(name, stride) for name in names}
+                else:
+                    arrays = {name: getattr(log, name)[::stride] for name in names}
+                n = log.n if hasattr(log, "every") else log.t.size
+                # (an evaluation may return its series at every tick, strided here, or already
+                # at every stride-th tick)
+                series = setup.task.evaluation.timeseries(log)
                 if stride > 1:  # every stride-th tick of the per-tick arrays
-                    n = log.t.size
-                    arrays = {k: v[::stride] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in arrays.items()}
-                    summary["timeseries_every_s"] = float(log.t[stride] - log.t[0]) if n > stride else None
+                    series = {k: v[::stride] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in series.items()}
+                    summary["timeseries_every_s"] = float(arrays["t"][1] - arrays["t"][0]) if n > stride else None
+                arrays.update(series)
                 np.savez_compressed(tmp / "timeseries.npz", **arrays)
                 setup.task.evaluation.report(log, result.checks, tmp / "report.png")
                 render = dict(speed=setup.output.video_speed, quiet=quiet, frame_qpos=setup.output.video_qpos)

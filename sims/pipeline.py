@@ -8,9 +8,12 @@ and records them in the run's provenance (summary.json's "plugins").
 
 from __future__ import annotations
 
+import contextlib
+import tempfile
 from typing import Callable
 
-from sims import runner
+from sims import run_limits, runner
+from sims.logfile import LOG_FILE
 
 
 def build(scenario, params, plant=None, planner=None, controller=None) -> runner.Setup:
@@ -51,11 +54,40 @@ def execute(scenario, params, plant=None, *, plugins: dict | None = None, planne
     setup.provenance.plugins = plugins
     if on_built is not None:
         on_built(setup)
-    result = runner.run(scenario.name, setup, quiet=quiet, profile=profile)
-    if on_judged is not None:
-        on_judged(result)
-    if out is not None:
+    if out is None:
+        check_log_space(setup, params, None)
+        result = runner.run(scenario.name, setup, quiet=quiet, profile=profile)
+        if on_judged is not None:
+            on_judged(result)
+        return setup, result
+    target = out if isinstance(out, outputs.OutputDir) else outputs.OutputDir(out)
+    check_log_space(setup, params, target.path)
+    with contextlib.ExitStack() as stack:
+        if not target.is_reserved:
+            stack.enter_context(target.reserved())
+        # The log streams into the output's staging directory, swapped in with the rest.
+        tmp = stack.enter_context(target.staging({"scenario": scenario.name}))
+        result = runner.run(scenario.name, setup, quiet=quiet, profile=profile, log_path=tmp / LOG_FILE)
+        if on_judged is not None:
+            on_judged(result)
         supervise.phase("writing the outputs (planbench's own code)")
-        outputs.write_run(result, setup, out, video=video, camera=camera or scenario.camera, quiet=quiet,
-                          more_videos=more_videos)
+        outputs.write_run(result, setup, target, video=video, camera=camera or scenario.camera, quiet=quiet,
+                          more_videos=more_videos, staging=tmp)
     return setup, result
+
+
+def check_log_space(setup: runner.Setup, params, directory) -> None:
+    """A RunLimitError (bad input) before the first physics step if the run's log would not
+    fit in the free space where it streams: ``directory`` (the output directory's place) or,
+    None, the temporary directory (``sims.run_limits.log_space_limit``)."""
+    per_tick = getattr(params, "log_bytes_per_tick", None)
+    if per_tick is None:
+        return
+    try:
+        bytes_per_tick = per_tick()
+    except NotImplementedError:
+        return
+    task = setup.task
+    where = tempfile.gettempdir() if directory is None else directory
+    run_limits.check_duration(float(task.duration), task.control_dt, bytes_per_tick,
+                              run_limits.log_space_limit(where))

@@ -1,4 +1,4 @@
-"""What a run may ask for: its duration against the control tick and the memory its log
+"""What a run may ask for: its duration against the control tick and the disk space its log
 needs, and the range of angle options. Checked before anything is built (README.md,
 "Scenario parameters, scenario files and reruns"), by the parameters' ``check`` (which
 ``planbench run`` calls while it reads its options) and again by every mechanism's ``build``
@@ -7,15 +7,17 @@ needs, and the range of angle options. Checked before anything is built (README.
 Duration:
   * at least one control tick of the scenario: a shorter run takes no physics step and its
     checks would pass on the initial state alone;
-  * its log must fit in memory. The runner preallocates the log (``sims.runner.RunLog``:
-    t, qpos, qvel, act, ctrl, actuator_force, sensordata, mocap, the reference sampled at
-    every tick) and the controllers and disturbances preallocate their own per-tick arrays;
-    each mechanism states those per tick (its package's ``log_bytes_per_tick``, e.g.
-    ``sims.loader.log_bytes_per_tick``; tests/test_run_options.py measures them). A run whose
-    estimate exceeds ``log_memory_limit()``, a quarter of the machine's physical memory, is
-    refused: evaluating the checks and writing the outputs needs about as much again as the
-    log (measured peaks of 1.2-2.5 times the log), so a quarter leaves the rest of the machine
-    its memory.
+  * its log must fit on disk. The runner streams the log to a file as the run goes
+    (``sims.logfile``: t, qpos, qvel, act, ctrl, actuator_force, sensordata, mocap, in
+    chunks), in the output directory's staging directory (``planbench run``) or the temporary
+    directory (a run that writes nothing). Each mechanism states its bytes per tick (its
+    package's ``log_bytes_per_tick``, e.g. ``sims.loader.log_bytes_per_tick``: the log's
+    columns and the reference, controller and disturbance arrays kept per tick, an upper
+    bound of the file's size; tests/test_run_options.py measures them). A run whose estimate
+    exceeds the free space where its log goes (``log_space_limit``) is refused: by the
+    parameters' check against the current directory's file system (``planbench run``'s
+    default ``results/``), and again by ``sims.pipeline.execute`` against the output's
+    (or the temporary directory's) before the first physics step.
 
 Angles (wave heading, wind direction, a wind file's directions): refused beyond
 +-ANGLE_LIMIT_DEG (``ANGLE``, the one declaration of their range), used as given inside (every
@@ -27,14 +29,11 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
+from pathlib import Path
 
 from sims.params import ParamError
 
-#: The log may take this fraction of physical memory (see the module doc).
-LOG_MEMORY_FRACTION = 0.25
-#: The limit where the system does not report its memory (os.sysconf): 4 GiB, a quarter of a
-#: 16 GiB machine.
-FALLBACK_LOG_LIMIT_BYTES = 4 * 2**30
 #: Angle options are refused beyond +- this, deg (one turn either way).
 ANGLE_LIMIT_DEG = 360.0
 #: The range of an angle parameter (``sims.params.param`` keywords).
@@ -45,24 +44,28 @@ _BYTES_PER_FLOAT = 8
 
 
 class RunLimitError(ParamError):
-    """A run option that is a valid number but not a run (too short, too long for memory)."""
+    """A run option that is a valid number but not a run (too short, too long for the disk)."""
 
 
-def physical_memory_bytes() -> int | None:
-    """This machine's physical memory (os.sysconf), None where the system does not say."""
-    try:
-        pages, size = os.sysconf("SC_PHYS_PAGES"), os.sysconf("SC_PAGE_SIZE")
-    except (AttributeError, ValueError, OSError):
-        return None
-    return pages * size if pages > 0 and size > 0 else None
+def _existing(path: Path) -> Path:
+    """``path``, or the nearest folder above it that exists (an output not yet created)."""
+    path = Path(os.path.abspath(path))
+    while not path.exists() and path != path.parent:
+        path = path.parent
+    return path
 
 
-def log_memory_limit() -> tuple[float, str]:
-    """(bytes, why): the largest log a run may preallocate, and the rule in words."""
-    total = physical_memory_bytes()
-    if total is None:
-        return float(FALLBACK_LOG_LIMIT_BYTES), "this system does not report its memory"
-    return LOG_MEMORY_FRACTION * total, f"a quarter of this machine's {format_bytes(total)} of memory"
+def free_bytes(directory) -> int:
+    """Free space (bytes, for this user) on the file system that holds ``directory``."""
+    return shutil.disk_usage(_existing(Path(directory))).free
+
+
+def log_space_limit(directory=None) -> tuple[float, str]:
+    """(bytes, why): the largest log a run writing at ``directory`` may stream, the free space
+    on its file system, and the rule in words. None: the current directory (where
+    ``planbench run`` writes ``results/`` unless told otherwise)."""
+    where = _existing(Path.cwd() if directory is None else Path(directory))
+    return float(free_bytes(where)), f"the free space on the file system of {where}"
 
 
 def format_bytes(n: float) -> str:
@@ -84,9 +87,10 @@ def format_bytes(n: float) -> str:
 def runlog_floats_per_tick(model, channels: int) -> int:
     """Doubles per tick of ``sims.runner.RunLog`` for a compiled model: t, qpos (nq), qvel
     (nv), act (na), ctrl and actuator_force (nu each), sensordata, mocap_pos and mocap_quat
-    (3 + 4 per mocap body), and the reference's position, velocity and acceleration
-    (``channels`` each; its t is the log's)."""
-    return (1 + model.nq + model.nv + model.na + 2 * model.nu + model.nsensordata
+    (3 + 4 per mocap body), streamed to the log file, and what stays in memory per tick:
+    the reference's position, velocity and acceleration (``channels`` each) and two arrays of
+    the ticks' times (the reference's t, the episode's)."""
+    return (3 + model.nq + model.nv + model.na + 2 * model.nu + model.nsensordata
             + 7 * model.nmocap + 3 * channels)
 
 
@@ -97,7 +101,7 @@ def floats(n: float) -> float:
 
 def check_duration(duration: float | None, control_dt: float, bytes_per_tick: float,
                    limit: tuple[float, str] | None = None) -> float | None:
-    """The duration (s) if it is at least one control tick and its log fits the memory limit;
+    """The duration (s) if it is at least one control tick and its log fits the disk-space limit;
     a RunLimitError naming the value and the limit otherwise.
 
     Args:
@@ -105,7 +109,7 @@ def check_duration(duration: float | None, control_dt: float, bytes_per_tick: fl
       control_dt: the scenario's control period, s.
       bytes_per_tick: the log's bytes per control tick (``log_bytes_per_tick`` of the
         mechanism).
-      limit: (bytes, why), default ``log_memory_limit()``.
+      limit: (bytes, why), default ``log_space_limit()``.
     """
     if duration is None:
         return None
@@ -115,7 +119,7 @@ def check_duration(duration: float | None, control_dt: float, bytes_per_tick: fl
     if duration < control_dt * (1.0 - 1e-9):
         raise RunLimitError(f"duration {duration:g} s is shorter than one control tick "
                             f"({control_dt * 1e3:g} ms): nothing would be simulated")
-    limit_bytes, why = log_memory_limit() if limit is None else limit
+    limit_bytes, why = log_space_limit() if limit is None else limit
     need = (duration / control_dt + 1.0) * bytes_per_tick  # ticks, to within one
     if need > limit_bytes:
         raise RunLimitError(f"duration {duration:g} s needs {'' if math.isinf(need) else '~'}"

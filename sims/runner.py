@@ -3,9 +3,10 @@
 Per control tick it updates the task's sensors (``sims.task.Sensors``: the observation),
 calls the controller once with that observation (it writes or returns the actuator commands;
 it never gets the physics, ``sims.task``), applies the disturbance, lets MuJoCo take ``k``
-physics steps with ``mj_step(model, data, nstep=k)`` and copies the state into preallocated
-logs. Everything else (the planned motion, checks,
-rendering) works on whole arrays before or after the loop.
+physics steps with ``mj_step(model, data, nstep=k)`` and copies the state into the log's
+chunk buffer, which streams to disk a chunk at a time (``sims.logfile``). Everything else (the
+planned motion, checks, rendering) works before or after the loop, on whole arrays or on the
+log's chunks (``RunLog.chunks``).
 
 Divergence (a NaN in the state, or any MuJoCo warning such as the bad-qacc reset) ends the
 run early; the ``simulation_warnings`` check then fails with a message that says when and why.
@@ -17,9 +18,12 @@ evaluated and written as usual.
 
 from __future__ import annotations
 
+import tempfile
 import time
+import weakref
 from dataclasses import dataclass, field
 from math import isfinite
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -28,6 +32,7 @@ from tqdm import tqdm
 from planners.trajectory import Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, controller_check, divergence_check
 from sims import supervise
+from sims.logfile import CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly
 from sims.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
                        check_controller, check_first_command, fault_text, sample_checked)
 
@@ -62,6 +67,25 @@ class Setup:
             self.task.attach(self.physics)
 
 
+class _Logged:
+    """A per-tick array of RunLog: read from the run's log file (``RunLog.file``) on first
+    use, or the array it was given."""
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __get__(self, log, owner=None):
+        if log is None:
+            return None  # the dataclass default
+        value = log.__dict__.get(self.name)
+        if value is None and log.file is not None:
+            value = log.__dict__[self.name] = log.file.column(self.name)
+        return value
+
+    def __set__(self, log, value):
+        log.__dict__[self.name] = value
+
+
 @dataclass
 class RunLog:
     """State at every control tick (row i is the state at time ``t[i]``; row 0 is the start).
@@ -72,18 +96,22 @@ class RunLog:
     the last row, after which no physics runs, the controls still held there. ``contacts``
     lists (tick, geom1, geom2, distance) of every contact seen at a tick's end. ``n`` may be
     shorter than planned when the run diverged.
+
+    A simulated run's arrays live in its log file (``file``, a ``sims.logfile.LogFile``,
+    streamed to disk as the run went): each is read whole on first use; ``file.chunks()``
+    reads them a chunk at a time.
     """
 
-    t: np.ndarray
-    qpos: np.ndarray
-    qvel: np.ndarray
-    act: np.ndarray
-    ctrl: np.ndarray
-    actuator_force: np.ndarray
-    sensordata: np.ndarray
-    mocap_pos: np.ndarray
-    mocap_quat: np.ndarray
-    reference: TrajectorySample
+    t: np.ndarray = _Logged()
+    qpos: np.ndarray = _Logged()
+    qvel: np.ndarray = _Logged()
+    act: np.ndarray = _Logged()
+    ctrl: np.ndarray = _Logged()
+    actuator_force: np.ndarray = _Logged()
+    sensordata: np.ndarray = _Logged()
+    mocap_pos: np.ndarray = _Logged()
+    mocap_quat: np.ndarray = _Logged()
+    reference: TrajectorySample | None = None
     contacts: list = field(default_factory=list)
     warnings: dict = field(default_factory=dict)
     diverged_at: float | None = None
@@ -93,6 +121,39 @@ class RunLog:
     loop_wall_s: float = 0.0
     controller_wall_s: float | None = None
     physics_wall_s: float | None = None
+    file: LogFile | None = field(default=None, repr=False, compare=False)
+
+    def held(self, name: str) -> bool:
+        """Whether the array ``name`` is in memory (given, or read whole already)."""
+        return self.__dict__.get(name) is not None
+
+    @property
+    def n(self) -> int:
+        """Ticks logged."""
+        return self.file.n if self.file is not None and not self.held("t") else len(self.t)
+
+    def chunks(self, names, size: int = CHUNK_TICKS):
+        """(first row, {name: rows}) for each chunk of the log in turn: the file's chunks
+        (read one at a time), or, for a log held in memory, slices of ``size`` rows."""
+        if self.file is not None and not any(self.held(name) for name in names):
+            start = 0
+            for part in self.file.chunks(list(names)):
+                yield start, part
+                start += part[names[0]].shape[0]
+            return
+        n = self.n
+        for start in range(0, n, size):
+            yield start, {name: getattr(self, name)[start:start + size] for name in names}
+
+    def every(self, name: str, stride: int) -> np.ndarray:
+        """Rows 0, stride, 2 stride, ... of the array ``name`` (``array[::stride]``), read a
+        chunk at a time."""
+        if self.file is None or self.held(name):
+            value = getattr(self, name)
+            return value if value is None else value[::stride]
+        parts = [part[name][-start % stride::stride].copy() for start, part in self.chunks([name])]
+        shape = () if name == "t" else tuple(self.file.shapes[name])
+        return np.concatenate(parts) if parts else np.zeros((0, *shape))
 
 
 @dataclass
@@ -151,10 +212,12 @@ _WARNINGS = [
 ]
 
 
-def _divergence(data, qpos, qvel, times, i: int, window: int):
-    """(time, message) if the state diverged in the ticks up to ``i``, else None."""
+def _divergence(data, qpos, qvel, times, i: int, window: int, base: int = 0):
+    """(time, message) if the state diverged in the ticks up to ``i``, else None. ``qpos``
+    and ``qvel`` hold the run's rows from ``base`` on (the log's chunk buffer)."""
     lo = max(0, i - window)
-    finite = np.isfinite(qpos[lo : i + 1]).all(axis=1) & np.isfinite(qvel[lo : i + 1]).all(axis=1)
+    finite = (np.isfinite(qpos[lo - base : i + 1 - base]).all(axis=1)
+              & np.isfinite(qvel[lo - base : i + 1 - base]).all(axis=1))
     if not finite.all():
         first = lo + int(np.argmin(finite))
         return float(times[first]), f"non-finite state at t = {times[first]:.4f} s"
@@ -261,13 +324,18 @@ def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     return Episode(times, reference, observation, context, k)
 
 
-def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, profile: bool = False) -> RunLog:
+def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, profile: bool = False,
+             log_path=None, chunk_ticks: int = CHUNK_TICKS) -> RunLog:
     """Run the control loop of ``setup`` and return its log.
 
     ``profile``: also time the code under test (the controller's calls, the online planner's
     updates inside them) and MuJoCo's steps (``RunLog.controller_wall_s``,
     ``physics_wall_s``); the rest of ``loop_wall_s`` is the testbed's own cost (sensors,
-    disturbance, logging). Off, the loop reads no clock per tick."""
+    disturbance, logging). Off, the loop reads no clock per tick.
+
+    The log streams to ``log_path`` (``sims.logfile``: a chunk of ``chunk_ticks`` ticks at a
+    time; complete, with its footer, when this returns). None: to a temporary file, removed
+    from the file system once the run is over (the returned log keeps it open)."""
     physics = setup.physics
     model, data = physics.model.ptr, physics.data.ptr
     episode = start_episode(setup)
@@ -275,31 +343,35 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     k, n = episode.steps_per_tick, episode.times.size
     controller = setup.components.controller
 
-    log = RunLog(
-        t=times,
-        qpos=np.empty((n, model.nq)),
-        qvel=np.empty((n, model.nv)),
-        act=np.empty((n, model.na)),
-        ctrl=np.zeros((n, model.nu)),
-        actuator_force=np.empty((n, model.nu)),
-        sensordata=np.empty((n, model.nsensordata)),
-        mocap_pos=np.empty((n, model.nmocap, 3)),
-        mocap_quat=np.empty((n, model.nmocap, 4)),
-        reference=reference,
-    )
-    qpos, qvel, act, ctrl = log.qpos, log.qvel, log.act, log.ctrl
-    frc, sens, mpos, mquat = log.actuator_force, log.sensordata, log.mocap_pos, log.mocap_quat
+    log = RunLog(reference=reference)
+    temporary = log_path is None
+    if temporary:
+        log_path = Path(tempfile.mkdtemp(prefix="planbench-log-")) / LOG_FILE
+    # Rows go to a chunk buffer (run row j is buffer row j - base); full chunks to the file.
+    writer = ChunkWriter(log_path, model_shapes(model), times, chunk=chunk_ticks, history=SCAN_TICKS)
+    if temporary:  # also when the run raises
+        weakref.finalize(writer, remove_quietly, log_path)
+    buffers = writer.buffers
+    qpos, qvel, act, ctrl = buffers["qpos"], buffers["qvel"], buffers["act"], buffers["ctrl"]
+    frc, sens = buffers["actuator_force"], buffers["sensordata"]
+    mpos, mquat = buffers["mocap_pos"], buffers["mocap_quat"]
     has_mocap = model.nmocap > 0
+    base, end = writer.base, writer.end
 
     def record(i: int) -> None:
-        qpos[i] = data.qpos
-        qvel[i] = data.qvel
-        act[i] = data.act
-        frc[i] = data.actuator_force
-        sens[i] = data.sensordata
+        nonlocal base, end
+        if i == end:
+            writer.flush()
+            base, end = writer.base, writer.end
+        j = i - base
+        qpos[j] = data.qpos
+        qvel[j] = data.qvel
+        act[j] = data.act
+        frc[j] = data.actuator_force
+        sens[j] = data.sensordata
         if has_mocap:
-            mpos[i] = data.mocap_pos
-            mquat[i] = data.mocap_quat
+            mpos[j] = data.mocap_pos
+            mquat[j] = data.mocap_quat
 
     record(0)
     initial_ctrl = data.ctrl.copy()
@@ -340,7 +412,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             last = i
             break
         before_step(i, physics)
-        ctrl[i] = data.ctrl
+        ctrl[i - base] = data.ctrl
         if profile:
             t1 = clock()
             mujoco.mj_step(model, data, nstep=k)
@@ -352,7 +424,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             contact = data.contact
             contacts.append((i + 1, contact.geom.copy(), contact.dist.copy()))
         if i % SCAN_TICKS == 0 or i == n - 2:
-            message = _divergence(data, qpos, qvel, times, i + 1, SCAN_TICKS)
+            message = _divergence(data, qpos, qvel, times, i + 1, SCAN_TICKS, base)
             if message:
                 log.warnings = warning_counts(data)
                 log.diverged_at, log.divergence_message = message
@@ -366,16 +438,17 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
         log.controller_wall_s, log.physics_wall_s = controller_wall, physics_wall
     bar.close()
     if log.controller_error is None:
-        ctrl[last] = data.ctrl  # held at the end (no controller call there)
-    else:
-        ctrl[last] = ctrl[last - 1] if last > 0 else initial_ctrl  # the last good command, held
+        ctrl[last - base] = data.ctrl  # held at the end (no controller call there)
+    else:  # the last good command, held
+        ctrl[last - base] = ctrl[last - 1 - base] if last > 0 else initial_ctrl
     log.physics_steps = last * k
     log.contacts = [(tick, int(g1), int(g2), float(dist)) for tick, geoms, dists in contacts
                     for (g1, g2), dist in zip(geoms.tolist(), dists.tolist())]
+    writer.close(last + 1)  # the rows up to ``last`` and the footer: the log is complete
+    log.file = read_log(log_path)
+    if temporary:  # the open file keeps the data until the log is dropped
+        remove_quietly(log_path)
     if last < n - 1:
-        for name in ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata",
-                     "mocap_pos", "mocap_quat"):
-            setattr(log, name, getattr(log, name)[: last + 1])
         r = log.reference
         log.reference = TrajectorySample(r.t[: last + 1], r.position[: last + 1],
                                          r.velocity[: last + 1], r.acceleration[: last + 1])
@@ -384,10 +457,10 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     return log
 
 
-def run(name: str, setup: Setup, quiet: bool = True, profile: bool = False) -> RunResult:
-    """Simulate ``setup`` (``profile``: see ``simulate``) and evaluate its checks."""
+def run(name: str, setup: Setup, quiet: bool = True, profile: bool = False, log_path=None) -> RunResult:
+    """Simulate ``setup`` (``profile``, ``log_path``: see ``simulate``) and evaluate its checks."""
     start = time.perf_counter()
-    log = simulate(setup, quiet=quiet, profile=profile)
+    log = simulate(setup, quiet=quiet, profile=profile, log_path=log_path)
     task, components, provenance = setup.task, setup.components, setup.provenance
     checks, metrics = task.evaluation.evaluate(log)
     checks = list(checks) + [

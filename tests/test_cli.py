@@ -38,7 +38,7 @@ def test_run_writes_summary_timeseries_report_and_video(tmp_path):
     proc = planbench("run", "loader-supply", "--out", out, "--video", out / "loader.mp4", "--quiet")
     assert proc.returncode == 0, proc.stderr
     assert {p.name for p in out.iterdir()} == {"summary.json", "timeseries.npz", "report.png", "loader.mp4",
-                                            "planbench-manifest.json"}
+                                            "log.arrow", "planbench-manifest.json"}
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"] == "loader-supply" and summary["passed"] is True
     assert summary["sim_time_s"] == pytest.approx(3.0) and summary["realtime_factor"] > 0

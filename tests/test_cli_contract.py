@@ -115,18 +115,22 @@ def _fake_demo(monkeypatch):
     class Result:
         checks, passed, sim_time_s, wall_time_s = [], True, 0.0, 0.0
 
-    def run(name, setup, quiet, profile=False):
+    def run(name, setup, quiet, profile=False, log_path=None):
         calls.append(name)
         result = Result()
         result.passed = scenarios.SCENARIOS[name].expect_pass
         return result
 
-    def write_run(result, setup, out, **kw):
+    def write_run(result, setup, out, staging=None, **kw):
+        if staging is not None:  # the pipeline's, which it swaps in
+            (staging / "summary.json").write_text("{}")
+            return
         with out.staging({"scenario": "x"}) as tmp:
             (tmp / "summary.json").write_text("{}")
 
     monkeypatch.setattr(runner, "run", run)
     monkeypatch.setattr(outputs, "write_run", write_run)
+    monkeypatch.setattr("sims.pipeline.check_log_space", lambda *args: None)
     monkeypatch.setattr("sims.cli.format_checks", lambda rows: "")
     return calls
 

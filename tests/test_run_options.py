@@ -1,7 +1,7 @@
 """Run options that are valid numbers but not a run.
 
 Refused up front, before anything is built or written: a duration under one control tick or
-whose log would not fit in memory (sims.run_limits), sea states outside the range of the
+whose log would not fit in the free disk space (sims.run_limits), sea states outside the range of the
 spectrum and the RAOs (sims.antenna.ship_motion.check_sea_state), angles beyond one turn, winds
 beyond IEC 61400-1's classes, IMU rates and latencies the controller does not model, cable
 segments beyond the timestep's limit. The CLI says so in one line (exit 2); the Python API
@@ -28,9 +28,9 @@ def _read(args):
     return _resolve_source("run", list(args))[2]
 
 
-def _memory_limit_words():
-    limit, why = run_limits.log_memory_limit()
-    return f"more than the limit of {run_limits.format_bytes(limit)} ({why})"
+def _space_limit_words():
+    """The limit's words, less its number (the free space changes as the tests write)."""
+    return f"B ({run_limits.log_space_limit()[1]})"
 
 
 def _snapshot(root):
@@ -54,7 +54,7 @@ BAD_RUNS = [
     (("antenna-sea-state", "--duration", "0.004"), ("duration = 0.004 s", "[0.005, ...] s")),
     (("fast-ra-scan", "--duration", "0.0199"), ("duration = 0.0199 s", "(20 ms)")),
     (("fast-ra-scan", "--duration", "0.0099", "--set", "control_rate_hz=100"), ("duration = 0.0099 s", "(10 ms)")),
-    # a log that would not fit in memory: the estimate and the limit
+    # a log that would not fit on disk: the estimate and the limit
     (("fast-tracking", "--duration", "1e12"), ("duration 1e+12 s", "PiB of log", "LIMIT")),
     (("antenna-paper-motion", "--duration", "1e12"), ("duration 1e+12 s", "PiB of log", "LIMIT")),
     (("loader-direct", "--duration", "1e9"), ("duration 1e+09 s", "TiB of log", "LIMIT")),
@@ -116,7 +116,7 @@ def test_bad_run_options_exit_2_with_one_line(tmp_path, capsys, args, words):
     assert len(lines) == 1, captured.err
     assert "Traceback" not in captured.err and captured.out == ""
     for word in words:
-        word = word.replace("LIMIT", _memory_limit_words()).replace("SEGMENTS", str(max_cable_segments()))
+        word = word.replace("LIMIT", _space_limit_words()).replace("SEGMENTS", str(max_cable_segments()))
         assert word in lines[0], lines[0]
     assert not out.exists() and _snapshot(tmp_path) == before
     # Found while the parameters are read, before the scenario is built.
@@ -160,11 +160,10 @@ def test_the_limits_themselves_are_accepted(args):
     assert isinstance(params, type(scenarios.get(args[0]).params))
 
 
-def test_default_runs_are_well_under_the_memory_limit():
+def test_default_runs_need_little_disk_space():
     """Every registered scenario's default run (what ``make demo`` runs) needs under 1 GiB of
-    log, a quarter of the fallback limit, so it runs on any machine the limit would allow;
-    with 14-segment cables FAST's longest still under the 4 GiB fallback."""
-    limit = run_limits.FALLBACK_LOG_LIMIT_BYTES
+    log; with 14-segment cables FAST's longest under 4 GiB."""
+    limit = 4 * 2**30
     durations = {}
     for name, scenario in scenarios.SCENARIOS.items():
         params = scenario.resolve()
@@ -219,19 +218,21 @@ _LOG_KNOBS = [
 
 
 @pytest.mark.parametrize("name, extra", [(name, {}) for name in scenarios.SCENARIOS] + _LOG_KNOBS)
-def test_log_estimate_matches_the_arrays_a_run_holds(name, extra):
+def test_log_estimate_matches_the_arrays_a_run_holds(tmp_path, name, extra):
     """The parameters' per-tick estimate (``ScenarioParams.log_bytes_per_tick``) against what two
-    short runs hold after the loop (log, controller, sensors, planner, disturbance,
-    trajectory): the difference of their bytes over the difference of their ticks. Within
+    short runs write and hold after the loop (the log file; controller, sensors, planner,
+    disturbance, trajectory): the difference of their bytes over the difference of their ticks. Within
     10 %, never below."""
     scenario = scenarios.get(name)
     held = []
     for ticks in (20, 120):
         params = scenario.resolve(duration=ticks * scenario.control_dt, **extra)
         setup = scenario.build(params)
-        log = runner.simulate(setup)
-        held.append((log.t.size, _held_bytes(log, setup.components.controller, setup.task.sensors, setup.components.planner, setup.task.disturbance,
-                                             setup.components.trajectory)))
+        path = tmp_path / f"{ticks}.arrow"
+        log = runner.simulate(setup, log_path=path)
+        held.append((log.n, path.stat().st_size + _held_bytes(
+            log, setup.components.controller, setup.task.sensors, setup.components.planner, setup.task.disturbance,
+            setup.components.trajectory)))
     (n1, b1), (n2, b2) = held
     measured = (b2 - b1) / (n2 - n1)
     estimate = params.log_bytes_per_tick()
@@ -274,17 +275,17 @@ def test_build_checks_before_any_work(monkeypatch, name):
         scenario.build(unchecked)
 
 
-def test_memory_rule_is_stated_and_follows_the_machine(monkeypatch):
-    limit, why = run_limits.log_memory_limit()
-    total = run_limits.physical_memory_bytes()
-    if total is not None:
-        assert limit == pytest.approx(total / 4) and why.startswith("a quarter of this machine's")
-    monkeypatch.setattr(run_limits, "physical_memory_bytes", lambda: None)
-    assert run_limits.log_memory_limit() == (run_limits.FALLBACK_LOG_LIMIT_BYTES,
-                                             "this system does not report its memory")
+def test_disk_rule_is_stated_and_follows_the_free_space(monkeypatch, tmp_path):
+    import shutil
+
+    limit, why = run_limits.log_space_limit(tmp_path / "not" / "yet")
+    assert why == f"the free space on the file system of {tmp_path}"
+    assert limit == pytest.approx(shutil.disk_usage(tmp_path).free, rel=0.01)
+    monkeypatch.setattr(run_limits, "free_bytes", lambda directory: 4 * 2**30)
     with pytest.raises(run_limits.RunLimitError,
-                       match=r"duration 1e\+12 s needs ~1\.4 PiB of log, more than the limit of 4 GiB \(this"):
+                       match=r"duration 1e\+12 s needs ~1\.4 PiB of log, more than the limit of 4 GiB \(the free "):
         run_limits.check_duration(1e12, 0.005, 8.0)  # 2e14 ticks x 8 B = 1.42 PiB
+    run_limits.check_duration(1e5, 0.005, 8.0)  # 160 MB: fits
     assert run_limits.format_bytes(12 * 2**30) == "12 GiB" and run_limits.format_bytes(512) == "512 B"
 
 

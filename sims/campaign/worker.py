@@ -181,6 +181,7 @@ def _watchdog(limit_s: float):
 def _simulate(scenario, context, params, plant, plugin_specs, row, meta) -> dict:
     """One run in MuJoCo (``sims.pipeline.execute``); its row filled in, its files returned."""
     from sims import outputs, pipeline, supervise
+    from sims.logfile import LOG_FILE
 
     start = time.perf_counter()
     board = supervise.in_worker()
@@ -204,7 +205,13 @@ def _simulate(scenario, context, params, plant, plugin_specs, row, meta) -> dict
                                              on_built=follow_duration,
                                              on_judged=lambda _: signal.setitimer(signal.ITIMER_REAL, 0))
             if out is not None:
-                files = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file() and p.name != outputs.MANIFEST}
+                # A campaign keeps a run's summary, timeseries, report and video, not its log
+                # (the per-tick state: timeseries.npz has it at the rate saved).
+                files = {p.name: p.read_bytes() for p in out.iterdir()
+                         if p.is_file() and p.name not in (outputs.MANIFEST, LOG_FILE)}
+                summary = json.loads(files["summary.json"])
+                if summary.pop("log", None) is not None:
+                    files["summary.json"] = (json.dumps(summary, indent=2) + "\n").encode()
             else:
                 files = {"summary.json": (json.dumps(outputs.summary_dict(result), indent=2) + "\n").encode()}
     except RunTimeout:

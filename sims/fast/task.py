@@ -243,88 +243,146 @@ class FastEvaluation:
     plan's unstretched lengths are computed (default the plant's: the nominal plant)."""
 
     def __init__(self, physics: FastPhysics, problem: fp.FastProblem, loads: CableLoads, description: dict,
-                 planned_tower_tops: np.ndarray | None = None, sensors=None):
+                 planned_tower_tops: np.ndarray | None = None, sensors=None, stride: int = 1):
         self.physics, self.problem, self.loads = physics, problem, loads
         self.sensors = sensors  # the fused system's estimates are judged against the truth
         self.planned_tower_tops = planned_tower_tops
         self.goal = problem.goal
         self.description = description
-        self._series = (None, None)  # (log, its series): checks, timeseries and report share it
+        self.stride = stride  # timeseries and report: every stride-th tick (Output.output_stride)
+        self._summary = (None, None)  # (log, its summary): checks, timeseries and report share it
 
-    def series(self, log: RunLog) -> dict:
-        """The quantities of the checks, SI, one row per logged tick (computed once per log)."""
-        if self._series[0] is not log:
-            self._series = (log, self._compute_series(log))
-        return self._series[1]
+    def summary(self, log: RunLog) -> dict:
+        """What the checks, the timeseries and the report need, computed once per log, one
+        chunk of the log at a time (``_reduce``)."""
+        if self._summary[0] is not log:
+            self._summary = (log, self._reduce(log))
+        return self._summary[1]
 
-    def _compute_series(self, log: RunLog) -> dict:
-        """The goal (``problem.goal``'s feed and segments at the logged times), the returned
-        trajectory (``log.reference``, and the cabin pose and tensions that go with it) and the
-        run (its sensors, actuators and the plant's catenary tensions)."""
+    def _rows_series(self, rows: dict, reference, start: int, n: int) -> dict:
+        """The series of the checks for the log's rows ``start`` on (``rows``: their t,
+        sensordata, qpos, qvel, act, ctrl, actuator_force; ``reference``: the reference at
+        them) of a log of ``n`` rows: the goal (``problem.goal``'s feed and segments), the
+        returned trajectory (the reference, and the cabin pose and tensions that go with it)
+        and the run (its sensors, actuators and the plant's catenary tensions)."""
         p = self.physics
-        state = fp.reference_state(log.reference)  # what the returned trajectory asks of the cabin
-        segment, goal_feed, _, _ = self.goal.feed(log.t)
-        feed = log.sensordata[:, p.sensor_block("feed_pos")]
-        cabin = log.sensordata[:, p.sensor_block("cabin_pos")]
-        legs = log.qpos[:, p.leg_qpos]
+        m = rows["t"].shape[0]
+        state = fp.reference_state(reference)  # what the returned trajectory asks of the cabin
+        segment, goal_feed, _, _ = self.goal.feed(rows["t"])
+        feed = rows["sensordata"][:, p.sensor_block("feed_pos")]
+        cabin = rows["sensordata"][:, p.sensor_block("cabin_pos")]
+        legs = rows["qpos"][:, p.leg_qpos]
         kp, kv = p.drive_gains(p.leg_ids)
         # The plan's unstretched lengths on the nominal geometry (what the winch feed-forward
         # commands; the plant's tower tops may differ).
         towers = p.tower_tops if self.planned_tower_tops is None else self.planned_tower_tops
         unstretched = winch_feedforward(state, towers)
+        law = self.loads.tension_log[start:start + m].copy()
+        if start + m == n:  # the runner applies no loads after its last tick: the last one held
+            law[m - 1] = self.loads.tension_log[max(n - 2, 0)]
         return {
             "feed_goal": goal_feed,
-            "feed_planned": log.reference.position[:, :3],
+            "feed_planned": reference.position[:, :3],
             "feed_actual": feed,
             "feed_error": np.linalg.norm(feed - goal_feed, axis=1),
             "cabin_planned": state.cabin_origin,
             "cabin_actual": cabin,
             "cabin_error": np.linalg.norm(cabin - state.cabin_origin, axis=1),
-            "cable_tension": -log.actuator_force[:, p.cable_ids],
-            "cable_tension_law": _hold_last(self.loads.tension_log, log.t.size),
+            "cable_tension": -rows["actuator_force"][:, p.cable_ids],
+            "cable_tension_law": law,
             "cable_tension_planned": state.tension,
-            "cable_length": log.sensordata[:, p.sensor_columns([f"cable{i}_length" for i in range(1, 7)])],
-            "cable_unstretched": log.ctrl[:, p.cable_ids],
+            "cable_length": rows["sensordata"][:, p.sensor_columns([f"cable{i}_length" for i in range(1, 7)])],
+            "cable_unstretched": rows["ctrl"][:, p.cable_ids],
             "cable_unstretched_planned": unstretched,
             "ab_planned": np.column_stack([state.theta_a, state.theta_b]),
-            "ab_actual": log.qpos[:, p.ab_qpos],
+            "ab_actual": rows["qpos"][:, p.ab_qpos],
             "stewart_leg": legs,
-            "stewart_setpoint": log.act[:, p.leg_act],
-            "stewart_force_demanded": demanded_force(kp, kv, log.act[:, p.leg_act], legs, log.qvel[:, p.leg_dofs]),
+            "stewart_setpoint": rows["act"][:, p.leg_act],
+            "stewart_force_demanded": demanded_force(kp, kv, rows["act"][:, p.leg_act], legs,
+                                                     rows["qvel"][:, p.leg_dofs]),
             "segment": segment,
             "observing": observing_mask(self.goal, segment),
         }
 
+    def _reduce(self, log: RunLog) -> dict:
+        """One pass over the log's chunks: the per-tick errors, segments and observing flags
+        whole (one number a tick), the extremes of the wide series (tensions, legs, forces,
+        angles; max and min, exact in any order), and every ``stride``-th row of each series
+        (the timeseries and the report)."""
+        n = log.n
+        r = log.reference
+        scalars = {"feed_error": [], "cabin_error": [], "segment": [], "observing": []}
+        rows_kept = {}
+        ext = {}
+
+        def extreme(key, value, where, better):
+            if key not in ext or better(value, ext[key][0]):
+                ext[key] = (value, where)
+
+        for start, rows in log.chunks(("t", "sensordata", "qpos", "qvel", "act", "ctrl", "actuator_force")):
+            m = rows["t"].shape[0]
+            reference = type(r)(r.t[start:start + m], r.position[start:start + m], r.velocity[start:start + m],
+                                r.acceleration[start:start + m])
+            s = self._rows_series(rows, reference, start, n)
+            for key in scalars:
+                scalars[key].append(s[key])
+            for key, value in s.items():
+                # (a copy: a view would keep the whole chunk it was read with)
+                rows_kept.setdefault(key, []).append(value[-start % self.stride::self.stride].copy())
+            tension, law = s["cable_tension"], s["cable_tension_law"]
+            low = np.unravel_index(np.argmin(tension), tension.shape)
+            high = np.unravel_index(np.argmax(law), law.shape)
+            extreme("tension_min", tension[low], (start + low[0], low[1]), lambda a, b: a < b)
+            extreme("tension_max", tension.max(), None, lambda a, b: a > b)
+            extreme("law_max", law[high], (start + high[0], high[1]), lambda a, b: a > b)
+            extreme("planned_min", s["cable_tension_planned"].min(), None, lambda a, b: a < b)
+            extreme("planned_max", s["cable_tension_planned"].max(), None, lambda a, b: a > b)
+            extreme("leg_abs", np.abs(s["stewart_leg"]).max(initial=0.0), None, lambda a, b: a > b)
+            extreme("setpoint_abs", np.abs(s["stewart_setpoint"]).max(initial=0.0), None, lambda a, b: a > b)
+            extreme("force_abs", np.abs(s["stewart_force_demanded"]).max(), None, lambda a, b: a > b)
+            extreme("feedback_abs", np.abs(s["cable_unstretched"] - s["cable_unstretched_planned"]).max(), None,
+                    lambda a, b: a > b)
+            ab = np.abs(s["ab_actual"] - s["ab_planned"]).max(axis=0)
+            ext["ab_abs"] = (ab if "ab_abs" not in ext else np.maximum(ext["ab_abs"][0], ab), None)
+        out = {key: np.concatenate(parts) for key, parts in scalars.items()}
+        out["extremes"] = {key: value for key, value in ext.items()}
+        out["every"] = {key: np.concatenate(parts) for key, parts in rows_kept.items()}
+        out["t_every"] = log.every("t", self.stride)
+        return out
+
     def evaluate(self, log: RunLog):
         p = self.physics
-        s = self.series(log)
-        n = log.t.size
+        s = self.summary(log)
+        ext = s["extremes"]
+        n = log.n
         observing = s["observing"]
         window = observing if observing.any() else np.ones(n, bool)
         where = ("over the observing segments" if observing.any()
                  else "no observing segment in this run: over the whole run")
         feed_mm, cabin_mm = 1e3 * s["feed_error"], 1e3 * s["cabin_error"]
-        tension = s["cable_tension"]
         t_min = fast.FAST_LIMITS.tension_min
-        low = np.unravel_index(np.argmin(tension), tension.shape)
-        high = np.unravel_index(np.argmax(s["cable_tension_law"]), tension.shape)
-        stroke = np.maximum(np.abs(s["stewart_leg"]).max(initial=0.0), np.abs(s["stewart_setpoint"]).max(initial=0.0))
-        force = np.abs(s["stewart_force_demanded"])
+        tension_min, low = ext["tension_min"]
+        law_max, high = ext["law_max"]
+        stroke = np.maximum(ext["leg_abs"][0], ext["setpoint_abs"][0])
         force_limit = float(p.force_limit(p.leg_ids).min())
         stewart = self.description.get("stewart")
+
+        def time_of(row: int) -> float:
+            return float(log.t[row])
+
         checks = [
             Check("feed_error_rms", _rms(feed_mm[window]), FEED_RMS_LIMIT_MM, "mm",
                   note=(f"Stewart {stewart}; " if stewart else "") + f"against the goal feed path; {where}"),
             Check("feed_error_max", float(feed_mm[window].max()), FEED_MAX_LIMIT_MM, "mm", note=where),
             Check("cabin_error_rms", _rms(cabin_mm[window]), CABIN_RMS_LIMIT_MM, "mm",
                   note=f"cabin origin; {where}"),
-            Check("cable_tension_min", float(tension.min()) / 1e3, t_min / 1e3, "kN", ">=",
-                  note=f"cable{low[1] + 1} at t = {log.t[low[0]]:.2f} s; a slack cable fails"),
-            Check("cable_tension_max", float(s["cable_tension_law"].max()) / 1e3, p.tension_max / 1e3, "kN",
-                  note=f"cable{high[1] + 1} at t = {log.t[high[0]]:.2f} s (catenary law, before the winch's clamp)"),
+            Check("cable_tension_min", float(tension_min) / 1e3, t_min / 1e3, "kN", ">=",
+                  note=f"cable{low[1] + 1} at t = {time_of(low[0]):.2f} s; a slack cable fails"),
+            Check("cable_tension_max", float(law_max) / 1e3, p.tension_max / 1e3, "kN",
+                  note=f"cable{high[1] + 1} at t = {time_of(high[0]):.2f} s (catenary law, before the winch's clamp)"),
             Check("stewart_stroke", 1e3 * float(stroke), 1e3 * fast.STEWART.stroke, "mm",
                   note="largest leg change, measured or its drive's set-point"),
-            Check("stewart_force", float(force.max()) / 1e3, force_limit / 1e3, "kN", note="demanded"),
+            Check("stewart_force", float(ext["force_abs"][0]) / 1e3, force_limit / 1e3, "kN", note="demanded"),
         ]
         segments = {}
         for k, seg in enumerate(self.goal.segments):
@@ -333,7 +391,7 @@ class FastEvaluation:
                 segments[seg.name] = segments.get(seg.name, []) + [{
                     "t0_s": seg.t0, "feed_error_rms_mm": _rms(feed_mm[mask]),
                     "feed_error_max_mm": float(feed_mm[mask].max()), "cabin_error_rms_mm": _rms(cabin_mm[mask])}]
-        ab_error = np.degrees(np.abs(s["ab_actual"] - s["ab_planned"]).max(axis=0)) * 3600.0
+        ab_error = np.degrees(ext["ab_abs"][0]) * 3600.0
         metrics = dict(self.description)
         metrics.update({
             "cables": (f"{p.cable_segments} segments each" if p.cable_segments
@@ -343,18 +401,19 @@ class FastEvaluation:
             "feed_error_rms_all_mm": _rms(feed_mm),
             "feed_error_max_all_mm": float(feed_mm.max()),
             "cabin_error_max_mm": float(cabin_mm[window].max()),
-            "observing_s": float(observing.sum() * (log.t[1] - log.t[0])) if log.t.size > 1 else 0.0,
+            "observing_s": float(observing.sum() * (log.t[1] - log.t[0])) if n > 1 else 0.0,
             "segments": segments,
-            "cable_tension_range_kN": [float(tension.min()) / 1e3, float(tension.max()) / 1e3],
-            "planned_tension_range_kN": [float(s["cable_tension_planned"].min()) / 1e3,
-                                         float(s["cable_tension_planned"].max()) / 1e3],
+            "cable_tension_range_kN": [float(tension_min) / 1e3, float(ext["tension_max"][0]) / 1e3],
+            "planned_tension_range_kN": [float(ext["planned_min"][0]) / 1e3, float(ext["planned_max"][0]) / 1e3],
             # The winch commands less the unstretched lengths the plan implies: the feedback.
-            "cable_feedback_max_mm": 1e3 * float(np.abs(s["cable_unstretched"] - s["cable_unstretched_planned"]).max()),
+            "cable_feedback_max_mm": 1e3 * float(ext["feedback_abs"][0]),
             "ab_error_max_arcsec": ab_error.round(2).tolist(),
-            "stewart_leg_max_mm": 1e3 * float(np.abs(s["stewart_leg"]).max()),
+            "stewart_leg_max_mm": 1e3 * float(ext["leg_abs"][0]),
         })
-        if isinstance(self.sensors, FusedSensors):
-            metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, log.qpos)
+        if isinstance(self.sensors, FusedSensors):  # (qpos read whole for this, then let go)
+            qpos = log.file.column("qpos") if log.file is not None and not log.held("qpos") else log.qpos
+            metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, qpos)
+            del qpos
         if self.loads.mean_speed > 0:
             wind = self.loads.speed[:n]
             metrics.update({"wind_speed_std_m_s": float(np.std(wind)),
@@ -362,8 +421,9 @@ class FastEvaluation:
         return checks, metrics
 
     def timeseries(self, log: RunLog) -> dict:
-        s = self.series(log)
-        n = log.t.size
+        """The series at every ``stride``-th tick (every tick for a run written whole)."""
+        s = self.summary(log)["every"]
+        n = log.n
         out = {
             "cable_names": np.array(fast.CABLE_LABELS),
             "feed_pos_planned": s["feed_planned"],
@@ -384,14 +444,15 @@ class FastEvaluation:
             "observing": s["observing"],
         }
         if self.loads.mean_speed > 0:
-            out["wind_speed"] = self.loads.speed[:n]
-            out["wind_force"] = _hold_last(self.loads.force, n)
+            out["wind_speed"] = self.loads.speed[:n][::self.stride]
+            out["wind_force"] = _hold_last(self.loads.force, n)[::self.stride]
         return out
 
     def report(self, log: RunLog, checks, path) -> None:
         from sims.fast.report import fast_report
 
-        fast_report(self.timeseries(log), log.t, checks, path, fast.FAST_LIMITS.tension_min)
+        fast_report(self.timeseries(log), self.summary(log)["t_every"], checks, path,
+                    fast.FAST_LIMITS.tension_min)
 
 
 def problem(plan: fp.FastPlan) -> fp.FastProblem:
@@ -458,12 +519,13 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     else:
         loads = (ChainCableLoads if segments else CableLoads)(**wind)
     sensors = make_sensors(physics, params.sensors if sensor_options is None else sensor_options, control_dt)
+    stride = output_stride(control_dt) if duration > LONG_RUN_S else 1
     evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops,
-                                sensors=sensors)
+                                sensors=sensors, stride=stride)
     task = Task(problem=session, sensors=sensors, evaluation=evaluation, control_dt=control_dt, duration=duration,
                 disturbance=loads, nominal_physics=nominal_copy(nominal) if perturbed else None)  # None: a copy
     return Setup(physics, task, Components(planner=planner, trajectory=trajectory, controller=controller),
-                 Output(output_stride=output_stride(control_dt) if duration > LONG_RUN_S else 1),
+                 Output(output_stride=stride),
                  Provenance(seed=params.seed, params=params, plant=plant if plant is not None else FastPlant()))
 
 
