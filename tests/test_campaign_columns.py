@@ -172,15 +172,26 @@ def test_which_campaigns_take_the_columnar_path(tmp_path):
     assert not campaign.columnar(spec_of('planner = "planners.hexapod:PaperMovePlanner"'))
 
 
+@pytest.fixture(scope="module")
+def per_run_campaign(tmp_path_factory):
+    """(spec, table) of a 200-run planner-only campaign run run by run (the columns off),
+    shared by the chunk sizes below."""
+    tmp = tmp_path_factory.mktemp("per-run")
+    spec = _spec(tmp, 21, 50, 2, [(k, *_bounds(k)) for k in AXES[:3] + AXES[6:9]], ("true", "false"), None)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(campaign, "columnar", lambda spec: False)
+        runs = campaign.sweep(spec.path, tmp / "runs", workers=1, quiet=True)
+    return spec, runs.table
+
+
 @pytest.mark.parametrize("chunk", [1, 7, 64])
-def test_a_columnar_campaign_writes_the_per_run_table(tmp_path, monkeypatch, chunk):
-    spec = _spec(tmp_path, 21, 50, 2, [(k, *_bounds(k)) for k in AXES[:3] + AXES[6:9]], ("true", "false"), None)
+def test_a_columnar_campaign_writes_the_per_run_table(tmp_path, monkeypatch, chunk, per_run_campaign):
+    spec, per_run = per_run_campaign
     monkeypatch.setattr(campaign, "PLAN_CHUNK", chunk)
+    assert campaign.columnar(spec)
     columns = campaign.sweep(spec.path, tmp_path / "columns", workers=1, quiet=True)
-    monkeypatch.setattr(campaign, "columnar", lambda spec: False)
-    runs = campaign.sweep(spec.path, tmp_path / "runs", workers=1, quiet=True)
     assert columns.table.num_rows == spec.size == 200
-    _same(columns.table, runs.table)
+    _same(columns.table, per_run)
     parts = sorted((tmp_path / "columns" / "table").glob("part-*.parquet"))
     assert len(parts) == -(-spec.size // chunk)
     assert sum(pq.read_metadata(p).num_rows for p in parts) == spec.size
