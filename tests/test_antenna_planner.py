@@ -493,7 +493,9 @@ def test_scalar_crr_follows_the_paper_path(omega_method, limited):
                                         omega_method=omega_method)
         np.testing.assert_allclose(new, path.theta[i + 1], rtol=0, atol=1e-14)
         iterations.append(info.iterations)
-    assert np.mean(np.array(iterations) == path.iterations[1:]) > 0.99
+    # The Newton stop rule (a step under 1e-15 rad) sits at round-off: the two paths may stop
+    # one iteration apart, never more (their angles agree to 1e-14 above).
+    assert np.abs(np.array(iterations) - path.iterations[1:]).max() <= 1
     planner = ant.CrrPlanner(omega_method=omega_method)
     problem = ant.AntennaProblem(attitudes[0], 0.0, 0.0, 0.0, theta0,
                                  limits if limits is not None else ant.AntennaLimits(), update_dt=ant.PAPER_DT)

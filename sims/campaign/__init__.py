@@ -5,7 +5,7 @@
      unless ``invalid = "skip"``, every run's parameters, before any run starts;
   2. open DIR (sims.campaign.store): new, or the same spec resumed (finished runs skipped);
   3. send chunks of runs to the engine (sims.campaign.engines: a spawned process pool, started
-     as the campaign begins, or Ray), and write each finished chunk's rows (one part file of
+     once the spec and the options hold, or Ray), and write each finished chunk's rows (one part file of
      the results table) and its runs' summaries as they come, under a tqdm bar of runs done,
      failures and time left; a planner-only campaign whose scenario judges columns sends its
      chunks as arrays (``worker.ColumnTask``) and gets Arrow tables back;
@@ -150,28 +150,26 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
     from sims.params import ParamError
 
     start = time.perf_counter()
-    # A local pool's workers start now, while the spec is read and checked; a campaign that
-    # stops before its runs (a bad spec, a held directory) ends them (``close``).
-    early = engines.started_early(engine, workers, address)
-    try:
-        return _sweep(spec_path, out, engine, workers, address, rerun_worst, quiet, echo, early, start)
-    finally:
-        if early is not None:
-            early.close()
-
-
-def _sweep(spec_path, out, engine, workers, address, rerun_worst, quiet, echo, early, campaign_start) -> Outcome:
-    from sims.params import ParamError
-
     spec = spec_module.load(spec_path)
     target = store_module.CampaignDir(out)
     runner_engine = engines.make(engine, workers, address)
-    if early is not None:
-        runner_engine = early
     if rerun_worst < 0:
         raise ParamError(f"--rerun-worst {rerun_worst} must be >= 0")
     if rerun_worst and spec.mode == "plan":
         raise ParamError("--rerun-worst replays simulated runs; a planner-only campaign has none")
+    # The spec and the options hold: a local pool's workers start now (they import planbench
+    # and MuJoCo while the runs' parameters and the plug-ins are checked and the directory is
+    # opened); a campaign that stops before its runs ends them (``close``).
+    if isinstance(runner_engine, engines.LocalEngine):
+        runner_engine.start()
+    try:
+        return _sweep(spec, target, runner_engine, rerun_worst, quiet, echo, start)
+    finally:
+        if isinstance(runner_engine, engines.LocalEngine):
+            runner_engine.close()
+
+
+def _sweep(spec, target, runner_engine, rerun_worst, quiet, echo, campaign_start) -> Outcome:
     if spec.invalid == "refuse":
         check_runs(spec, spec.iter_runs(), quiet, spec.size)
     check_plugins(spec)

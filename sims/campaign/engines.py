@@ -358,16 +358,6 @@ def ray_available() -> bool:
     return importlib.util.find_spec("ray") is not None
 
 
-def started_early(engine: str, workers: int | None, address: str | None):
-    """A started LocalEngine (``LocalEngine.start``) when the options name a valid local
-    engine, else None (``make`` refuses bad options, after the spec's own checks)."""
-    if engine != "local" or address or (workers is not None and not 1 <= workers <= 4096):
-        return None
-    local = LocalEngine(workers)
-    local.start()
-    return local
-
-
 def make(engine: str, workers: int | None, address: str | None):
     from sims.params import ParamError
 

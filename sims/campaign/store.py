@@ -66,6 +66,7 @@ class CampaignDir(outputs._Target):
 
     def __init__(self, raw, option: str = "--out"):
         super().__init__(raw, option)
+        self._checks: dict = {}  # checks.json as last written by this process
         path = self.path
         real = Path(os.path.realpath(path))
         cwd = Path(os.path.realpath(os.getcwd()))
@@ -86,7 +87,6 @@ class CampaignDir(outputs._Target):
             if not os.access(path, os.W_OK | os.X_OK):
                 raise OutputError(f"{self.what} {path} is not writable")
 
-    _checks: dict = {}  # checks.json as last written by this process
 
     @property
     def table_dir(self) -> Path:

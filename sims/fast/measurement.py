@@ -142,14 +142,25 @@ def encoder_specs(rate_hz: float) -> list[SensorSpec]:
             SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate_hz)]
 
 
-def read_encoders(physics, data, obs: dict) -> None:
-    """Write the encoders' readings (``encoder_specs``) into ``obs``: the A-B angles and the B
-    frame's rotation in the cabin frame that they give, the legs' lengths and set-points."""
-    obs["ab_angles"][:] = data.qpos[physics.ab_qpos]  # (fancy indexing: a fifth of np.take's cost)
-    obs["leg_positions"][:] = data.qpos[physics.leg_qpos]
-    obs["leg_setpoints"][:] = data.act[physics.leg_act]
-    np.matmul(data.xmat[physics.cabin_body].reshape(3, 3).T, data.xmat[physics.ab_b_body].reshape(3, 3),
-              out=obs["ab_rotation"])
+class Encoders:
+    """The encoders' readings (``encoder_specs``) written into an observation every tick: the
+    A-B angles and the B frame's rotation in the cabin frame that they give, the legs' lengths
+    and set-points. The places are looked up once, as views where the indices step evenly
+    (``index_view``)."""
+
+    def __init__(self, physics, obs: dict):
+        self._data = physics.data.ptr
+        self._reads = ((obs["ab_angles"], "qpos", index_view(physics.ab_qpos)),
+                       (obs["leg_positions"], "qpos", index_view(physics.leg_qpos)),
+                       (obs["leg_setpoints"], "act", index_view(physics.leg_act)))
+        self._cabin, self._ab_b, self._ab_rotation = physics.cabin_body, physics.ab_b_body, obs["ab_rotation"]
+
+    def __call__(self) -> None:
+        data = self._data
+        for out, buffer, index in self._reads:
+            out[:] = getattr(data, buffer)[index]
+        xmat = data.xmat
+        np.matmul(xmat[self._cabin].reshape(3, 3).T, xmat[self._ab_b].reshape(3, 3), out=self._ab_rotation)
 
 
 class IdealSensors(Sensors):
@@ -205,7 +216,6 @@ class IdealSensors(Sensors):
                            np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
         self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
                               np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
-        self._physics = physics
         self.observation = obs = {
             "cabin_pose_ts_position": np.zeros(3), "cabin_pose_ts_rotation": np.eye(3),
             "cabin_pose_ts_time": np.zeros(1), "cabin_pose_ts_count": np.zeros(1, dtype=int),
@@ -213,6 +223,7 @@ class IdealSensors(Sensors):
             "ab_angles": np.zeros(2), "ab_rotation": np.eye(3), "leg_positions": np.zeros(6),
             "leg_setpoints": np.zeros(6),
         }
+        self._encoders = Encoders(physics, obs)
         self(0, physics)
         return obs
 
@@ -235,7 +246,7 @@ class IdealSensors(Sensors):
         j = self._measured(tick, self.stewart_lag, self.stewart_noise, obs["cabin_pose_position"],
                            obs["cabin_pose_rotation"])
         obs["cabin_pose_time"][0] = j * self.dt
-        read_encoders(self._physics, data, obs)
+        self._encoders()
 
 
 
@@ -326,6 +337,11 @@ def point_pose_noise(points: np.ndarray, sigma: float) -> float:
     return float(sigma * math.sqrt(np.linalg.eigvalsh(inverse_point_inertia(points)).max()))
 
 
+def _as_array(name: str, doc: str, shape: tuple = (3,)) -> property:
+    """A read-only property: the per-body float lists ``name`` as an array (B, *shape)."""
+    return property(lambda self: np.array(getattr(self, name)).reshape(-1, *shape), doc=doc)
+
+
 class FusedPoses:
     """Kalman filters of several bodies' poses (one each, batched), IMU-propagated and
     corrected by delayed point fixes.
@@ -385,30 +401,12 @@ class FusedPoses:
         self._samples = [deque() for _ in self.points]
         self.tick = 0
 
-    @property
-    def position(self) -> np.ndarray:
-        """(B, 3) the IMUs' estimated positions, world, m."""
-        return np.array(self._position)
-
-    @property
-    def velocity(self) -> np.ndarray:
-        """(B, 3) their velocities, world, m/s."""
-        return np.array(self._velocity)
-
-    @property
-    def rotation(self) -> np.ndarray:
-        """(B, 3, 3) the bodies' estimated rotations, world."""
-        return np.array(self._rotation).reshape(-1, 3, 3)
-
-    @property
-    def accel_bias(self) -> np.ndarray:
-        """(B, 3) the accelerometers' estimated biases, IMU frame, m/s^2."""
-        return np.array(self._accel_bias)
-
-    @property
-    def gyro_bias(self) -> np.ndarray:
-        """(B, 3) the gyros' estimated biases, IMU frame, rad/s."""
-        return np.array(self._gyro_bias)
+    # The estimates as arrays, from the per-body lists the filters keep (module doc).
+    position = _as_array("_position", "(B, 3) the IMUs' estimated positions, world, m.")
+    velocity = _as_array("_velocity", "(B, 3) their velocities, world, m/s.")
+    rotation = _as_array("_rotation", "(B, 3, 3) the bodies' estimated rotations, world.", (3, 3))
+    accel_bias = _as_array("_accel_bias", "(B, 3) the accelerometers' estimated biases, IMU frame, m/s^2.")
+    gyro_bias = _as_array("_gyro_bias", "(B, 3) the gyros' estimated biases, IMU frame, rad/s.")
 
     def propagate(self, specific_force, rate) -> None:
         """One tick of strapdown navigation of every body from its IMU's readings (B, 3), its
@@ -626,7 +624,6 @@ class FusedSensors(Sensors):
         self._last_velocity = np.zeros((2, 3))
         self.pending = {b: deque() for b in self.BODIES}  # (arrival tick, points (3, 3), taken at tick)
         self.estimate_log = np.zeros((n, 2, 12))  # per tick: position (3) and rotation (9) of each body
-        self._physics = physics
         obs = {}
         # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
         self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
@@ -661,9 +658,7 @@ class FusedSensors(Sensors):
             self._fixes.append((self.fix_every[b], self.fix_lag[b], index_view(self.point_sites[b]),
                                 self.fix_error[b], self.pending[b], obs[f"{key}_points"], obs[f"{key}_time"],
                                 obs[f"{key}_count"]))
-        self._encoders = (obs["ab_angles"], index_view(physics.ab_qpos), obs["leg_positions"],
-                          index_view(physics.leg_qpos), obs["leg_setpoints"], index_view(physics.leg_act),
-                          physics.cabin_body, physics.ab_b_body, obs["ab_rotation"])
+        self._encoders = Encoders(physics, obs)
         self._rotation_rows = self._rotation.reshape(2, 9)
         self._accel_flat, self._gyro_flat = self._accel.reshape(6), self._gyro.reshape(6)
         self._velocity_flat = self._velocity.reshape(6)
@@ -721,12 +716,7 @@ class FusedSensors(Sensors):
         cabin, platform = f._velocity
         self._velocity_flat[:] = cabin + platform
         self._time[0] = tick * dt
-        ab_angles, ab_qpos, legs, leg_qpos, setpoints, leg_act, cabin, ab_b, ab_rotation = self._encoders
-        qpos, xmat = data.qpos, data.xmat
-        ab_angles[:] = qpos[ab_qpos]
-        legs[:] = qpos[leg_qpos]
-        setpoints[:] = data.act[leg_act]
-        np.matmul(xmat[cabin].reshape(3, 3).T, xmat[ab_b].reshape(3, 3), out=ab_rotation)
+        self._encoders()
 
 
 def _ticks(seconds: float, dt: float, least: int) -> int:

@@ -33,9 +33,9 @@ DEFAULT_WIND_M_S = 5.0
 
 
 def pose_si(pose_mm_deg) -> np.ndarray:
-    """A pose in the parameters' units (x, y, z mm; rx, ry, rz deg) in m and rad."""
+    """Poses (..., 6) in the parameters' units (x, y, z mm; rx, ry, rz deg) in m and rad."""
     pose = np.asarray(pose_mm_deg, dtype=float)
-    return np.concatenate([pose[:3] / 1000.0, np.radians(pose[3:])])
+    return np.concatenate([pose[..., :3] / 1000.0, np.radians(pose[..., 3:])], axis=-1)
 
 
 def pose_mm_deg(pose_si) -> tuple:

@@ -21,7 +21,7 @@ import numpy as np
 from planners import hexapod as hexapod_planner
 from planners.hexapod import RUBIN_LIMITS, STRUT_LABELS
 from sims.hexapod import plan_checks
-from sims.hexapod.params import HexapodMove, HexapodParams
+from sims.hexapod.params import HexapodMove, HexapodParams, pose_si
 from sims.hexapod.task import ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM
 from sims.params import _bound
 
@@ -40,11 +40,6 @@ def supports(base: HexapodParams, paths) -> bool:
                 continue
         return False
     return True
-
-
-def _si(pose_mm_deg: np.ndarray) -> np.ndarray:
-    """``sims.hexapod.params.pose_si`` of (..., 6) poses, elementwise the same."""
-    return np.concatenate([pose_mm_deg[..., :3] / 1000.0, np.radians(pose_mm_deg[..., 3:])], axis=-1)
 
 
 def _outside_range(values: np.ndarray, declared) -> np.ndarray:
@@ -98,7 +93,7 @@ def validate(base: HexapodParams, paths, values, n: int):
     """
     start_mm, targets_mm, synchronous = poses_of(base, paths, values, n)
     moves = targets_mm.shape[1]
-    start, targets = _si(start_mm), _si(targets_mm)
+    start, targets = pose_si(start_mm), pose_si(targets_mm)
     unsure = _outside_range(start_mm, HexapodParams.__dataclass_fields__["start_pose"].metadata["declared"])
     target_declared = HexapodMove.__dataclass_fields__["target"].metadata["declared"]
     for k in range(moves):
