@@ -44,6 +44,38 @@ def leg_vectors(anchors: np.ndarray, points: np.ndarray, position: np.ndarray,
     return position[..., None, :] + moved - anchors
 
 
+def leg_vector_components(anchors: np.ndarray, points: np.ndarray, position: np.ndarray,
+                          rotation: np.ndarray) -> tuple[tuple, tuple]:
+    """``leg_vectors`` of M poses as components: ((l_x, l_y, l_z), (R b_x, R b_y, R b_z)),
+    each (M, n), m.
+
+    The same numbers as ``leg_vectors``, bit for bit: R b_i is summed in the order einsum
+    sums it, (R_j0 b_i0 + R_j2 b_i2) + R_j1 b_i1, and l = (p + R b) - a. Each component is a
+    contiguous (M, n) array, which spares the (M, n, 3) array's strided gathers where a caller
+    works on components (the hexapod's batched kinematics: several times faster).
+
+    Args:
+      anchors: (n, 3) fixed anchors a_i, m.
+      points: (n, 3) attachment points b_i in the moving body's frame, m.
+      position: (M, 3) positions p of the moving frame's origin, m.
+      rotation: (M, 3, 3) orientations R.
+    """
+    anchors = np.asarray(anchors, dtype=float)
+    points = np.asarray(points, dtype=float)
+    position = np.asarray(position, dtype=float)
+    rotation = np.asarray(rotation, dtype=float)
+    arms = tuple((rotation[:, j, 0, None] * points[:, 0] + rotation[:, j, 2, None] * points[:, 2])
+                 + rotation[:, j, 1, None] * points[:, 1] for j in range(3))
+    vectors = tuple((position[:, j, None] + arms[j]) - anchors[:, j] for j in range(3))
+    return vectors, arms
+
+
+def component_norm(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """|(x, y, z)| of component arrays, summed as ``np.linalg.norm`` sums a 3-vector (bit for
+    bit)."""
+    return np.sqrt((x * x + y * y) + z * z)
+
+
 def leg_lengths(anchors, points, position, rotation) -> np.ndarray:
     """(..., n) leg lengths |p + R b_i - a_i|, m."""
     return np.linalg.norm(leg_vectors(anchors, points, position, rotation), axis=-1)

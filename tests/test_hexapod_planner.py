@@ -19,6 +19,7 @@ from planners.hexapod import (
     RUBIN_LIMITS,
     KinematicsError,
     forward_kinematics,
+    euler_rate_matrix,
     hexapod_space_min_time,
     jacobian,
     long_move_closed_form,
@@ -34,7 +35,7 @@ from planners.hexapod import (
     strut_min_time,
     strut_positions,
 )
-from planners.legs import structure_matrix
+from planners.legs import component_norm, leg_vector_components, leg_vectors, structure_matrix
 
 UM = 1e-6
 DT = CONTROL_DT
@@ -239,6 +240,33 @@ def test_jacobian_is_finite_differences():
     stacked = jacobian(batch)
     for k in range(7):
         np.testing.assert_allclose(stacked[k], jacobian(batch[k]), atol=1e-15)
+
+
+def _jacobian_as_arrays(pose):
+    """``jacobian``'s formula on (..., 6, 3) arrays and einsum (the reference form of its
+    component arithmetic)."""
+    position, rotation = RUBIN_CAMERA.rotation_pivot + pose[..., :3], rotation_matrix(pose[..., 3:])
+    vectors = leg_vectors(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local, position, rotation)
+    units = vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+    arms = np.einsum("...jk,nk->...nj", rotation, RUBIN_CAMERA.platform_local)
+    angular = np.einsum("...nj,...jk->...nk", np.cross(arms, units), euler_rate_matrix(pose[..., 3:]))
+    return np.concatenate([units, angular], axis=-1)
+
+
+@given(st.lists(poses(), min_size=1, max_size=5), st.floats(1.0, 1e4))
+def test_components_are_the_array_form_bit_for_bit(pose_list, scale):
+    """The kinematics on components (``leg_vector_components``, ``jacobian``) gives the numbers
+    of the (..., 6, 3) array form, bit for bit, in and far outside the pose limits."""
+    batch = np.array(pose_list) * np.array([scale, scale, scale, 1.0, 1.0, 1.0])
+    position, rotation = RUBIN_CAMERA.rotation_pivot + batch[:, :3], rotation_matrix(batch[:, 3:])
+    arrays = leg_vectors(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local, position, rotation)
+    vectors, arms = leg_vector_components(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local, position, rotation)
+    np.testing.assert_array_equal(np.stack(vectors, axis=-1), arrays)
+    np.testing.assert_array_equal(np.stack(arms, axis=-1),
+                                  np.einsum("...jk,nk->...nj", rotation, RUBIN_CAMERA.platform_local))
+    np.testing.assert_array_equal(component_norm(*vectors), np.linalg.norm(arrays, axis=-1))
+    np.testing.assert_array_equal(jacobian(batch), _jacobian_as_arrays(batch))
+    np.testing.assert_array_equal(jacobian(batch[0]), _jacobian_as_arrays(batch[0]))
 
 
 def test_ik_independent_formula():

@@ -46,7 +46,7 @@ from typing import Sequence
 import numpy as np
 
 from planners.errors import LimitError, PlanningError
-from planners.legs import leg_forces, leg_lengths, leg_vectors, structure_matrix
+from planners.legs import component_norm, leg_forces, leg_lengths, leg_vector_components, structure_matrix
 from planners.trajectory import TrajectorySample, check_positive, check_values, sample_times
 
 POSE_LABELS = ("x", "y", "z", "rx", "ry", "rz")
@@ -279,14 +279,25 @@ def jacobian(pose, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
     """(..., 6, 6) dL/d(pose): row i is strut i, columns x, y, z, rx, ry, rz.
 
     dL_i = u_i . (dp + omega x R b_i) = u_i . dp + (R b_i x u_i) . E d(angles).
+    Computed on components (``planners.legs.leg_vector_components``); E's first column is
+    e_x and its (1, 0), (2, 0), (0, 1) entries are zeros, whose products the sum drops.
     """
     pose = _as_poses(pose)
-    position, rotation = platform_frame(pose, geometry)
-    vectors = leg_vectors(geometry.base_pivots, geometry.platform_local, position, rotation)
-    units = vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
-    arms = np.einsum("...jk,nk->...nj", rotation, geometry.platform_local)
-    angular = np.einsum("...nj,...jk->...nk", np.cross(arms, units), euler_rate_matrix(pose[..., 3:]))
-    return np.concatenate([units, angular], axis=-1)
+    flat = pose.reshape(-1, 6)
+    position, rotation = platform_frame(flat, geometry)
+    (lx, ly, lz), (ax, ay, az) = leg_vector_components(geometry.base_pivots, geometry.platform_local,
+                                                       position, rotation)
+    length = component_norm(lx, ly, lz)
+    ux, uy, uz = lx / length, ly / length, lz / length
+    out = np.empty(flat.shape[:1] + (geometry.base_pivots.shape[0], 6))
+    out[..., 0], out[..., 1], out[..., 2] = ux, uy, uz
+    # R b_i x u_i (np.cross's arithmetic), times E.
+    cx, cy, cz = ay * uz - az * uy, az * ux - ax * uz, ax * uy - ay * ux
+    e = euler_rate_matrix(flat[:, 3:])
+    out[..., 3] = cx
+    out[..., 4] = cy * e[:, 1, 1, None] + cz * e[:, 2, 1, None]
+    out[..., 5] = (cx * e[:, 0, 2, None] + cy * e[:, 1, 2, None]) + cz * e[:, 2, 2, None]
+    return out.reshape(pose.shape[:-1] + out.shape[-2:])
 
 
 def forward_kinematics(lengths, geometry: HexapodGeometry = RUBIN_CAMERA, initial=None,

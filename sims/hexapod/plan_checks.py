@@ -105,6 +105,7 @@ import numpy as np
 from planners import hexapod as hexapod_planner
 from planners.errors import PlanningError
 from planners.hexapod import POSE_LABELS, RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS, StrutMove
+from planners.legs import component_norm, leg_vector_components
 from planners.trajectory import PiecewiseTrajectory, control_ticks
 from sims.checks import Check
 from sims.hexapod.params import HexapodParams
@@ -129,10 +130,12 @@ _AXIS_UNIT = ("mm",) * 3 + ("deg",) * 3
 
 def _strut_lengths(pose: np.ndarray) -> np.ndarray:
     """``planners.hexapod.strut_lengths`` without its input check (the poses here are the
-    kinematics' own iterates, finite by construction), (M, 6) -> (M, 6) m."""
-    return hexapod_planner.leg_lengths(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local,
+    kinematics' own iterates, finite by construction), on components (the same numbers),
+    (M, 6) -> (M, 6) m."""
+    vectors, _ = leg_vector_components(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local,
                                        RUBIN_CAMERA.rotation_pivot + pose[:, :3],
                                        hexapod_planner.rotation_matrix(pose[:, 3:]))
+    return component_norm(*vectors)
 
 
 def poses_of_lengths(lengths: np.ndarray, guess: np.ndarray, inverse_jacobian: np.ndarray,
