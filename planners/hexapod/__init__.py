@@ -289,15 +289,16 @@ def jacobian(pose, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
                                                        position, rotation)
     length = component_norm(lx, ly, lz)
     ux, uy, uz = lx / length, ly / length, lz / length
-    out = np.empty(flat.shape[:1] + (geometry.base_pivots.shape[0], 6))
-    out[..., 0], out[..., 1], out[..., 2] = ux, uy, uz
+    # Column by column (contiguous writes); the result is the transposed view.
+    columns = np.empty(flat.shape[:1] + (6, geometry.base_pivots.shape[0]))
+    columns[:, 0], columns[:, 1], columns[:, 2] = ux, uy, uz
     # R b_i x u_i (np.cross's arithmetic), times E.
     cx, cy, cz = ay * uz - az * uy, az * ux - ax * uz, ax * uy - ay * ux
     e = euler_rate_matrix(flat[:, 3:])
-    out[..., 3] = cx
-    out[..., 4] = cy * e[:, 1, 1, None] + cz * e[:, 2, 1, None]
-    out[..., 5] = (cx * e[:, 0, 2, None] + cy * e[:, 1, 2, None]) + cz * e[:, 2, 2, None]
-    return out.reshape(pose.shape[:-1] + out.shape[-2:])
+    columns[:, 3] = cx
+    columns[:, 4] = cy * e[:, 1, 1, None] + cz * e[:, 2, 1, None]
+    columns[:, 5] = (cx * e[:, 0, 2, None] + cy * e[:, 1, 2, None]) + cz * e[:, 2, 2, None]
+    return columns.swapaxes(-1, -2).reshape(pose.shape[:-1] + (columns.shape[-1], 6))
 
 
 def forward_kinematics(lengths, geometry: HexapodGeometry = RUBIN_CAMERA, initial=None,
@@ -366,17 +367,28 @@ def check_pose_limits(pose, limits: HexapodLimits = RUBIN_LIMITS, what: str = "t
         raise LimitError(f"{what} {name} = {text}{where}")
 
 
+def beyond_stroke(positions, limits: HexapodLimits = RUBIN_LIMITS) -> np.ndarray:
+    """(..., 6) whether each strut position (m) is beyond the stroke."""
+    return np.abs(positions) > limits.stroke + 1e-15
+
+
+def stroke_messages(positions: np.ndarray, what: str, limits: HexapodLimits = RUBIN_LIMITS) -> list[str]:
+    """``check_stroke``'s message for each row of (k, 6) strut positions (m), each with a strut
+    beyond the stroke: the first such strut, its length change in mm."""
+    strut = np.argmax(beyond_stroke(positions, limits), axis=1)
+    change_mm = (positions[np.arange(positions.shape[0]), strut] * 1e3).tolist()
+    heads = [f"{what} {label} length change " for label in STRUT_LABELS]
+    tail = f" mm is beyond the stroke limit +/-{limits.stroke * 1e3:.4g} mm"
+    return [f"{heads[s]}{v:.4f}{tail}" for s, v in zip(strut.tolist(), change_mm)]
+
+
 def check_stroke(positions, limits: HexapodLimits = RUBIN_LIMITS, what: str = "target") -> None:
     """Raise a LimitError naming the strut if a strut position exceeds the stroke."""
     flat = np.asarray(positions, dtype=float).reshape(-1, 6)
-    bad = np.abs(flat) > limits.stroke + 1e-15
-    if bad.any():
-        row, strut = np.argwhere(bad)[0]
-        where = f" (move {row})" if flat.shape[0] > 1 else ""
-        raise LimitError(
-            f"{what} {STRUT_LABELS[strut]} length change {flat[row, strut] * 1e3:.4f} mm is "
-            f"beyond the stroke limit +/-{limits.stroke * 1e3:.4g} mm{where}"
-        )
+    rows = np.flatnonzero(beyond_stroke(flat, limits).any(axis=1))
+    if rows.size:
+        where = f" (move {rows[0]})" if flat.shape[0] > 1 else ""
+        raise LimitError(stroke_messages(flat[rows[:1]], what, limits)[0] + where)
 
 
 def random_poses(n: int, rng: np.random.Generator, geometry: HexapodGeometry = RUBIN_CAMERA,

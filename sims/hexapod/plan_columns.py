@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from planners import hexapod as hexapod_planner
-from planners.hexapod import RUBIN_LIMITS, STRUT_LABELS
+from planners.hexapod import RUBIN_LIMITS
 from sims.hexapod import plan_checks
 from sims.hexapod.params import HexapodMove, HexapodParams, pose_si
 from sims.hexapod.task import ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM
@@ -60,14 +60,6 @@ def _outside_pose_limits(si: np.ndarray) -> np.ndarray:
     return ((si < limits.pose_lower - 1e-15) | (si > limits.pose_upper + 1e-15)).any(axis=-1)
 
 
-def _stroke_text(what: str, struts: np.ndarray, row: int) -> str:
-    """``planners.hexapod.check_stroke``'s message of the pose ``row`` of (n, 6) ``struts``."""
-    bad = np.abs(struts[row]) > RUBIN_LIMITS.stroke + 1e-15
-    strut = int(np.argmax(bad))
-    return (f"{what} {STRUT_LABELS[strut]} length change {struts[row, strut] * 1e3:.4f} mm is "
-            f"beyond the stroke limit +/-{RUBIN_LIMITS.stroke * 1e3:.4g} mm")
-
-
 def poses_of(base: HexapodParams, paths, values, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(start (n, 6), targets (n, M, 6) in mm and deg, synchronous (n, M)) of the runs."""
     start = np.tile(np.asarray(base.start_pose, dtype=float), (n, 1))
@@ -102,7 +94,7 @@ def validate(base: HexapodParams, paths, values, n: int):
     # The strut positions of each pose (computed row by row, as one pose at a time gives them).
     struts = hexapod_planner.strut_positions(np.concatenate([start[:, None], targets], axis=1).reshape(-1, 6))
     struts = struts.reshape(n, moves + 1, 6)
-    beyond = (np.abs(struts) > RUBIN_LIMITS.stroke + 1e-15).any(axis=2)  # (n, M + 1)
+    beyond = hexapod_planner.beyond_stroke(struts).any(axis=2)  # (n, M + 1)
     # A move of zero length (no strut changes) is rare: the run is validated on its own.
     unsure |= (struts[:, 1:] == struts[:, :-1]).all(axis=2).any(axis=1)
     messages = [None] * n
@@ -113,8 +105,8 @@ def validate(base: HexapodParams, paths, values, n: int):
     for column, what in order:
         rows = np.flatnonzero(beyond[:, column] & ~decided)
         if rows.size:
-            for row in rows:
-                messages[row] = _stroke_text(what, struts[row], column)
+            for row, text in zip(rows.tolist(), hexapod_planner.stroke_messages(struts[rows, column], what)):
+                messages[row] = text
             decided[rows] = True
     return messages, unsure, (start, targets, synchronous)
 
