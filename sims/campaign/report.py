@@ -214,6 +214,7 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -221,11 +222,16 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
     keep = np.isin(counted, ["passed", "failed"])
     axis_values = {}
     stride = max(1, int(math.ceil(keep.sum() / MAX_SCATTER)))
+    sel = np.flatnonzero(keep)[::stride]
     axes = spec.axes or []
+    n = max(1, len(axes))
     for name, meta in summary["checks"].items():
         value = _column(table, f"check.{name}")
-        n = max(1, len(axes))
-        fig, plots = plt.subplots(1, n, figsize=(4.2 * n, 3.4), squeeze=False)
+        # One y scale per check (its tick labels on the first plot) and fixed margins: the
+        # layout of many plots is most of a figure's cost (tight_layout measures every text).
+        fig, plots = plt.subplots(1, n, figsize=(4.2 * n, 3.4), squeeze=False, sharey=True)
+        fig.subplots_adjust(left=0.8 / (4.2 * n), right=1 - 0.1 / (4.2 * n), bottom=0.28, top=0.88,
+                            wspace=0.08)
         for ax_plot, axis in zip(plots[0], axes or [None]):
             if axis is None:
                 x, labels = _column(table, "run"), None
@@ -235,7 +241,6 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
                     axis_values[axis.column] = _axis_values(table, axis.column)
                 x, labels = axis_values[axis.column]
                 xlabel = axis.column + (f" ({axis.unit})" if axis.unit else "")
-            sel = np.flatnonzero(keep)[::stride]
             ax_plot.plot(x[sel], value[sel], ".", alpha=0.35 if sel.size > 200 else 0.7, ms=3, color="tab:blue",
                          label="runs" + (f" (every {stride}th)" if stride > 1 else ""))
             if axis is not None and axis.values is not None:
@@ -255,12 +260,16 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
                                 f"{meta['limit']:.4g}")
             if labels is not None:
                 ax_plot.set_xticks(range(len(labels)), labels, rotation=30, fontsize=7)
+            elif axis is not None and axis.values is not None:
+                ax_plot.set_xticks(centres)
+            else:
+                ax_plot.xaxis.set_major_locator(MaxNLocator(4))  # few ticks: each is drawn as its own artist
             ax_plot.set_xlabel(xlabel)
-            ax_plot.set_ylabel(f"{name} ({meta.get('unit', '')})")
             ax_plot.grid(alpha=0.3)
+        plots[0][0].yaxis.set_major_locator(MaxNLocator(5))
+        plots[0][0].set_ylabel(f"{name} ({meta.get('unit', '')})")
         plots[0][0].legend(fontsize=7)
         fig.suptitle(f"{summary['scenario']}: {name}", fontsize=10)
-        fig.tight_layout()
         path = folder / f"{_safe(name)}.png"
         fig.savefig(path, dpi=90)
         plt.close(fig)
