@@ -215,3 +215,37 @@ def test_random_valid_moves_pass_the_limits_the_generator_keeps(params):
     ends = [params.start_pose] + [m.target for m in params.moves]
     worst_end = max(np.abs((pose_si(p) - centre) / half).max() for p in ends)
     assert c["pose_limits"].evaluated and c["pose_limits"].value >= worst_end - 1e-12
+
+
+# ----------------------------------------------------------------------------- the kernels
+
+
+@given(st.lists(st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.just(0.0), st.just(-0.0)),
+                         min_size=6, max_size=6), min_size=1, max_size=20))
+def test_max_of_the_last_axis_is_numpys(rows):
+    from sims.hexapod.plan_checks import _max_last
+
+    values = np.array(rows)
+    np.testing.assert_array_equal(_max_last(values), values.max(axis=-1))
+    np.testing.assert_array_equal(_max_last(values.reshape(-1, 2, 3)), values.reshape(-1, 2, 3).max(axis=-1))
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40))
+def test_the_nearest_anchor_is_the_argmin_of_the_distances(seed, count):
+    from sims.hexapod.plan_checks import _Anchors
+
+    rng = np.random.default_rng(seed)
+    start, target = hp.random_poses(count, rng), hp.random_poses(count, rng)
+    anchors = _Anchors(hp.plan_moves(start, target, synchronous=bool(seed % 2), method="closed"))
+    rows = rng.integers(0, count, 3 * count)
+    # Positions between and at the anchors (exact ties: the first anchor, as argmin).
+    position = anchors.struts[rows, rng.integers(0, 3, rows.size)]
+    position[::2] += rng.uniform(-1, 1, (position[::2].shape[0], 6)) * 1e-3
+    distance = np.abs(position[:, None, :] - anchors.struts[rows]).max(axis=-1)
+    np.testing.assert_array_equal(anchors.nearest(rows, position), 3 * rows + np.argmin(distance, axis=1))
+    # Exact ties go to the first anchor, as argmin's.
+    tied = object.__new__(_Anchors)
+    tied.struts = np.broadcast_to(np.array([0.0, 2.0, 4.0])[None, :, None], (2, 3, 6)).copy()
+    np.testing.assert_array_equal(tied.nearest(np.array([0, 1, 1]), np.array([[1.0] * 6, [3.0] * 6, [2.0] * 6])),
+                                  [0, 3 + 1, 3 + 1])
