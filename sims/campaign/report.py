@@ -225,13 +225,14 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
     sel = np.flatnonzero(keep)[::stride]
     axes = spec.axes or []
     n = max(1, len(axes))
+    # One figure for all checks, its plots made once: each check draws its data on them and
+    # takes them away after its PNG (making plots and their ticks is most of a figure's cost).
+    # One y scale per check (its tick labels on the first plot) and fixed margins
+    # (tight_layout would measure every text).
+    fig, plots = plt.subplots(1, n, figsize=(4.2 * n, 3.4), squeeze=False, sharey=True)
+    fig.subplots_adjust(left=0.8 / (4.2 * n), right=1 - 0.1 / (4.2 * n), bottom=0.28, top=0.88, wspace=0.08)
     for name, meta in summary["checks"].items():
         value = _column(table, f"check.{name}")
-        # One y scale per check (its tick labels on the first plot) and fixed margins: the
-        # layout of many plots is most of a figure's cost (tight_layout measures every text).
-        fig, plots = plt.subplots(1, n, figsize=(4.2 * n, 3.4), squeeze=False, sharey=True)
-        fig.subplots_adjust(left=0.8 / (4.2 * n), right=1 - 0.1 / (4.2 * n), bottom=0.28, top=0.88,
-                            wspace=0.08)
         for ax_plot, axis in zip(plots[0], axes or [None]):
             if axis is None:
                 x, labels = _column(table, "run"), None
@@ -268,12 +269,18 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
             ax_plot.grid(alpha=0.3)
         plots[0][0].yaxis.set_major_locator(MaxNLocator(5))
         plots[0][0].set_ylabel(f"{name} ({meta.get('unit', '')})")
-        plots[0][0].legend(fontsize=7)
+        legend = plots[0][0].legend(fontsize=7)
         fig.suptitle(f"{summary['scenario']}: {name}", fontsize=10)
         path = folder / f"{_safe(name)}.png"
         fig.savefig(path, dpi=90)
-        plt.close(fig)
         paths.append(path)
+        legend.remove()
+        for ax_plot in plots[0]:
+            for artist in [*ax_plot.lines, *ax_plot.collections]:
+                artist.remove()
+            ax_plot.containers.clear()
+            ax_plot.relim()  # the data limits of the next check's data alone
+    plt.close(fig)
     return paths
 
 
