@@ -254,11 +254,6 @@ def rows_table(rows: list[dict]):
     return pa.Table.from_pydict({k: [row.get(k) for row in rows] for k in order})
 
 
-def _error_text(name: str, message: str) -> str:
-    text = " ".join(f"{name}: {message}".split())
-    return text if len(text) <= 500 else text[:497] + "..."
-
-
 def _head_arrays(context: Context, columns: dict, n: int) -> dict:
     import numpy as np
     import pyarrow as pa
@@ -343,7 +338,9 @@ def run_columns(context: Context, task: ColumnTask) -> dict:
     paths = [parse_path(axis) for axis in context.axes]
     values = [columns[axis] for axis in context.axes]
     messages, unsure, poses = columnar.validate(base_params, paths, values, n)
-    errors = [None if m is None else _error_text("ParamError", m) for m in messages]
+    # validate's messages are one line with single spaces, far under 500 characters: the
+    # text _exception_text gives their ParamError.
+    errors = [None if m is None else "ParamError: " + m for m in messages]
     base_dict = None
     for i in np.flatnonzero(unsure):
         base_dict = base_params.to_dict() if base_dict is None else base_dict
