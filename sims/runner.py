@@ -365,6 +365,8 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     frc, sens = buffers["actuator_force"], buffers["sensordata"]
     base, end = writer.base, writer.end
     get_state = mujoco.mj_getState
+    # MuJoCo's arrays as views, looked up once (each attribute read makes a new one).
+    ctrl_now, force_now, sensors_now = data.ctrl, data.actuator_force, data.sensordata
 
     def record(i: int) -> None:
         nonlocal base, end
@@ -373,14 +375,14 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             base, end = writer.base, writer.end
         j = i - base
         get_state(model, data, state[j], STATE_SPEC)  # qpos, qvel, act and mocap in one copy
-        frc[j] = data.actuator_force
-        sens[j] = data.sensordata
+        frc[j] = force_now
+        sens[j] = sensors_now
 
     record(0)
-    initial_ctrl = data.ctrl.copy()
+    initial_ctrl = ctrl_now.copy()
     task = setup.task
     observe, before_step = task.observe, task.before_step  # the same tick as sims.envs'
-    ctrl_now = context.command
+    command_now = context.command
     contacts = []  # (tick, geoms (ncon, 2), distances (ncon,)) of every tick with contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
                desc="simulating")
@@ -398,7 +400,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             command = controller(i, observation)
             if command is not None:
                 # At the first call a wrong shape is a broken contract (bad input), not a fault.
-                ctrl_now[:] = command if i else check_first_command(command, ctrl_now.size, context.actuators)
+                command_now[:] = command if i else check_first_command(command, command_now.size, context.actuators)
         except PluginError:
             raise
         except (Exception, SystemExit) as e:  # a controller's fault ends the run as a failed check
@@ -407,7 +409,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             break
         if profile:
             controller_wall += clock() - t0
-        if not isfinite(sum(data.ctrl.tolist())):  # <1 us (numpy's sum: 2 us): no NaN command reaches MuJoCo
+        if not isfinite(sum(ctrl_now.tolist())):  # <1 us (numpy's sum: 2 us): no NaN command reaches MuJoCo
             if i == 0:
                 raise PluginError(_bad_command(model, data.ctrl, times[i]) + ", its first command "
                                   "(before any physics step)")
@@ -415,7 +417,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             last = i
             break
         before_step(i, physics)
-        ctrl[i - base] = data.ctrl
+        ctrl[i - base] = ctrl_now
         if profile:
             t1 = clock()
             mujoco.mj_step(model, data, nstep=k)

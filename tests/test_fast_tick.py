@@ -197,7 +197,7 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
             loads._passive_rest = loads._first_lengths = loads._node_xfrc = None
             loads._node_force = np.empty_like(loads._node_drag)
             loads._node_mass_view = loads._node_damping_view = loads._anchor_mass_view = loads._law_views = None
-            loads._ropes = physics.cable_ids
+            loads._ropes, loads._rope_ctrl = physics.cable_ids, None
         else:
             assert loads._law_views is not None and loads._node_xfrc is not None
             assert loads._passive_rest is not None and loads._node_mass_view is not None

@@ -196,6 +196,8 @@ class CableLoads:
         self._cabin = physics.cabin_body
         self._xfrc = data.xfrc_applied[self._cabin]
         self._ropes = index_view(self._cables)  # the winches' commands in ctrl
+        # A view of them where the cables' actuators are a run (None: read by index).
+        self._rope_ctrl = data.ctrl[self._ropes] if isinstance(self._ropes, slice) else None
         if self.winches is not None:
             self.winches.reset(data.ctrl[self._cables], times[1] - times[0] if times.size > 1 else CONTROL_DT)
         mujoco.mj_forward(model, data)
@@ -267,9 +269,12 @@ class CableLoads:
         if self._directions is not None:
             self.direction = self._directions[tick]
         if self.winches is not None:
-            ropes = self._data.ctrl[self._ropes]  # a view where the cables' actuators are a run
-            self.winches(ropes)
-            self._data.ctrl[self._ropes] = ropes
+            if self._rope_ctrl is not None:
+                self.winches(self._rope_ctrl)  # in place
+            else:
+                ropes = self._data.ctrl[self._ropes]
+                self.winches(ropes)
+                self._data.ctrl[self._ropes] = ropes
         self.apply(physics, tick)
 
 
@@ -377,7 +382,8 @@ class ChainCableLoads(CableLoads):
 
     def apply(self, physics, tick: int | None = None) -> None:
         model, data = self._model, self._data
-        self._rest = rest = data.ctrl[self._ropes] * (1.0 / self._n)  # (6,) every segment's unstretched length
+        ropes = data.ctrl[self._ropes] if self._rope_ctrl is None else self._rope_ctrl
+        self._rest = rest = ropes * (1.0 / self._n)  # (6,) every segment's unstretched length
         refresh = tick is None or tick % self.geometry_ticks == 0 or self._directions is not None
         if refresh:
             self._refresh(rest)

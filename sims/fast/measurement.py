@@ -162,14 +162,16 @@ class Encoders:
             else:
                 reads.append((obs[key], buffer, index))
         self._reads = tuple(reads)
-        self._cabin, self._ab_b, self._ab_rotation = physics.cabin_body, physics.ab_b_body, obs["ab_rotation"]
+        # The B frame in the cabin frame, R_cabin^T R_B, from views of the live rotations.
+        self._ab_rotation_of = (data.xmat[physics.cabin_body].reshape(3, 3).T, data.xmat[physics.ab_b_body].reshape(3, 3),
+                                obs["ab_rotation"])
 
     def __call__(self) -> None:
         data = self._data
         for out, buffer, index in self._reads:
             out[:] = getattr(data, buffer)[index]
-        xmat = data.xmat
-        np.matmul(xmat[self._cabin].reshape(3, 3).T, xmat[self._ab_b].reshape(3, 3), out=self._ab_rotation)
+        cabin_transposed, ab_b, out = self._ab_rotation_of
+        np.matmul(cabin_transposed, ab_b, out=out)
 
 
 class IdealSensors(Sensors):
@@ -669,7 +671,12 @@ class FusedSensors(Sensors):
         obs = {}
         # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
         self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
-        self._position, self._rotation, self._velocity = np.zeros((2, 3)), np.zeros((2, 3, 3)), np.zeros((2, 3))
+        # The estimates' position and rotation of both bodies side by side (2, 12), the
+        # estimate log's row: one write a tick.
+        self._estimate = np.zeros((2, 12))
+        self._position, self._rotation = self._estimate[:, :3], self._estimate[:, 3:]
+        self._rotation.shape = (2, 3, 3)  # in place: a view
+        self._velocity = np.zeros((2, 3))
         self._time = np.zeros(1)
         bodies = [self.body_ids[b] for b in self.BODIES]
         self.filters.reset(data.xpos[bodies], data.xmat[bodies].reshape(-1, 3, 3))
@@ -686,10 +693,10 @@ class FusedSensors(Sensors):
         # What the tick reads, looked up once: the IMUs' sites and their readings' places in
         # one block of sensordata; per body its fix's period, latency, points, errors, queue
         # and observation arrays; the encoders' views.
-        self._imu_site_ids = [int(i) for i in self._imu_sites]
+        self._imu_rotations = [data.site_xmat[int(i)] for i in self._imu_sites]  # views of the live rows
         columns = np.concatenate([self._vel_columns.ravel(), self._gyro_columns.ravel()])
         low = int(columns.min())
-        self._imu_block = slice(low, int(columns.max()) + 1)
+        self._imu_readings = data.sensordata[low:int(columns.max()) + 1]  # a view
         self._imu_places = [(int(v[0]) - low, int(g[0]) - low) for v, g in zip(self._vel_columns, self._gyro_columns)]
         if not all(np.array_equal(c, c[0] + np.arange(3)) for c in (*self._vel_columns, *self._gyro_columns)):
             raise ValueError("the IMUs' readings must be 3 consecutive sensordata columns each")
@@ -701,7 +708,7 @@ class FusedSensors(Sensors):
                                 self.fix_error[b], self.pending[b], obs[f"{key}_points"], obs[f"{key}_time"],
                                 obs[f"{key}_count"]))
         self._encoders = Encoders(physics, obs)
-        self._rotation_rows = self._rotation.reshape(2, 9)
+        self._estimate_flat = self._estimate.reshape(24)
         self._accel_flat, self._gyro_flat = self._accel.reshape(6), self._gyro.reshape(6)
         self._velocity_flat = self._velocity.reshape(6)
         self(0, physics)
@@ -713,13 +720,12 @@ class FusedSensors(Sensors):
         # their frames, with their errors. In Python floats, each element's arithmetic that
         # of the vectorized form (tests/test_fast_measurement.py): the world velocity R v
         # summed as numpy's einsum sums it (FusedPoses.propagate), R^T f in order.
-        block = data.sensordata[self._imu_block].tolist()
+        block = self._imu_readings.tolist()
         accel_error, gyro_error = self.accel_error[tick].tolist(), self.gyro_error[tick].tolist()
         gx, gy, gz = self._gravity_list
-        xmat = data.site_xmat
         velocities, accels, gyros = [], [], []
-        for k, site in enumerate(self._imu_site_ids):
-            r0, r1, r2, r3, r4, r5, r6, r7, r8 = xmat[site].tolist()
+        for k, site_rotation in enumerate(self._imu_rotations):
+            r0, r1, r2, r3, r4, r5, r6, r7, r8 = site_rotation.tolist()
             at, gt = self._imu_places[k]
             v0, v1, v2 = block[at:at + 3]
             w0, w1, w2 = (r0 * v0 + r2 * v2) + r1 * v1, (r3 * v0 + r5 * v2) + r4 * v1, (r6 * v0 + r8 * v2) + r7 * v1
@@ -750,11 +756,9 @@ class FusedSensors(Sensors):
                 points_obs[:] = points
                 time_obs[0] = taken * dt
                 count_obs[0] += 1
-        row = self.estimate_log[tick]
         (cabin, platform), (cabin_rotation, platform_rotation) = f.body_origins(), f._rotation
-        row.reshape(24)[:] = cabin + cabin_rotation + platform + platform_rotation
-        self._position[:] = row[:, :3]
-        self._rotation_rows[:] = row[:, 3:]
+        self._estimate_flat[:] = cabin + cabin_rotation + platform + platform_rotation
+        self.estimate_log[tick] = self._estimate
         cabin, platform = f._velocity
         self._velocity_flat[:] = cabin + platform
         self._time[0] = tick * dt
