@@ -69,9 +69,15 @@ class ChunkWriter:
     row ``j - base``. When a row would fall past the buffer's end, ``flush`` appends the
     chunk (rows ``HISTORY`` on) to the file and keeps its last HISTORY rows at the top, so
     that code looking a few ticks back (the runner's divergence scan) still finds them.
-    ``close(n)`` writes the rows up to run row ``n`` (exclusive) and the file's footer."""
+    ``close(n)`` writes the rows up to run row ``n`` (exclusive) and the file's footer.
 
-    def __init__(self, path, shapes: dict, times: np.ndarray, chunk: int = CHUNK_TICKS, history: int = 0):
+    ``block``: names of arrays whose buffers share one row of ``self.block`` (rows, widths
+    summed), side by side in that order, so that one copy fills them all (the runner's
+    ``mj_getState`` of qpos, qvel, act and the mocap poses); their ``buffers`` are views of
+    it."""
+
+    def __init__(self, path, shapes: dict, times: np.ndarray, chunk: int = CHUNK_TICKS, history: int = 0,
+                 block: tuple = ()):
         if chunk < 1:
             raise ValueError(f"chunk of {chunk} ticks: at least 1")
         self.path = Path(path)
@@ -79,7 +85,15 @@ class ChunkWriter:
         self.times = times
         self.chunk, self.history = int(chunk), int(history)
         rows = self.history + self.chunk
-        self.buffers = {name: np.zeros((rows, *shape)) for name, shape in self.shapes.items()}
+        self.block = np.zeros((rows, sum(_width(self.shapes[name]) for name in block)))
+        self.buffers, at = {}, 0
+        for name in block:
+            width = _width(self.shapes[name])
+            view = self.block[:, at:at + width]
+            view.shape = (rows, *self.shapes[name])  # in place: raises rather than copy
+            self.buffers[name], at = view, at + width
+        self.buffers.update({name: np.zeros((rows, *shape)) for name, shape in self.shapes.items()
+                             if name not in self.buffers})
         self.base = -self.history  # run row of buffer row 0
         self.written = 0  # run rows in the file
         self.schema = _schema(self.shapes)
@@ -101,7 +115,7 @@ class ChunkWriter:
         h = self.history
         if h:
             for a in self.buffers.values():
-                a[:h] = a[self.chunk:self.chunk + h]
+                a[:h] = a[self.chunk:self.chunk + h]  # (the block's views move the block)
         self.base += self.chunk
 
     def _write(self, stop: int) -> None:

@@ -36,6 +36,12 @@ from sims.logfile import CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shap
 from sims.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
                        check_controller, check_first_command, fault_text, sample_checked)
 
+#: The arrays of MuJoCo's state that the log records with one ``mj_getState`` a tick, in its
+#: order (``STATE_SPEC``): a row of the log's buffer block (``ChunkWriter(block=...)``).
+STATE_ARRAYS = ("qpos", "qvel", "act", "mocap_pos", "mocap_quat")
+STATE_SPEC = int(mujoco.mjtState.mjSTATE_QPOS | mujoco.mjtState.mjSTATE_QVEL | mujoco.mjtState.mjSTATE_ACT
+                 | mujoco.mjtState.mjSTATE_MOCAP_POS | mujoco.mjtState.mjSTATE_MOCAP_QUAT)
+
 #: How often (in control ticks) the loop scans for divergence: NaN or inf in the logged
 #: state since the last scan, and MuJoCo's warning counters (its bad-qacc detection resets the
 #: state and raises a warning). A divergence ends the run within this many ticks.
@@ -216,9 +222,9 @@ def _divergence(data, qpos, qvel, times, i: int, window: int, base: int = 0):
     """(time, message) if the state diverged in the ticks up to ``i``, else None. ``qpos``
     and ``qvel`` hold the run's rows from ``base`` on (the log's chunk buffer)."""
     lo = max(0, i - window)
-    finite = (np.isfinite(qpos[lo - base : i + 1 - base]).all(axis=1)
-              & np.isfinite(qvel[lo - base : i + 1 - base]).all(axis=1))
-    if not finite.all():
+    rows = slice(lo - base, i + 1 - base)
+    if not (np.isfinite(qpos[rows]).all() and np.isfinite(qvel[rows]).all()):  # (the row only then)
+        finite = np.isfinite(qpos[rows]).all(axis=1) & np.isfinite(qvel[rows]).all(axis=1)
         first = lo + int(np.argmin(finite))
         return float(times[first]), f"non-finite state at t = {times[first]:.4f} s"
     warnings = warning_counts(data) if data.warning.number.any() else None  # (one call, not one per warning)
@@ -348,15 +354,19 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     if temporary:
         log_path = Path(tempfile.mkdtemp(prefix="planbench-log-")) / LOG_FILE
     # Rows go to a chunk buffer (run row j is buffer row j - base); full chunks to the file.
-    writer = ChunkWriter(log_path, model_shapes(model), times, chunk=chunk_ticks, history=SCAN_TICKS)
+    writer = ChunkWriter(log_path, model_shapes(model), times, chunk=chunk_ticks, history=SCAN_TICKS,
+                         block=STATE_ARRAYS)
     if temporary:  # also when the run raises
         weakref.finalize(writer, remove_quietly, log_path)
-    buffers = writer.buffers
-    qpos, qvel, act, ctrl = buffers["qpos"], buffers["qvel"], buffers["act"], buffers["ctrl"]
+    buffers, state = writer.buffers, writer.block
+    if state.shape[1] != mujoco.mj_stateSize(model, STATE_SPEC):
+        raise RuntimeError("MuJoCo's state layout is not qpos, qvel, act, mocap_pos, mocap_quat")
+    qpos, qvel, ctrl = buffers["qpos"], buffers["qvel"], buffers["ctrl"]
     frc, sens = buffers["actuator_force"], buffers["sensordata"]
-    mpos, mquat = buffers["mocap_pos"], buffers["mocap_quat"]
-    has_mocap = model.nmocap > 0
     base, end = writer.base, writer.end
+    get_state = mujoco.mj_getState
+    # MuJoCo's arrays as views, looked up once (each attribute read makes a new one).
+    ctrl_now, force_now, sensors_now = data.ctrl, data.actuator_force, data.sensordata
 
     def record(i: int) -> None:
         nonlocal base, end
@@ -364,20 +374,15 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             writer.flush()
             base, end = writer.base, writer.end
         j = i - base
-        qpos[j] = data.qpos
-        qvel[j] = data.qvel
-        act[j] = data.act
-        frc[j] = data.actuator_force
-        sens[j] = data.sensordata
-        if has_mocap:
-            mpos[j] = data.mocap_pos
-            mquat[j] = data.mocap_quat
+        get_state(model, data, state[j], STATE_SPEC)  # qpos, qvel, act and mocap in one copy
+        frc[j] = force_now
+        sens[j] = sensors_now
 
     record(0)
-    initial_ctrl = data.ctrl.copy()
+    initial_ctrl = ctrl_now.copy()
     task = setup.task
     observe, before_step = task.observe, task.before_step  # the same tick as sims.envs'
-    ctrl_now = context.command
+    command_now = context.command
     contacts = []  # (tick, geoms (ncon, 2), distances (ncon,)) of every tick with contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
                desc="simulating")
@@ -395,7 +400,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             command = controller(i, observation)
             if command is not None:
                 # At the first call a wrong shape is a broken contract (bad input), not a fault.
-                ctrl_now[:] = command if i else check_first_command(command, ctrl_now.size, context.actuators)
+                command_now[:] = command if i else check_first_command(command, command_now.size, context.actuators)
         except PluginError:
             raise
         except (Exception, SystemExit) as e:  # a controller's fault ends the run as a failed check
@@ -404,7 +409,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             break
         if profile:
             controller_wall += clock() - t0
-        if not isfinite(data.ctrl.sum()):  # ~1 us: no NaN command ever reaches MuJoCo
+        if not isfinite(sum(ctrl_now.tolist())):  # <1 us (numpy's sum: 2 us): no NaN command reaches MuJoCo
             if i == 0:
                 raise PluginError(_bad_command(model, data.ctrl, times[i]) + ", its first command "
                                   "(before any physics step)")
@@ -412,7 +417,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             last = i
             break
         before_step(i, physics)
-        ctrl[i - base] = data.ctrl
+        ctrl[i - base] = ctrl_now
         if profile:
             t1 = clock()
             mujoco.mj_step(model, data, nstep=k)

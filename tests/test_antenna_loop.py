@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
+from hypothesis.extra.numpy import arrays
 
 from sims import runner
 from sims.antenna import sensors as antenna_sensors
@@ -129,3 +131,29 @@ def test_the_tabulated_ramps_are_the_per_tick_ramps(imu):
     per_tick = _run(imu, PerTickController())
     for name in LOGGED:
         np.testing.assert_array_equal(getattr(tabulated, name), getattr(per_tick, name), err_msg=name)
+
+
+def _exp_so3_by_norm(rotvec) -> np.ndarray:
+    """The rotation of a rotation vector with its angle by np.linalg.norm (the earlier form)."""
+    import mujoco
+
+    angle = float(np.linalg.norm(rotvec))
+    if angle < 1e-300:
+        return np.eye(3)
+    quat, mat = np.empty(4), np.empty(9)
+    mujoco.mju_axisAngle2Quat(quat, rotvec / angle, angle)
+    mujoco.mju_quat2Mat(mat, quat)
+    return mat.reshape(3, 3)
+
+
+@settings(max_examples=200, deadline=None)
+@given(arrays(float, 3, elements=st.floats(-4.0, 4.0)), st.integers(-12, 0))
+def test_the_rotation_of_a_rotation_vector_is_the_norm_form_s(rotvec, exponent):
+    """_exp_so3's angle in floats against np.linalg.norm's, for small and large rotations: the
+    same matrix to round-off (bit for bit where numpy sums the three squares in order), and
+    a rotation (scipy's Rotation.from_rotvec)."""
+    from scipy.spatial.transform import Rotation
+
+    rotvec = rotvec * 10.0**exponent
+    np.testing.assert_allclose(_exp_so3(rotvec), _exp_so3_by_norm(rotvec), rtol=0.0, atol=1e-15)
+    np.testing.assert_allclose(_exp_so3(rotvec), Rotation.from_rotvec(rotvec).as_matrix(), rtol=0.0, atol=1e-14)

@@ -3,7 +3,9 @@ vectorized numpy forms it replaced: the same numbers.
 
 Where the scalar code sums a matrix-vector product in the order numpy's einsum sums it on
 this machine (``EINSUM_PAIRS``), the two agree to the bit; on a numpy whose einsum sums in
-another order they agree to round-off (1e-15 of the terms)."""
+another order they agree to round-off (1e-15 of the terms). A fix's correction sums in
+another order than its numpy form (the fit in the body frame, Phi^k K in one product): the
+two agree to round-off (1e-12 of each quantity's scale)."""
 
 from __future__ import annotations
 
@@ -195,7 +197,7 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
             loads._passive_rest = loads._first_lengths = loads._node_xfrc = None
             loads._node_force = np.empty_like(loads._node_drag)
             loads._node_mass_view = loads._node_damping_view = loads._anchor_mass_view = loads._law_views = None
-            loads._ropes = physics.cable_ids
+            loads._ropes, loads._rope_ctrl = physics.cable_ids, None
         else:
             assert loads._law_views is not None and loads._node_xfrc is not None
             assert loads._passive_rest is not None and loads._node_mass_view is not None
@@ -212,12 +214,67 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
         np.testing.assert_array_equal(ours, theirs)
 
 
-@settings(max_examples=100, deadline=None)
-@given(arrays(float, 3, elements=st.floats(-1.0, 1.0)), arrays(float, (3, 3), elements=st.floats(-2.0, 2.0)))
-def test_eye_plus_skew_is_the_sum_it_replaces(v, m):
-    """The fix's I + [v]x, written at once, is np.eye(3) + skew(v), and turns a matrix as it."""
+def _vectorized_correct(f: FusedPoses, body: int, measured: np.ndarray, at_tick: int) -> None:
+    """A fix's correction on numpy arrays (the earlier implementation): the fit by
+    small_rotation_fit in the world frame, K y, then Phi^k of it."""
     from planners.rotations import skew
-    from sims.fast.measurement import _eye_plus_skew
+    from sims.fast.measurement import BA, BG, P, TH, V, _orthonormal, small_rotation_fit
 
-    np.testing.assert_array_equal(_eye_plus_skew(v), np.eye(3) + skew(v))
-    np.testing.assert_array_equal(_eye_plus_skew(v) @ m, (np.eye(3) + skew(v)) @ m)
+    samples = f._samples[body]
+    _, position, estimated = samples.popleft()
+    position, estimated = np.array(position), np.array(estimated).reshape(3, 3)
+    centre = measured.mean(axis=0)
+    theta = small_rotation_fit(measured - centre, f._local_points[body] @ estimated.T,
+                               estimated @ f._inverse_inertia[body] @ estimated.T)
+    imu_fix = centre + (np.eye(3) + skew(theta)) @ (estimated @ f._local_imu[body])
+    dx = f.gains[body] @ np.concatenate([imu_fix - position, theta])
+    for k, (tick, later_position, later_rotation) in enumerate(samples):
+        later = f._powers[tick - at_tick] @ dx
+        turned = (np.eye(3) + skew(later[TH])) @ np.array(later_rotation).reshape(3, 3)
+        samples[k] = (tick, (np.array(later_position) + later[P]).tolist(), turned.ravel().tolist())
+    now = f._powers[f.tick - at_tick] @ dx
+    f._position[body] = (np.array(f._position[body]) + now[P]).tolist()
+    f._velocity[body] = (np.array(f._velocity[body]) + now[V]).tolist()
+    rotation = _orthonormal((np.eye(3) + skew(now[TH])) @ np.array(f._rotation[body]).reshape(3, 3))
+    f._rotation[body] = rotation.ravel().tolist()
+    f._accel_bias[body] = (np.array(f._accel_bias[body]) + rotation.T @ now[BA]).tolist()
+    f._gyro_bias[body] = (np.array(f._gyro_bias[body]) + rotation.T @ now[BG]).tolist()
+
+
+@settings(max_examples=80, deadline=None)
+@given(arrays(float, (2, 3), elements=st.floats(-3.0, 3.0)), arrays(float, (2, 3), elements=st.floats(-300.0, 300.0)),
+       st.lists(st.tuples(vectors, arrays(float, (2, 3), elements=st.floats(-0.5, 0.5))), min_size=1, max_size=6),
+       arrays(float, (3, 3), elements=st.floats(-0.05, 0.05)), st.integers(0, 1), st.integers(1, 3))
+def test_the_scalar_fix_correction_is_the_vectorized_one(angles, positions, readings, errors, body, pending):
+    """A fix of a body's points (its estimate's points moved by up to 5 cm) taken some ticks
+    ago, with later fixes still pending: the corrected estimates (position, velocity,
+    rotation, biases) and the kept samples as the numpy form gives them, to round-off (1e-12
+    of each quantity's scale: the scalar fit and Phi^k K y sum in another order)."""
+    import copy
+
+    from scipy.spatial.transform import Rotation
+
+    offsets = np.array([[0.3, -1.2, 2.5], [-0.7, 0.4, -1.9]])
+    rotations = Rotation.from_rotvec(angles).as_matrix()
+    f = _filters(offsets)
+    f.reset(positions, rotations)
+    for k, (force, rate) in enumerate(readings):  # samples at the first ticks, the fix of the first
+        if k < pending:
+            f.sample(body)
+        f.propagate(force, rate)
+    if len(readings) < pending:
+        f.sample(body)
+    measured = positions[body] + f.points[body] @ rotations[body].T + errors
+    reference = copy.deepcopy(f)
+    f.correct(body, measured, 0)
+    _vectorized_correct(reference, body, measured, 0)
+    for name, scale in (("position", 400.0), ("velocity", 20.0), ("rotation", 1.0), ("accel_bias", 1.0),
+                        ("gyro_bias", 1.0)):
+        np.testing.assert_allclose(getattr(f, name), getattr(reference, name), rtol=0.0, atol=1e-12 * scale,
+                                   err_msg=name)
+    assert len(f._samples[body]) == len(reference._samples[body])
+    for (tick, position, rotation), (tick_ref, position_ref, rotation_ref) in zip(f._samples[body],
+                                                                                   reference._samples[body]):
+        assert tick == tick_ref
+        np.testing.assert_allclose(position, position_ref, rtol=0.0, atol=400e-12)
+        np.testing.assert_allclose(rotation, rotation_ref, rtol=0.0, atol=1e-12)

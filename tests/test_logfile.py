@@ -27,11 +27,12 @@ ROOT = Path(__file__).resolve().parents[1]
 SHAPES = {"qpos": (3,), "act": (0,), "mocap_pos": (2, 3)}
 
 
-def _write(path, n, chunk, history, stop_at=None):
+def _write(path, n, chunk, history, stop_at=None, block=()):
     """Rows 0..n-1 of known values through a ChunkWriter as the runner records them (a row
-    is written when its tick comes; the buffer flushes when a row falls past its end)."""
+    is written when its tick comes; the buffer flushes when a row falls past its end);
+    ``block``: the arrays that share one buffer row."""
     times = np.arange(n) * 0.01
-    writer = ChunkWriter(path, SHAPES, times, chunk=chunk, history=history)
+    writer = ChunkWriter(path, SHAPES, times, chunk=chunk, history=history, block=block)
     for i in range(n):
         if i == writer.end:
             writer.flush()
@@ -47,11 +48,22 @@ def _write(path, n, chunk, history, stop_at=None):
     return writer
 
 
+def test_a_block_row_is_its_arrays_side_by_side(tmp_path):
+    writer = ChunkWriter(tmp_path / "log.arrow", SHAPES, np.zeros(3), chunk=2, block=("mocap_pos", "act", "qpos"))
+    assert writer.block.shape == (2, 9)
+    writer.block[1] = np.arange(9.0)  # one copy fills every array of the block
+    np.testing.assert_array_equal(writer.buffers["mocap_pos"][1], np.arange(6.0).reshape(2, 3))
+    np.testing.assert_array_equal(writer.buffers["qpos"][1], [6.0, 7.0, 8.0])
+    assert writer.buffers["act"].shape == (2, 0) and not writer.buffers["qpos"][0].any()
+    writer.abandon()
+
+
 @settings(max_examples=60, deadline=None)
-@given(n=st.integers(1, 40), chunk=st.integers(1, 9), history=st.integers(0, 4))
-def test_every_row_arrives_at_every_chunk_boundary(tmp_path_factory, n, chunk, history):
+@given(n=st.integers(1, 40), chunk=st.integers(1, 9), history=st.integers(0, 4),
+       block=st.sampled_from([(), ("qpos", "act", "mocap_pos"), ("mocap_pos", "qpos")]))
+def test_every_row_arrives_at_every_chunk_boundary(tmp_path_factory, n, chunk, history, block):
     path = tmp_path_factory.mktemp("log") / "log.arrow"
-    _write(path, n, chunk, history)
+    _write(path, n, chunk, history, block=block)
     log = read_log(path)
     assert log.complete and log.n == n
     assert log.rows == [chunk] * (n // chunk) + ([n % chunk] if n % chunk else [])

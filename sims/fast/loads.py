@@ -30,6 +30,7 @@ from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_
 #: as built"): 25 % above the paper's source-switching speed of the cabin (0.4 m/s, which no
 #: rope exceeds), twice its 0.025 m/s^2.
 WINCH_MAX_SPEED = 0.5
+_CENTRE = tuple(CABIN_CENTRE.tolist())
 WINCH_MAX_ACCEL = 0.05
 
 
@@ -195,6 +196,8 @@ class CableLoads:
         self._cabin = physics.cabin_body
         self._xfrc = data.xfrc_applied[self._cabin]
         self._ropes = index_view(self._cables)  # the winches' commands in ctrl
+        # A view of them where the cables' actuators are a run (None: read by index).
+        self._rope_ctrl = data.ctrl[self._ropes] if isinstance(self._ropes, slice) else None
         if self.winches is not None:
             self.winches.reset(data.ctrl[self._cables], times[1] - times[0] if times.size > 1 else CONTROL_DT)
         mujoco.mj_forward(model, data)
@@ -247,22 +250,31 @@ class CableLoads:
     def _cabin_drag(self, u: float):
         """(force (3,), torque (3,) about the cabin body's centre of mass) of the wind speed
         ``u`` on the cabin: a cylinder of its size along its z axis, drag at the shell's centre."""
-        data = self._data
-        rotation = data.xmat[self._cabin].reshape(3, 3)
-        cos_t = min(abs(float(rotation[:, 2] @ self.direction)), 1.0)
+        data, cabin = self._data, self._cabin
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = data.xmat[cabin].tolist()
+        dx, dy, dz = self.direction.tolist()
+        cos_t = min(abs(r2 * dx + r5 * dy + r8 * dz), 1.0)  # the cabin's axis along the wind
         area = CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + \
             math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
-        drag = 0.5 * AIR_DENSITY * CABIN_DRAG_COEFFICIENT * area * abs(u) * u * self.direction
-        centre = data.xpos[self._cabin] + rotation @ CABIN_CENTRE - data.xipos[self._cabin]
-        return drag, moment_sum(centre[None], drag[None])
+        size = 0.5 * AIR_DENSITY * CABIN_DRAG_COEFFICIENT * area * abs(u) * u
+        fx, fy, fz = size * dx, size * dy, size * dz
+        # The shell's centre R c + x less the centre of mass, in floats (c = CABIN_CENTRE).
+        (px, py, pz), (qx, qy, qz), (c0, c1, c2) = data.xpos[cabin].tolist(), data.xipos[cabin].tolist(), _CENTRE
+        ax = px + ((r0 * c0 + r1 * c1) + r2 * c2) - qx
+        ay = py + ((r3 * c0 + r4 * c1) + r5 * c2) - qy
+        az = pz + ((r6 * c0 + r7 * c1) + r8 * c2) - qz
+        return np.array([fx, fy, fz]), np.array([ay * fz - az * fy, az * fx - ax * fz, ax * fy - ay * fx])
 
     def __call__(self, tick: int, physics) -> None:
         if self._directions is not None:
             self.direction = self._directions[tick]
         if self.winches is not None:
-            ropes = self._data.ctrl[self._ropes]  # a view where the cables' actuators are a run
-            self.winches(ropes)
-            self._data.ctrl[self._ropes] = ropes
+            if self._rope_ctrl is not None:
+                self.winches(self._rope_ctrl)  # in place
+            else:
+                ropes = self._data.ctrl[self._ropes]
+                self.winches(ropes)
+                self._data.ctrl[self._ropes] = ropes
         self.apply(physics, tick)
 
 
@@ -333,6 +345,8 @@ class ChainCableLoads(CableLoads):
         self._node_damping_factor = 2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ
         self._end_mass_factor = end_fraction(n, load=False) * self.mass_per_length
         self._end_weight_factor = -end_fraction(n, load=True) * self.weight
+        self._points = np.empty((6, n + 1, 3))
+        self._points[:, 0] = physics.tower_tops
         super().reset(physics, times, rng)
 
     def _set_masses(self, rest: np.ndarray) -> None:
@@ -368,7 +382,8 @@ class ChainCableLoads(CableLoads):
 
     def apply(self, physics, tick: int | None = None) -> None:
         model, data = self._model, self._data
-        self._rest = rest = data.ctrl[self._ropes] * (1.0 / self._n)  # (6,) every segment's unstretched length
+        ropes = data.ctrl[self._ropes] if self._rope_ctrl is None else self._rope_ctrl
+        self._rest = rest = ropes * (1.0 / self._n)  # (6,) every segment's unstretched length
         refresh = tick is None or tick % self.geometry_ticks == 0 or self._directions is not None
         if refresh:
             self._refresh(rest)
@@ -418,15 +433,17 @@ class ChainCableLoads(CableLoads):
             model.tendon_damping[self._passive] = CABLE_DAMPING_S * k[self._passive_cable]
         anchors = data.site_xpos[self._sites]
         arms = anchors - data.xipos[self._cabin]
-        weight = np.zeros((6, 3))
-        weight[:, 2] = self._end_weight_factor * rest * n  # -end_fraction(n, load=True) w L0
-        self._static_wrench = np.concatenate([weight.sum(axis=0), moment_sum(arms, weight)])
+        # The end weights -end_fraction(n, load=True) w L0, straight down: their moment about
+        # the centre of mass is (sum y w, -sum x w, 0).
+        weight = self._end_weight_factor * rest * n
+        self._static_wrench = np.array([0.0, 0.0, weight.sum(), arms[:, 1] @ weight, -(arms[:, 0] @ weight), 0.0])
         if self.still_air:
             self._drag_wrench = np.zeros(6)
             return
-        nodes = data.xpos[self._nodes]  # (6, n - 1, 3)
-        points = np.concatenate([self._towers[:, None], nodes, anchors[:, None]], axis=1)
-        pieces = np.diff(points, axis=1)  # (6, n, 3) segment vectors
+        points = self._points  # (6, n + 1, 3): tower top, nodes, anchor
+        points[:, 1:-1] = data.xpos[self._nodes]
+        points[:, -1] = anchors
+        pieces = points[:, 1:] - points[:, :-1]  # (6, n, 3) segment vectors
         drag = cable_drag_force(self.direction, pieces.reshape(-1, 3), np.repeat(rest, n)).reshape(6, n, 3)
         self._node_drag = (0.5 * (drag[:, :-1] + drag[:, 1:])).reshape(-1, 3)  # half of each neighbour
         if self._node_xfrc is None:

@@ -143,24 +143,35 @@ def encoder_specs(rate_hz: float) -> list[SensorSpec]:
 
 
 class Encoders:
-    """The encoders' readings (``encoder_specs``) written into an observation every tick: the
-    A-B angles and the B frame's rotation in the cabin frame that they give, the legs' lengths
-    and set-points. The places are looked up once, as views where the indices step evenly
-    (``index_view``)."""
+    """The encoders' readings (``encoder_specs``) in an observation every tick: the A-B angles
+    and the B frame's rotation in the cabin frame that they give, the legs' lengths and
+    set-points. Exact readings whose indices step evenly (``index_view``) are read-only views
+    of the live buffers, put in ``obs`` (no cost per tick, as ``sims.task.JointEncoders``');
+    the others are copied every tick."""
 
     def __init__(self, physics, obs: dict):
-        self._data = physics.data.ptr
-        self._reads = ((obs["ab_angles"], "qpos", index_view(physics.ab_qpos)),
-                       (obs["leg_positions"], "qpos", index_view(physics.leg_qpos)),
-                       (obs["leg_setpoints"], "act", index_view(physics.leg_act)))
-        self._cabin, self._ab_b, self._ab_rotation = physics.cabin_body, physics.ab_b_body, obs["ab_rotation"]
+        data = self._data = physics.data.ptr
+        reads = []
+        for key, buffer, ids in (("ab_angles", "qpos", physics.ab_qpos), ("leg_positions", "qpos", physics.leg_qpos),
+                                 ("leg_setpoints", "act", physics.leg_act)):
+            index = index_view(ids)
+            if isinstance(index, slice):
+                view = getattr(data, buffer)[index]
+                view.flags.writeable = False
+                obs[key] = view
+            else:
+                reads.append((obs[key], buffer, index))
+        self._reads = tuple(reads)
+        # The B frame in the cabin frame, R_cabin^T R_B, from views of the live rotations.
+        self._ab_rotation_of = (data.xmat[physics.cabin_body].reshape(3, 3).T, data.xmat[physics.ab_b_body].reshape(3, 3),
+                                obs["ab_rotation"])
 
     def __call__(self) -> None:
         data = self._data
         for out, buffer, index in self._reads:
             out[:] = getattr(data, buffer)[index]
-        xmat = data.xmat
-        np.matmul(xmat[self._cabin].reshape(3, 3).T, xmat[self._ab_b].reshape(3, 3), out=self._ab_rotation)
+        cabin_transposed, ab_b, out = self._ab_rotation_of
+        np.matmul(cabin_transposed, ab_b, out=out)
 
 
 class IdealSensors(Sensors):
@@ -380,6 +391,11 @@ class FusedPoses:
         for _ in range(history - 1):
             powers.append(phi @ powers[-1])
         self._powers = np.stack(powers)
+        # Per body, Phi^k K (history, 15, 6): a fix's innovation to the correction k ticks
+        # after it, in one product; and the fix's constants as Python floats (``correct``).
+        self._carry = [self._powers @ gain for gain in self.gains]
+        self._fit_constants = [(q.tolist(), j.ravel().tolist(), o.tolist())
+                               for q, j, o in zip(self._local_points, self._inverse_inertia, self._local_imu)]
 
     def reset(self, positions, rotations) -> None:
         """Start every body at a known pose (the operator's survey of the parked machine),
@@ -445,39 +461,66 @@ class FusedPoses:
 
     def sample(self, body: int) -> None:
         """Keep ``body``'s estimate of the present tick: a fix taken now will be compared with it."""
-        self._samples[body].append((self.tick, np.array(self._position[body]),
-                                    np.array(self._rotation[body]).reshape(3, 3)))
+        self._samples[body].append((self.tick, list(self._position[body]), list(self._rotation[body])))
 
     def correct(self, body: int, measured_points: np.ndarray, at_tick: int) -> None:
         """A fix of body ``body``'s points (k, 3) world, m, taken at tick ``at_tick`` (at most
         ``history - 1`` ticks ago, where ``sample`` kept the estimate): the innovation against
-        that estimate, the steady-state correction, carried to the estimates kept for later
-        fixes and to the present (x_k = Phi^(k - at_tick) dx; exact for the linear error model)."""
+        that estimate (position of the IMU and the small rotation theta that best turns the
+        predicted points onto the measured ones), the steady-state correction carried to the
+        estimates kept for later fixes and to the present (x_k = Phi^k K y, exact for the
+        linear error model).
+
+        The fit in Python floats (a fraction of numpy's calls on 3-vectors): theta =
+        R J R^T sum p x (m - c - p), p = R q the predicted points about their centroid, c the
+        measured centroid, J the points' inverse inertia (``small_rotation_fit``'s normal
+        equations); tests/test_fast_tick.py compares it with the vectorized form."""
         age = self.tick - at_tick
         if not 0 <= age < self.history:
             raise ValueError(f"a fix {age} ticks old: the filter keeps {self.history}")
         samples = self._samples[body]
-        sampled, position, estimated = samples.popleft()
+        sampled, (sx, sy, sz), rotation = samples.popleft()
         if sampled != at_tick:  # fixes arrive in the order they were taken, each sampled once
             raise ValueError(f"a fix of tick {at_tick} where the filter kept tick {sampled}")
-        centre = measured_points.sum(axis=0) / len(measured_points)  # np.mean's arithmetic, at a third of its cost
-        theta = small_rotation_fit(measured_points - centre, self._local_points[body] @ estimated.T,
-                                   estimated @ self._inverse_inertia[body] @ estimated.T)
-        imu_fix = centre + _eye_plus_skew(theta) @ (estimated @ self._local_imu[body])
-        dx = self.gains[body] @ np.concatenate([imu_fix - position, theta])
-        for k, (tick, later_position, later_rotation) in enumerate(samples):
-            later = self._powers[tick - at_tick] @ dx
-            later_position += later[P]
-            samples[k] = (tick, later_position, _eye_plus_skew(later[TH]) @ later_rotation)
-        now = self._powers[age] @ dx
-        self._position[body] = (np.array(self._position[body]) + now[P]).tolist()
-        self._velocity[body] = (np.array(self._velocity[body]) + now[V]).tolist()
-        rotation = _orthonormal(_eye_plus_skew(now[TH]) @ np.array(self._rotation[body]).reshape(3, 3))
-        self._rotation[body] = rotation.ravel().tolist()
-        # The biases' corrections (world frame) in the IMU's frame: the error is the true
-        # bias less the estimate, so the estimate grows by it.
-        self._accel_bias[body] = (np.array(self._accel_bias[body]) + rotation.T @ now[BA]).tolist()
-        self._gyro_bias[body] = (np.array(self._gyro_bias[body]) + rotation.T @ now[BG]).tolist()
+        local, inverse_inertia, (ox, oy, oz) = self._fit_constants[body]
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation
+        measured = measured_points.tolist()
+        cx = cy = cz = 0.0
+        for mx, my, mz in measured:
+            cx, cy, cz = cx + mx, cy + my, cz + mz
+        count = len(measured)
+        cx, cy, cz = cx / count, cy / count, cz / count
+        ux = uy = uz = 0.0
+        for (mx, my, mz), (qx, qy, qz) in zip(measured, local):
+            px, py, pz = r0 * qx + r1 * qy + r2 * qz, r3 * qx + r4 * qy + r5 * qz, r6 * qx + r7 * qy + r8 * qz
+            dx, dy, dz = mx - cx - px, my - cy - py, mz - cz - pz
+            ux, uy, uz = ux + (py * dz - pz * dy), uy + (pz * dx - px * dz), uz + (px * dy - py * dx)
+        ux, uy, uz = r0 * ux + r3 * uy + r6 * uz, r1 * ux + r4 * uy + r7 * uz, r2 * ux + r5 * uy + r8 * uz
+        j0, j1, j2, j3, j4, j5, j6, j7, j8 = inverse_inertia
+        vx, vy, vz = j0 * ux + j1 * uy + j2 * uz, j3 * ux + j4 * uy + j5 * uz, j6 * ux + j7 * uy + j8 * uz
+        tx, ty, tz = r0 * vx + r1 * vy + r2 * vz, r3 * vx + r4 * vy + r5 * vz, r6 * vx + r7 * vy + r8 * vz
+        # The IMU where the fix puts it: c + (I + [theta]x) R o, o the IMU about the centroid.
+        ax, ay, az = r0 * ox + r1 * oy + r2 * oz, r3 * ox + r4 * oy + r5 * oz, r6 * ox + r7 * oy + r8 * oz
+        innovation = np.array([cx + ax + (ty * az - tz * ay) - sx, cy + ay + (tz * ax - tx * az) - sy,
+                               cz + az + (tx * ay - ty * ax) - sz, tx, ty, tz])
+        carry = self._carry[body]
+        for k, (tick, (px, py, pz), later_rotation) in enumerate(samples):
+            later = (carry[tick - at_tick] @ innovation).tolist()
+            samples[k] = (tick, [px + later[0], py + later[1], pz + later[2]], _turned(later[9:12], later_rotation))
+        now = (carry[age] @ innovation).tolist()
+        px, py, pz = self._position[body]
+        self._position[body] = [px + now[0], py + now[1], pz + now[2]]
+        vx, vy, vz = self._velocity[body]
+        self._velocity[body] = [vx + now[3], vy + now[4], vz + now[5]]
+        rotation = _orthonormal(np.array(_turned(now[9:12], self._rotation[body])).reshape(3, 3)).ravel().tolist()
+        self._rotation[body] = rotation
+        # The biases' corrections (world frame) in the IMU's frame (R^T b): the error is the
+        # true bias less the estimate, so the estimate grows by it.
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation
+        for biases, (bx, by, bz) in ((self._accel_bias, now[6:9]), (self._gyro_bias, now[12:15])):
+            ex, ey, ez = biases[body]
+            biases[body] = [ex + (r0 * bx + r3 * by + r6 * bz), ey + (r1 * bx + r4 * by + r7 * bz),
+                            ez + (r2 * bx + r5 * by + r8 * bz)]
 
     def body_poses(self):
         """(origins (B, 3), rotations (B, 3, 3), velocities (B, 3)) of the bodies' frames, world."""
@@ -494,16 +537,17 @@ class FusedPoses:
         return out
 
 
-#: Constants of the per-fix arithmetic (an allocation each, otherwise).
-_EYE3 = np.eye(3)
+#: A constant of the per-fix arithmetic (an allocation, otherwise).
 _EYE3_15 = 1.5 * np.eye(3)
 
 
-def _eye_plus_skew(v: np.ndarray) -> np.ndarray:
-    """I + [v]x (3, 3) of one vector (3,): the sum's elements (a one or a component) written
-    at once, a fraction of the sum's cost."""
-    x, y, z = v.tolist()
-    return np.array([[1.0, -z, y], [z, 1.0, -x], [-y, x, 1.0]])
+def _turned(w, r) -> list:
+    """(I + [w]x) R as 9 floats (rows), for w (3 floats) and R (9 floats, rows)."""
+    wx, wy, wz = w
+    r0, r1, r2, r3, r4, r5, r6, r7, r8 = r
+    return [r0 + (wy * r6 - wz * r3), r1 + (wy * r7 - wz * r4), r2 + (wy * r8 - wz * r5),
+            r3 + (wz * r0 - wx * r6), r4 + (wz * r1 - wx * r7), r5 + (wz * r2 - wx * r8),
+            r6 + (wx * r3 - wy * r0), r7 + (wx * r4 - wy * r1), r8 + (wx * r5 - wy * r2)]
 
 
 def small_rotation_fit(measured: np.ndarray, predicted: np.ndarray, inverse_inertia: np.ndarray) -> np.ndarray:
@@ -627,7 +671,12 @@ class FusedSensors(Sensors):
         obs = {}
         # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
         self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
-        self._position, self._rotation, self._velocity = np.zeros((2, 3)), np.zeros((2, 3, 3)), np.zeros((2, 3))
+        # The estimates' position and rotation of both bodies side by side (2, 12), the
+        # estimate log's row: one write a tick.
+        self._estimate = np.zeros((2, 12))
+        self._position, self._rotation = self._estimate[:, :3], self._estimate[:, 3:]
+        self._rotation.shape = (2, 3, 3)  # in place: a view
+        self._velocity = np.zeros((2, 3))
         self._time = np.zeros(1)
         bodies = [self.body_ids[b] for b in self.BODIES]
         self.filters.reset(data.xpos[bodies], data.xmat[bodies].reshape(-1, 3, 3))
@@ -644,10 +693,10 @@ class FusedSensors(Sensors):
         # What the tick reads, looked up once: the IMUs' sites and their readings' places in
         # one block of sensordata; per body its fix's period, latency, points, errors, queue
         # and observation arrays; the encoders' views.
-        self._imu_site_ids = [int(i) for i in self._imu_sites]
+        self._imu_rotations = [data.site_xmat[int(i)] for i in self._imu_sites]  # views of the live rows
         columns = np.concatenate([self._vel_columns.ravel(), self._gyro_columns.ravel()])
         low = int(columns.min())
-        self._imu_block = slice(low, int(columns.max()) + 1)
+        self._imu_readings = data.sensordata[low:int(columns.max()) + 1]  # a view
         self._imu_places = [(int(v[0]) - low, int(g[0]) - low) for v, g in zip(self._vel_columns, self._gyro_columns)]
         if not all(np.array_equal(c, c[0] + np.arange(3)) for c in (*self._vel_columns, *self._gyro_columns)):
             raise ValueError("the IMUs' readings must be 3 consecutive sensordata columns each")
@@ -659,7 +708,7 @@ class FusedSensors(Sensors):
                                 self.fix_error[b], self.pending[b], obs[f"{key}_points"], obs[f"{key}_time"],
                                 obs[f"{key}_count"]))
         self._encoders = Encoders(physics, obs)
-        self._rotation_rows = self._rotation.reshape(2, 9)
+        self._estimate_flat = self._estimate.reshape(24)
         self._accel_flat, self._gyro_flat = self._accel.reshape(6), self._gyro.reshape(6)
         self._velocity_flat = self._velocity.reshape(6)
         self(0, physics)
@@ -671,13 +720,12 @@ class FusedSensors(Sensors):
         # their frames, with their errors. In Python floats, each element's arithmetic that
         # of the vectorized form (tests/test_fast_measurement.py): the world velocity R v
         # summed as numpy's einsum sums it (FusedPoses.propagate), R^T f in order.
-        block = data.sensordata[self._imu_block].tolist()
+        block = self._imu_readings.tolist()
         accel_error, gyro_error = self.accel_error[tick].tolist(), self.gyro_error[tick].tolist()
         gx, gy, gz = self._gravity_list
-        xmat = data.site_xmat
         velocities, accels, gyros = [], [], []
-        for k, site in enumerate(self._imu_site_ids):
-            r0, r1, r2, r3, r4, r5, r6, r7, r8 = xmat[site].tolist()
+        for k, site_rotation in enumerate(self._imu_rotations):
+            r0, r1, r2, r3, r4, r5, r6, r7, r8 = site_rotation.tolist()
             at, gt = self._imu_places[k]
             v0, v1, v2 = block[at:at + 3]
             w0, w1, w2 = (r0 * v0 + r2 * v2) + r1 * v1, (r3 * v0 + r5 * v2) + r4 * v1, (r6 * v0 + r8 * v2) + r7 * v1
@@ -708,11 +756,9 @@ class FusedSensors(Sensors):
                 points_obs[:] = points
                 time_obs[0] = taken * dt
                 count_obs[0] += 1
-        row = self.estimate_log[tick]
         (cabin, platform), (cabin_rotation, platform_rotation) = f.body_origins(), f._rotation
-        row.reshape(24)[:] = cabin + cabin_rotation + platform + platform_rotation
-        self._position[:] = row[:, :3]
-        self._rotation_rows[:] = row[:, 3:]
+        self._estimate_flat[:] = cabin + cabin_rotation + platform + platform_rotation
+        self.estimate_log[tick] = self._estimate
         cabin, platform = f._velocity
         self._velocity_flat[:] = cabin + platform
         self._time[0] = tick * dt
