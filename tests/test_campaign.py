@@ -505,3 +505,27 @@ invalid = "skip"
     assert row["moves[0].synchronous"] is False
     for c in checks:
         assert np.array_equal(c.value, row[f"check.{c.name}"], equal_nan=True), c.name
+
+
+def test_a_pool_held_across_campaigns_serves_each_and_ends_with_its_block(tmp_path):
+    from sims import campaign
+    from sims.campaign.engines import LocalEngine
+
+    spec = _write(tmp_path / "spec.toml", """
+scenario = "hexapod-sync-move"
+mode = "plan"
+samples = 40
+invalid = "skip"
+[random]
+"moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
+""")
+    own = campaign.sweep(spec, tmp_path / "own", workers=2, quiet=True).table
+    with LocalEngine(2) as engine:
+        with pytest.raises(ParamError, match="the engine's own"):
+            campaign.sweep(spec, tmp_path / "refused", engine=engine, workers=2, quiet=True)
+        started = dict(engine._pool._processes)
+        held = [campaign.sweep(spec, tmp_path / f"held-{i}", engine=engine, quiet=True).table for i in range(2)]
+        assert engine._pool is not None and dict(engine._pool._processes) == started  # the same workers, still up
+    assert engine._pool is None and not any(p.is_alive() for p in started.values())
+    for table in held:
+        assert _comparable(table).equals(_comparable(own))
