@@ -519,7 +519,10 @@ invalid = "skip"
 [random]
 "moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
 """)
-    own = campaign.sweep(spec, tmp_path / "own", workers=2, quiet=True).table
+    from sims.campaign import context_of, worker
+
+    loaded = spec_module.load(spec)  # the rows computed here, in one chunk, for reference
+    own = worker.run_columns(context_of(loaded), worker.ColumnTask(loaded.columns(np.arange(loaded.size))))["table"]
     with LocalEngine(2) as engine:
         with pytest.raises(ParamError, match="the engine's own"):
             campaign.sweep(spec, tmp_path / "refused", engine=engine, workers=2, quiet=True)
