@@ -218,6 +218,20 @@ def get(name: str) -> Scenario:
         ) from None
 
 
+def get_of(mechanism: str, name: str) -> Scenario:
+    """The scenario ``name`` of the mechanism ``mechanism`` with that mechanism's package
+    imported alone: a campaign's worker needs one mechanism, and importing the others (FAST's
+    and the antenna's scipy modules) would cost each worker about a second of its start.
+    Once the registry is built, its answer; a name the mechanism does not declare is looked
+    up in the registry (``get``: a ValueError lists the known names)."""
+    if _registry.cache_info().currsize == 0:
+        record = getattr(_import_mechanism(mechanism), "MECHANISM", None)
+        for scenario in getattr(record, "scenarios", ()):
+            if scenario.name == name:
+                return scenario
+    return get(name)
+
+
 def get_plan(name: str) -> Scenario:
     """A scenario or a plan-only entry called ``name`` (``planbench plan``)."""
     scenarios, plans = _registry()

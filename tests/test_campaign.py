@@ -505,3 +505,30 @@ invalid = "skip"
     assert row["moves[0].synchronous"] is False
     for c in checks:
         assert np.array_equal(c.value, row[f"check.{c.name}"], equal_nan=True), c.name
+
+
+def test_a_pool_held_across_campaigns_serves_each_and_ends_with_its_block(tmp_path):
+    from sims import campaign
+    from sims.campaign.engines import LocalEngine
+
+    spec = _write(tmp_path / "spec.toml", """
+scenario = "hexapod-sync-move"
+mode = "plan"
+samples = 40
+invalid = "skip"
+[random]
+"moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
+""")
+    from sims.campaign import context_of, worker
+
+    loaded = spec_module.load(spec)  # the rows computed here, in one chunk, for reference
+    own = worker.run_columns(context_of(loaded), worker.ColumnTask(loaded.columns(np.arange(loaded.size))))["table"]
+    with LocalEngine(2) as engine:
+        with pytest.raises(ParamError, match="the engine's own"):
+            campaign.sweep(spec, tmp_path / "refused", engine=engine, workers=2, quiet=True)
+        started = dict(engine._pool._processes)
+        held = [campaign.sweep(spec, tmp_path / f"held-{i}", engine=engine, quiet=True).table for i in range(2)]
+        assert engine._pool is not None and dict(engine._pool._processes) == started  # the same workers, still up
+    assert engine._pool is None and not any(p.is_alive() for p in started.values())
+    for table in held:
+        assert _comparable(table).equals(_comparable(own))

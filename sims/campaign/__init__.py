@@ -42,10 +42,16 @@ class Outcome:
 
 
 def context_of(spec) -> worker.Context:
+    from sims import scenarios
+
+    try:
+        mechanism = scenarios.mechanism_of(spec.scenario.name).name
+    except ValueError:  # a scenario outside the registry: the workers look it up there as well
+        mechanism = None
     return worker.Context(spec.scenario.name, spec.base_params.to_dict(),
                           None if spec.base_plant is None else spec.base_plant.to_dict(),
                           dict(spec.plugins), spec.mode, spec.save, tuple(a.column for a in spec.axes),
-                          spec.timeout)
+                          spec.timeout, mechanism)
 
 
 def check_plugins(spec) -> None:
@@ -144,9 +150,11 @@ def check_columns(spec, quiet: bool) -> None:
         bar.close()
 
 
-def sweep(spec_path, out, engine: str = "local", workers: int | None = None, address: str | None = None,
+def sweep(spec_path, out, engine="local", workers: int | None = None, address: str | None = None,
           rerun_worst: int = 0, quiet: bool = False, echo=print) -> Outcome:
-    """Run (or resume) the campaign of ``spec_path`` into ``out``; see the module's steps."""
+    """Run (or resume) the campaign of ``spec_path`` into ``out``; see the module's steps.
+    ``engine``: "local", "ray", or an engine the caller holds (``engines.LocalEngine`` in a
+    ``with`` block: its workers serve this campaign and the next)."""
     from sims.params import ParamError
 
     start = time.perf_counter()
@@ -160,38 +168,41 @@ def sweep(spec_path, out, engine: str = "local", workers: int | None = None, add
     # The spec and the options hold: a local pool's workers start now (they import planbench
     # and MuJoCo while the runs' parameters and the plug-ins are checked and the directory is
     # opened); a campaign that stops before its runs ends them (``close``).
-    if isinstance(runner_engine, engines.LocalEngine):
-        runner_engine.start()
+    context = context_of(spec)
+    own_pool = isinstance(runner_engine, engines.LocalEngine) and not runner_engine.kept
+    if own_pool:
+        runner_engine.start(context)
     try:
-        return _sweep(spec, target, runner_engine, rerun_worst, quiet, echo, start)
+        return _sweep(spec, context, target, runner_engine, rerun_worst, quiet, echo, start)
     finally:
-        if isinstance(runner_engine, engines.LocalEngine):
+        if own_pool:
             runner_engine.close()
 
 
-def _sweep(spec, target, runner_engine, rerun_worst, quiet, echo, campaign_start) -> Outcome:
+def _sweep(spec, context, target, runner_engine, rerun_worst, quiet, echo, campaign_start) -> Outcome:
     if spec.invalid == "refuse":
         check_runs(spec, spec.iter_runs(), quiet, spec.size)
     check_plugins(spec)
     with target.reserved():
         target.open(spec, spec.path.read_text())
-        done = target.done()
-        pending = spec.size - len(done)
+        done = target.done_array()  # the part files read once
+        pending = spec.size - done.size
         chunk_size = 1 if spec.mode == "simulate" else max(1, min(PLAN_CHUNK, math.ceil(
             pending / (4 * (runner_engine.workers or 1)))))
         # Chunks are made as the engine asks for them: a campaign of 10^6 runs is never held whole.
         if columnar(spec):
-            chunks = column_chunks(spec, target.done_array() if done else None, chunk_size)
+            chunks = column_chunks(spec, done if done.size else None, chunk_size)
         else:
+            done_set = set(done.tolist())
             chunks = (tasks_of(spec, runs) for runs in spec_module.iter_chunks(
-                (r for r in spec.iter_runs() if r.index not in done), chunk_size))
-        if done and not quiet:
-            echo(f"resuming {target}: {len(done)} of {spec.size} runs done, {pending} to go")
+                (r for r in spec.iter_runs() if r.index not in done_set), chunk_size))
+        if done.size and not quiet:
+            echo(f"resuming {target}: {done.size} of {spec.size} runs done, {pending} to go")
         failed = errors = 0
-        bar = tqdm(total=spec.size, initial=len(done), unit="run", disable=quiet, desc="campaign", smoothing=0.1)
+        bar = tqdm(total=spec.size, initial=done.size, unit="run", disable=quiet, desc="campaign", smoothing=0.1)
         start = time.perf_counter()
         try:
-            for chunk, result in runner_engine.run(context_of(spec), chunks):
+            for chunk, result in runner_engine.run(context, chunks):
                 for index, files in result["files"].items():
                     target.write_run_files(index, files, spec.scenario.name)
                 rows = result["table"] if "table" in result else result["rows"]
@@ -211,7 +222,7 @@ def _sweep(spec, target, runner_engine, rerun_worst, quiet, echo, campaign_start
         worst = []
         if rerun_worst:
             worst = rerun_worst_runs(spec, target, table, rerun_worst, quiet, echo)
-    return Outcome(summary, pending, len(done), table, worst, engine_wall, campaign_wall)
+    return Outcome(summary, pending, done.size, table, worst, engine_wall, campaign_wall)
 
 
 def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:

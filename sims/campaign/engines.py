@@ -33,17 +33,20 @@ def _lost(context, chunk, why: str) -> dict:
     return {"rows": rows, "checks": {}, "files": {}}
 
 
-def _init_worker(parent: int | None = None):
+def _init_worker(parent: int | None = None, context: worker.Context | None = None):
     contain_worker(parent)
     if parent == os.getpid():  # an in-process stand-in for a pool (tests)
         return
-    # What every run needs, imported as the worker starts (while the driver reads the spec):
-    # planbench's scenarios, the pipeline and MuJoCo. An import that fails here fails again
-    # in the first chunk, which reports it in its rows (an initializer's error would break
-    # the pool instead).
+    # What every run needs, made as the worker starts (while the driver checks the runs and
+    # opens the campaign's directory): the pipeline, MuJoCo, the scenario's mechanism and the
+    # base parameters (``worker.prepare``). What fails here fails again in the first chunk,
+    # which reports it in its rows (an initializer's error would break the pool instead).
     try:
         import sims.pipeline  # noqa: F401
         import sims.scenarios  # noqa: F401
+
+        if context is not None:
+            worker.prepare(context)
     except Exception:  # noqa: BLE001
         pass
 
@@ -114,26 +117,45 @@ def _run_in_worker(context, chunk):
 
 
 class LocalEngine:
-    """A pool of ``workers`` spawned processes (default: the machine's cores)."""
+    """A pool of ``workers`` spawned processes (default: the machine's cores).
+
+    A campaign (``sweep(..., engine="local")``) starts its own pool and ends it. A caller
+    that runs several campaigns in one process may hold one pool across them, as a Ray
+    cluster is held: ``with LocalEngine(2) as engine: sweep(a, ..., engine=engine);
+    sweep(b, ..., engine=engine)``; its workers start once and keep what they imported
+    (planbench, MuJoCo, the mechanisms and plug-ins of earlier campaigns), and end when the
+    ``with`` block does.
+    """
 
     name = "local"
 
     def __init__(self, workers: int | None = None):
         self.workers = workers or os.cpu_count() or 1
-        self._pool = None  # started by ``start``, taken by ``run``
+        self._pool = None  # started by ``start``; taken by ``run``, which gives it back when kept
+        self.kept = False  # held by the caller across campaigns (``with``)
 
-    def _new_pool(self):
+    def __enter__(self):
+        self.start()
+        self.kept = True
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.kept = False
+        self.close()
+
+    def _new_pool(self, context: worker.Context | None):
         return cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                      initializer=_init_worker, initargs=(os.getpid(),))
+                                      initializer=_init_worker, initargs=(os.getpid(), context))
 
-    def start(self) -> None:
-        """Spawn the workers now: they start (import planbench and MuJoCo) while the driver
-        reads and checks the spec and opens its directory; ``run`` uses them. ``close``
-        ends them if ``run`` never does. Submitting spawns a worker per task until the pool
-        is full, with SIGINT, SIGTERM and SIGHUP held back (as ``run``'s submits)."""
+    def start(self, context: worker.Context | None = None) -> None:
+        """Spawn the workers now: they start (import planbench, MuJoCo and the scenario's
+        mechanism of ``context``) while the driver checks the runs and opens its
+        directory; ``run`` uses them. ``close`` ends them if ``run`` never does. Submitting
+        spawns a worker per task until the pool is full, with SIGINT, SIGTERM and SIGHUP
+        held back (as ``run``'s submits)."""
         if self._pool is not None:
             return
-        self._pool = self._new_pool()
+        self._pool = self._new_pool(context)
         with outputs.signals_deferred():
             for _ in range(self.workers):
                 try:
@@ -142,7 +164,8 @@ class LocalEngine:
                     break
 
     def close(self) -> None:
-        """End the started pool that ``run`` did not take (the campaign stopped before it)."""
+        """End the started pool that ``run`` did not take (the campaign stopped before it),
+        or the kept one."""
         pool, self._pool = self._pool, None
         if pool is not None:
             _terminate(pool)
@@ -152,7 +175,7 @@ class LocalEngine:
         flight (``chunks`` may be a generator). A worker that dies (out of memory, a crash in
         native code) takes its pool with it: the chunks in flight are tried once more, one at
         a time, in a new pool, and one that breaks a pool again is given error rows; the rest
-        go on."""
+        go on. A kept pool (``with``) stays up for the next campaign; an interrupt ends it."""
         source = iter(chunks)
         retry = collections.deque()
         broke_once = set()
@@ -170,8 +193,8 @@ class LocalEngine:
             return out
 
         while True:
-            # The pool ``start`` spawned, or a new one (the first was not started, or broke).
-            pool, self._pool = (self._pool or self._new_pool()), None
+            # The pool ``start`` spawned (or a kept one), or a new one (none was started, or one broke).
+            pool, self._pool = (self._pool or self._new_pool(context)), None
             broken, unsent = [], []
             futures = {}
 
@@ -210,9 +233,13 @@ class LocalEngine:
             except BaseException:
                 _terminate(pool)
                 raise
-            pool.shutdown(wait=True)
             if not broken and not unsent:
+                if self.kept:
+                    self._pool = pool
+                else:
+                    pool.shutdown(wait=True)
                 return
+            pool.shutdown(wait=True)
             retry.extendleft(reversed(unsent))
             for chunk in sorted(broken, key=_first_run, reverse=True):
                 if _first_run(chunk) in broke_once:
@@ -358,9 +385,15 @@ def ray_available() -> bool:
     return importlib.util.find_spec("ray") is not None
 
 
-def make(engine: str, workers: int | None, address: str | None):
+def make(engine, workers: int | None, address: str | None):
+    """The engine called ``engine`` ("local", "ray") with ``workers`` and ``address``, or
+    ``engine`` itself when it is one (a pool or Ray engine the caller holds)."""
     from sims.params import ParamError
 
+    if isinstance(engine, (LocalEngine, RayEngine)):
+        if workers is not None or address is not None:
+            raise ParamError("workers and address are the engine's own when an engine is given")
+        return engine
     if engine not in ENGINES:
         raise ParamError(f"--engine {engine!r} is not one of {', '.join(ENGINES)}")
     if workers is not None and not 1 <= workers <= 4096:

@@ -134,10 +134,7 @@ class CampaignDir(outputs._Target):
 
     def done(self) -> set[int]:
         """Indices of the runs that have a row."""
-        out = set()
-        for part in self.part_files():
-            out.update(pq.read_table(part, columns=["run"]).column("run").to_pylist())
-        return out
+        return set(self.done_array().tolist())
 
     def done_array(self):
         """Indices of the runs that have a row, a sorted int64 array."""

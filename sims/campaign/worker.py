@@ -35,6 +35,7 @@ class Context:
     save: tuple
     axes: tuple  # column names, in the order of RunTask.values
     timeout: float | None = None  # each run's wall-time limit, s (None: 600 s + its simulated duration)
+    mechanism: str | None = None  # the scenario's mechanism: a worker imports its package alone (None: all)
 
 
 @dataclass(frozen=True)
@@ -73,12 +74,19 @@ def _base(context: Context):
     if key not in _cache:
         from sims import plugins, scenarios
 
-        scenario = scenarios.get(context.scenario)
+        scenario = (scenarios.get(context.scenario) if context.mechanism is None
+                    else scenarios.get_of(context.mechanism, context.scenario))
         params = type(scenario.params).from_mapping(context.base_params)
         plant = None if context.base_plant is None else type(scenario.plant).from_mapping(context.base_plant)
         _cache.clear()
         _cache[key] = (scenario, params, plant, context.plugins, plugins)
     return _cache[key]
+
+
+def prepare(context: Context) -> None:
+    """What the runs of ``context`` share, made now (a local worker's start, while the driver
+    checks the runs): the scenario's mechanism imported, the base parameters built."""
+    _base(context)
 
 
 def _exception_text(e: BaseException) -> str:
