@@ -22,6 +22,7 @@ import tempfile
 import time
 import weakref
 from dataclasses import dataclass, field
+from functools import partial
 from math import isfinite
 from pathlib import Path
 
@@ -29,7 +30,7 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from planners.trajectory import Trajectory, TrajectorySample, control_ticks
+from planners.trajectory import ChunkedSample, Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, controller_check, divergence_check
 from sims import supervise
 from sims.logfile import CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly
@@ -92,7 +93,8 @@ class RunLog:
 
     Arrays: t (n,), qpos, qvel, act, ctrl, actuator_force, sensordata (n, size), mocap_pos
     and mocap_quat (n, nmocap, 3|4) when the model has mocap bodies. ``reference`` is the
-    planned motion sampled at ``t``. ``ctrl`` row i holds the controls applied from ``t[i]``;
+    planned motion sampled at ``t`` (of a simulated run, a ``ChunkedSample``: its ``rows``
+    sample a chunk of ticks, its arrays are sampled whole when first read). ``ctrl`` row i holds the controls applied from ``t[i]``;
     the last row, after which no physics runs, the controls still held there. ``contacts``
     lists (tick, geom1, geom2, distance) of every contact seen at a tick's end. ``n`` may be
     shorter than planned when the run diverged.
@@ -111,7 +113,7 @@ class RunLog:
     sensordata: np.ndarray = _Logged()
     mocap_pos: np.ndarray = _Logged()
     mocap_quat: np.ndarray = _Logged()
-    reference: TrajectorySample | None = None
+    reference: TrajectorySample | ChunkedSample | None = None
     contacts: list = field(default_factory=list)
     warnings: dict = field(default_factory=dict)
     diverged_at: float | None = None
@@ -257,7 +259,7 @@ class Episode:
     context. ``start_episode`` makes it."""
 
     times: np.ndarray
-    reference: TrajectorySample
+    reference: ChunkedSample
     observation: dict
     context: ControlContext
     steps_per_tick: int
@@ -300,7 +302,10 @@ def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     model, data = physics.model.ptr, physics.data.ptr
     k = steps_per_tick(model, task.control_dt)
     times = task.times()
-    reference = sample_checked(components.trajectory, times)
+    # Sampled a chunk of ticks at a time as it is read: a long run need not hold it whole.
+    # The first chunk now: a trajectory that cannot be sampled is bad input before the run.
+    reference = ChunkedSample(partial(sample_checked, components.trajectory), times, CHUNK_TICKS)
+    reference.rows(0, 0)
     controller = components.controller
     check_controller(controller)
     observation = task.initialize_episode(physics, times, setup.provenance.seed if seed is None else seed)
@@ -449,9 +454,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     if temporary:  # the open file keeps the data until the log is dropped
         remove_quietly(log_path)
     if last < n - 1:
-        r = log.reference
-        log.reference = TrajectorySample(r.t[: last + 1], r.position[: last + 1],
-                                         r.velocity[: last + 1], r.acceleration[: last + 1])
+        log.reference = log.reference.head(last + 1)
     if not log.warnings:
         log.warnings = warning_counts(data)
     return log

@@ -321,9 +321,7 @@ class FastEvaluation:
 
         for start, rows in log.chunks(("t", "sensordata", "qpos", "qvel", "act", "ctrl", "actuator_force")):
             m = rows["t"].shape[0]
-            reference = type(r)(r.t[start:start + m], r.position[start:start + m], r.velocity[start:start + m],
-                                r.acceleration[start:start + m])
-            s = self._rows_series(rows, reference, start, n)
+            s = self._rows_series(rows, r.rows(start, start + m), start, n)
             for key in scalars:
                 scalars[key].append(s[key])
             for key, value in s.items():
