@@ -213,12 +213,9 @@ WIND_AZIMUTH_DEG = 0.0
 DEFAULT_CABLE_SEGMENTS = 2
 
 #: Doubles per tick that a FAST run preallocates besides the runner's log and its sensors: the
-#: controller's plan state at every tick (FastPlanSample less its t: 53, of which the feed, its
-#: velocity and acceleration and the multi-feed angle, 10, are views of the reference: 43), its
-#: winch feed-forward (6), platform rotation and position (9 + 3), A-B reference and set-point
-#: (2 + 2), the fused stabilizer's planned legs (6): 71; the plant's wind speed, wind force and
-#: catenary tensions (1 + 3 + 6).
-PER_TICK_FLOATS = 71 + 10
+#: plant's wind speed, wind force and catenary tensions (1 + 3 + 6). (The controller holds its
+#: plan's per-tick arrays a block of ticks at a time: sims.fast.controller.PLAN_BLOCK_TICKS.)
+PER_TICK_FLOATS = 10
 
 
 def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: SensorOptions = SensorOptions(),
