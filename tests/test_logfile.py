@@ -64,6 +64,22 @@ def test_every_row_arrives_at_every_chunk_boundary(tmp_path_factory, n, chunk, h
     assert rows == n
 
 
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(0, 30), chunk=st.integers(1, 7), start=st.integers(0, 35), length=st.integers(0, 35))
+def test_a_temporary_log_s_rows_and_spans(n, chunk, start, length):
+    """Rows written through ``row`` (a temporary log) read back; any span of them is the
+    whole array's slice; the file is gone once read back."""
+    writer = logfile.temporary_writer(SHAPES, np.arange(n) * 0.01, chunk=chunk)
+    for i in range(n):
+        writer.row("qpos", i)[:] = [i, -i, 0.5 * i]
+        writer.row("mocap_pos", i)[:] = np.arange(6).reshape(2, 3) + i
+    log = writer.read_back(n)
+    assert log.complete and log.n == n and not writer.path.exists()
+    for name in ("qpos", "mocap_pos", "act", "t"):
+        np.testing.assert_array_equal(log.span(name, start, start + length), log.column(name)[start:start + length])
+    np.testing.assert_array_equal(log.column("qpos")[:, 1], -np.arange(n))
+
+
 @pytest.mark.parametrize("n, chunk", [(1, 4), (4, 4), (8, 4), (9, 4)])
 def test_one_tick_one_chunk_and_chunk_multiples(tmp_path, n, chunk):
     _write(tmp_path / "log.arrow", n, chunk, 2)

@@ -42,6 +42,7 @@ import scipy.signal
 
 from planners.rotations import skew, vee
 from sims.fast.physics import CONTROL_DT, PHYSICS_DT, index_view, moment_sum
+from sims.logfile import temporary_writer
 from sims.params import ParamError, Params, param
 from sims.task import Sensors, SensorSpec
 
@@ -623,7 +624,9 @@ class FusedSensors(Sensors):
                                  + gauss_markov(rng, (m, 3, 3), point, tau, fix_dt))
         self._last_velocity = np.zeros((2, 3))
         self.pending = {b: deque() for b in self.BODIES}  # (arrival tick, points (3, 3), taken at tick)
-        self.estimate_log = np.zeros((n, 2, 12))  # per tick: position (3) and rotation (9) of each body
+        # Per tick: position (3) and rotation (9) of each body, streamed to a file of its own.
+        self.estimates = temporary_writer({"estimate": (2, 12)}, times, prefix="planbench-estimates-")
+        self._estimate_log = None
         obs = {}
         # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
         self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
@@ -664,6 +667,14 @@ class FusedSensors(Sensors):
         self._velocity_flat = self._velocity.reshape(6)
         self(0, physics)
         return obs
+
+    def estimate_log(self, rows: int):
+        """The estimates of the run's first ``rows`` ticks (a ``sims.logfile.LogFile`` whose
+        array ``estimate`` is (rows, 2, 12): per tick the position (3) and rotation (9) of each
+        body), their file closed the first time."""
+        if self._estimate_log is None:
+            self._estimate_log = self.estimates.read_back(rows)
+        return self._estimate_log
 
     def __call__(self, tick: int, physics) -> None:
         data, dt = self._data, self.dt
@@ -708,7 +719,7 @@ class FusedSensors(Sensors):
                 points_obs[:] = points
                 time_obs[0] = taken * dt
                 count_obs[0] += 1
-        row = self.estimate_log[tick]
+        row = self.estimates.row("estimate", tick)
         (cabin, platform), (cabin_rotation, platform_rotation) = f.body_origins(), f._rotation
         row.reshape(24)[:] = cabin + cabin_rotation + platform + platform_rotation
         self._position[:] = row[:, :3]
@@ -738,30 +749,38 @@ def make_sensors(physics, options: SensorOptions, control_dt: float = CONTROL_DT
 def floats_per_tick(options: SensorOptions, control_dt: float = CONTROL_DT) -> float:
     """Doubles per control tick that the sensors of ``options`` preallocate. Ideal: the true
     cabin pose (3 + 9) and the noise of their two measurements (2 x (3 + 9)). Fused: the IMUs'
-    errors (2 x (3 + 3)), the estimates' log (2 x 12), and the fixes' errors (9 a fix, and one
-    fix more per body: a run has n // every + 1)."""
+    errors (2 x (3 + 3)) and the fixes' errors (9 a fix, and one fix more per body: a run has
+    n // every + 1); the estimates' log (2 x 12) streams to a file (``FusedSensors.estimates``)."""
     if options.system == "ideal":
         return 36.0
     fixes = sum(1.0 / _ticks(1.0 / rate, control_dt, 1) for rate in (options.rtk_rate_hz, options.ts_rate_hz))
-    return 12.0 + 24.0 + 9.0 * fixes + 1.0
+    return 12.0 + 9.0 * fixes + 1.0
 
 
-def estimate_errors(sensors: FusedSensors, physics, qpos: np.ndarray) -> dict:
-    """The fused estimates' RMS errors against the true bodies over a run's logged ``qpos``
-    (n, nq) (all rows but the last, where no sensor read): {"cabin_mm", "cabin_deg",
-    "platform_mm", "platform_deg"}; position of the body frame's origin, attitude the angle
-    of the estimated rotation times the true one's inverse."""
+def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
+    """The fused estimates' RMS errors against the true bodies over a run's log (a
+    ``sims.runner.RunLog``; all rows but the last, where no sensor read), read a chunk at a
+    time: {"cabin_mm", "cabin_deg", "platform_mm", "platform_deg"}; position of the body
+    frame's origin, attitude the angle of the estimated rotation times the true one's
+    inverse."""
     from scipy.spatial.transform import Rotation
 
     model = physics.model.ptr
-    n = qpos.shape[0] - 1
+    n = log.n - 1
+    estimates = sensors.estimate_log(n)
+    bodies = (("cabin", "cabin"), ("platform", "feed_platform"))
+    adrs = [model.jnt_qposadr[model.body_jntadr[model.body(name).id]] for _, name in bodies]
+    position, attitude = [[], []], [[], []]  # per body, per chunk: the ticks' errors, m and rad
+    for start, rows in log.chunks(["qpos"]):
+        qpos = rows["qpos"][:max(n - start, 0)]
+        estimate = estimates.span("estimate", start, start + qpos.shape[0])
+        for k, adr in enumerate(adrs):
+            position[k].append(np.linalg.norm(estimate[:, k, :3] - qpos[:, adr:adr + 3], axis=1))
+            attitude[k].append((Rotation.from_matrix(estimate[:, k, 3:].reshape(-1, 3, 3))
+                                * Rotation.from_quat(qpos[:, adr + 3:adr + 7], scalar_first=True).inv()).magnitude())
     out = {}
-    for k, (body, name) in enumerate((("cabin", "cabin"), ("platform", "feed_platform"))):
-        adr = model.jnt_qposadr[model.body_jntadr[model.body(name).id]]
-        estimate = sensors.estimate_log[:n, k]
-        position = np.linalg.norm(estimate[:, :3] - qpos[:n, adr:adr + 3], axis=1)
-        attitude = (Rotation.from_matrix(estimate[:, 3:].reshape(-1, 3, 3))
-                    * Rotation.from_quat(qpos[:n, adr + 3:adr + 7], scalar_first=True).inv()).magnitude()
-        out[f"{body}_mm"] = 1e3 * float(np.sqrt(np.mean(position**2)))
-        out[f"{body}_deg"] = float(np.degrees(np.sqrt(np.mean(attitude**2))))
+    for k, (body, _) in enumerate(bodies):
+        p, a = np.concatenate(position[k]), np.concatenate(attitude[k])
+        out[f"{body}_mm"] = 1e3 * float(np.sqrt(np.mean(p**2)))
+        out[f"{body}_deg"] = float(np.degrees(np.sqrt(np.mean(a**2))))
     return out

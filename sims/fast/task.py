@@ -408,10 +408,8 @@ class FastEvaluation:
             "ab_error_max_arcsec": ab_error.round(2).tolist(),
             "stewart_leg_max_mm": 1e3 * float(ext["leg_abs"][0]),
         })
-        if isinstance(self.sensors, FusedSensors):  # (qpos read whole for this, then let go)
-            qpos = log.file.column("qpos") if log.file is not None and not log.held("qpos") else log.qpos
-            metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, qpos)
-            del qpos
+        if isinstance(self.sensors, FusedSensors):
+            metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, log)
         if self.loads.mean_speed > 0:
             wind = self.loads.speed[:n]
             metrics.update({"wind_speed_std_m_s": float(np.std(wind)),
