@@ -39,6 +39,7 @@ import signal
 import subprocess
 import tempfile
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -769,6 +770,38 @@ def _as_output_dir(out_dir, kind: str) -> OutputDir:
     return out_dir if isinstance(out_dir, OutputDir) else OutputDir(out_dir, kind=kind)
 
 
+class _StridedLog:
+    """Every ``stride``-th row of a logged array, read from the run's log file a chunk at a time
+    when written (``save_timeseries``)."""
+
+    def __init__(self, log, name: str, stride: int):
+        self.log, self.name, self.stride = log, name, stride
+        shape = () if name == "t" else tuple(log.file.shapes[name])
+        self.shape = (len(range(0, log.n, stride)), *shape)
+
+    def parts(self):
+        for start, part in self.log.chunks([self.name]):
+            yield np.ascontiguousarray(part[self.name][-start % self.stride::self.stride])
+
+
+def save_timeseries(path, arrays: dict) -> None:
+    """``np.savez_compressed(path, **arrays)``, where an array may also be a ``_StridedLog``,
+    whose rows are written as they are read from the log (a long run's arrays are never whole
+    in memory)."""
+    from numpy.lib import format as npy
+
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as archive:
+        for name, value in arrays.items():
+            with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+                if isinstance(value, _StridedLog):
+                    npy.write_array_header_1_0(member, {"descr": npy.dtype_to_descr(np.dtype(float)),
+                                                        "fortran_order": False, "shape": value.shape})
+                    for part in value.parts():
+                        member.write(part.tobytes())
+                else:
+                    npy.write_array(member, np.asanyarray(value), allow_pickle=True)
+
+
 def write_run(result, setup, out_dir, video=None, camera: str = "overview",
               quiet: bool = True, more_videos: tuple = (), staging: Path | None = None) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
@@ -809,19 +842,22 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                 log = result.log
                 stride = setup.output.output_stride
                 names = ("t", "qpos", "qvel", "ctrl", "act", "actuator_force", "sensordata")
-                if hasattr(log, "every"):  # read from the log file a chunk at a time
-                    arrays = {name: log.every(name, stride) for name in names}
+                streamed = hasattr(log, "every") and log.file is not None and not any(log.held(k) for k in names)
+                if streamed:  # copied from the log file a chunk at a time (save_timeseries)
+                    arrays = {name: _StridedLog(log, name, stride) for name in names}
+                    t_every = log.every("t", stride)
                 else:
                     arrays = {name: getattr(log, name)[::stride] for name in names}
+                    t_every = arrays["t"]
                 n = log.n if hasattr(log, "every") else log.t.size
                 # (an evaluation may return its series at every tick, strided here, or already
                 # at every stride-th tick)
                 series = setup.task.evaluation.timeseries(log)
                 if stride > 1:  # every stride-th tick of the per-tick arrays
                     series = {k: v[::stride] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in series.items()}
-                    summary["timeseries_every_s"] = float(arrays["t"][1] - arrays["t"][0]) if n > stride else None
+                    summary["timeseries_every_s"] = float(t_every[1] - t_every[0]) if n > stride else None
                 arrays.update(series)
-                np.savez_compressed(tmp / "timeseries.npz", **arrays)
+                save_timeseries(tmp / "timeseries.npz", arrays)
                 setup.task.evaluation.report(log, result.checks, tmp / "report.png")
                 render = dict(speed=setup.output.video_speed, quiet=quiet, frame_qpos=setup.output.video_qpos)
                 if video is not None:

@@ -80,6 +80,29 @@ def test_a_temporary_log_s_rows_and_spans(n, chunk, start, length):
     np.testing.assert_array_equal(log.column("qpos")[:, 1], -np.arange(n))
 
 
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(1, 30), chunk=st.integers(1, 7), stride=st.integers(1, 5))
+def test_a_timeseries_copied_from_the_log_is_savez_s(tmp_path_factory, n, chunk, stride):
+    """timeseries.npz with the log's arrays copied a chunk at a time holds what
+    np.savez_compressed writes of the whole arrays, in the same order."""
+    writer = logfile.temporary_writer(SHAPES, np.arange(n) * 0.01, chunk=chunk)
+    for i in range(n):
+        writer.row("qpos", i)[:] = [i, -i, 0.5 * i]
+        writer.row("mocap_pos", i)[:] = np.arange(6).reshape(2, 3) * i
+    log = runner.RunLog(file=writer.read_back(n))
+    folder = tmp_path_factory.mktemp("npz")
+    names = ("t", "qpos", "act", "mocap_pos")
+    series = {"names": np.array(["a", "bc"]), "series": np.arange(7.0) / 3}
+    outputs.save_timeseries(folder / "streamed.npz", {**{k: outputs._StridedLog(log, k, stride) for k in names},
+                                                      **series})
+    np.savez_compressed(folder / "whole.npz", **{k: log.file.column(k)[::stride] for k in names}, **series)
+    streamed, whole = np.load(folder / "streamed.npz"), np.load(folder / "whole.npz")
+    assert list(streamed.keys()) == list(whole.keys())
+    for key in whole.keys():
+        assert streamed[key].dtype == whole[key].dtype
+        np.testing.assert_array_equal(streamed[key], whole[key])
+
+
 @pytest.mark.parametrize("n, chunk", [(1, 4), (4, 4), (8, 4), (9, 4)])
 def test_one_tick_one_chunk_and_chunk_multiples(tmp_path, n, chunk):
     _write(tmp_path / "log.arrow", n, chunk, 2)
