@@ -842,9 +842,9 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                 log = result.log
                 stride = setup.output.output_stride
                 names = ("t", "qpos", "qvel", "ctrl", "act", "actuator_force", "sensordata")
-                streamed = hasattr(log, "every") and log.file is not None and not any(log.held(k) for k in names)
-                if streamed:  # copied from the log file a chunk at a time (save_timeseries)
-                    arrays = {name: _StridedLog(log, name, stride) for name in names}
+                if hasattr(log, "every"):  # from the log file (save_timeseries copies a chunk at a time)
+                    arrays = {name: log.every(name, stride) if log.file is None or log.held(name)
+                              else _StridedLog(log, name, stride) for name in names}
                     t_every = log.every("t", stride)
                 else:
                     arrays = {name: getattr(log, name)[::stride] for name in names}
