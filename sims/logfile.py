@@ -92,6 +92,7 @@ class ChunkWriter:
         self._writer.write_batch(pa.record_batch([pa.array([], f.type) for f in self.schema], schema=self.schema))
         self.closed = False
         self.temporary = False  # (temporary_writer)
+        self._read = None  # the LogFile read back
 
     @property
     def end(self) -> int:
@@ -102,9 +103,10 @@ class ChunkWriter:
         """Append the buffered chunk (a full one) and move the buffer on by a chunk."""
         self._write(self.end)
         h = self.history
-        if h:
-            for a in self.buffers.values():
+        for a in self.buffers.values():
+            if h:
                 a[:h] = a[self.chunk:self.chunk + h]
+            a[h:] = 0.0  # a row no tick writes reads 0, as in a fresh buffer
         self.base += self.chunk
 
     def _write(self, stop: int) -> None:
@@ -128,14 +130,15 @@ class ChunkWriter:
         return self.buffers[name][i - self.base]
 
     def read_back(self, rows: int) -> "LogFile":
-        """``close(rows)`` (once) and the log read back; a temporary log's file
-        (``temporary_writer``) is then removed, the open file keeping its data."""
-        if not self.closed:
-            self.close(rows)
-        log = read_log(self.path)
-        if self.temporary:
-            remove_quietly(self.path)
-        return log
+        """``close(rows)`` and the log read back, once (later calls return it); a temporary
+        log's file (``temporary_writer``) is then removed, the open file keeping its data."""
+        if self._read is None:
+            if not self.closed:
+                self.close(rows)
+            self._read = read_log(self.path)
+            if self.temporary:
+                remove_quietly(self.path)
+        return self._read
 
     def close(self, rows: int) -> None:
         """Write the run's rows up to ``rows`` (exclusive) not yet written, and the footer
@@ -205,6 +208,16 @@ class LogFile:
         """Each chunk's arrays in turn (``chunk``): the whole run, one chunk in memory."""
         for k in range(self.num_chunks):
             yield self.chunk(k, names)
+
+    def every(self, name: str, stride: int) -> np.ndarray:
+        """Rows 0, stride, 2 stride, ... of the array ``name``, read a chunk at a time."""
+        self._known(name)
+        parts, start = [], 0
+        for k, rows in enumerate(self.rows):
+            parts.append(self._array(self.batch(k), name)[-start % stride::stride].copy())
+            start += rows
+        shape = () if name == "t" else tuple(self.shapes[name])
+        return np.concatenate(parts) if parts else np.zeros((0, *shape))
 
     def span(self, name: str, start: int, stop: int) -> np.ndarray:
         """Rows ``start`` to ``stop`` (exclusive) of the array ``name``, read from the chunks

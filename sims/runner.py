@@ -153,9 +153,7 @@ class RunLog:
         if self.file is None or self.held(name):
             value = getattr(self, name)
             return value if value is None else value[::stride]
-        parts = [part[name][-start % stride::stride].copy() for start, part in self.chunks([name])]
-        shape = () if name == "t" else tuple(self.file.shapes[name])
-        return np.concatenate(parts) if parts else np.zeros((0, *shape))
+        return self.file.every(name, stride)
 
 
 @dataclass

@@ -207,7 +207,8 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
         runs.append([model.actuator_gainprm[:, :3].copy(), model.actuator_biasprm[:, :3].copy(),
                      model.tendon_lengthspring.copy(), model.tendon_stiffness.copy(), model.tendon_damping.copy(),
                      model.body_mass.copy(), model.dof_damping.copy(), data.xfrc_applied.copy(),
-                     loads.tension_log.copy(), loads.force.copy(), data.qpos.copy()])
+                     loads.log(times.size).column("tension"), loads.log(times.size).column("force"),
+                     data.qpos.copy()])
     for ours, theirs in zip(*runs):
         np.testing.assert_array_equal(ours, theirs)
 

@@ -626,7 +626,6 @@ class FusedSensors(Sensors):
         self.pending = {b: deque() for b in self.BODIES}  # (arrival tick, points (3, 3), taken at tick)
         # Per tick: position (3) and rotation (9) of each body, streamed to a file of its own.
         self.estimates = temporary_writer({"estimate": (2, 12)}, times, prefix="planbench-estimates-")
-        self._estimate_log = None
         obs = {}
         # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
         self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
@@ -672,9 +671,7 @@ class FusedSensors(Sensors):
         """The estimates of the run's first ``rows`` ticks (a ``sims.logfile.LogFile`` whose
         array ``estimate`` is (rows, 2, 12): per tick the position (3) and rotation (9) of each
         body), their file closed the first time."""
-        if self._estimate_log is None:
-            self._estimate_log = self.estimates.read_back(rows)
-        return self._estimate_log
+        return self.estimates.read_back(rows)
 
     def __call__(self, tick: int, physics) -> None:
         data, dt = self._data, self.dt
