@@ -744,14 +744,15 @@ def make_sensors(physics, options: SensorOptions, control_dt: float = CONTROL_DT
 
 
 def floats_per_tick(options: SensorOptions, control_dt: float = CONTROL_DT) -> float:
-    """Doubles per control tick that the sensors of ``options`` preallocate. Ideal: the true
-    cabin pose (3 + 9) and the noise of their two measurements (2 x (3 + 9)). Fused: the IMUs'
-    errors (2 x (3 + 3)) and the fixes' errors (9 a fix, and one fix more per body: a run has
-    n // every + 1); the estimates' log (2 x 12) streams to a file (``FusedSensors.estimates``)."""
+    """Doubles per control tick that the sensors of ``options`` keep, in memory or in a file.
+    Ideal: the true cabin pose (3 + 9) and the noise of their two measurements (2 x (3 + 9)).
+    Fused: the IMUs' errors (2 x (3 + 3)), the fixes' errors (9 a fix, and one fix more per
+    body: a run has n // every + 1), and the estimates' log (2 x 12), streamed to a file of its
+    own (``FusedSensors.estimates``)."""
     if options.system == "ideal":
         return 36.0
     fixes = sum(1.0 / _ticks(1.0 / rate, control_dt, 1) for rate in (options.rtk_rate_hz, options.ts_rate_hz))
-    return 12.0 + 9.0 * fixes + 1.0
+    return 12.0 + 24.0 + 9.0 * fixes + 1.0
 
 
 def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
