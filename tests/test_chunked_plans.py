@@ -56,3 +56,32 @@ def test_fast_controller_in_small_plan_blocks_runs_the_same(monkeypatch, system)
     blocks = _log({"system": system})
     for name, value in whole.items():
         np.testing.assert_array_equal(blocks[name], value, err_msg=name)
+
+
+@settings(max_examples=30, deadline=None)
+@given(n=st.integers(1, 40), block=st.integers(1, 9), seed=st.integers(0, 2**32 - 1),
+       stride=st.integers(1, 3))
+def test_imu_errors_in_blocks_are_the_whole_run_s_draws(n, block, seed, stride):
+    """ImuErrors, read every ``stride``-th tick in blocks of ``block`` ticks: the numbers of the
+    whole arrays drawn at once, and the generator left where those draws leave it."""
+    from sims.fast import measurement
+
+    white, bias, walk = 1e-3, 1e-2, 1e-4
+    rng = np.random.default_rng(seed)
+    whole = (rng.normal(0.0, white, (n, 2, 3)) + rng.normal(0.0, bias, (1, 2, 3))
+             + np.cumsum(rng.normal(0.0, walk, (n, 2, 3)), axis=0))
+    after = rng.normal(size=4)
+    saved = measurement.IMU_BLOCK_TICKS
+    measurement.IMU_BLOCK_TICKS = block
+    try:
+        rng = np.random.default_rng(seed)
+        errors = measurement.ImuErrors(rng, n, white, bias, walk)
+        np.testing.assert_array_equal(rng.normal(size=4), after)
+        for tick in range(0, n, stride):
+            np.testing.assert_array_equal(errors[tick], whole[tick])
+        np.testing.assert_array_equal(errors[n - 1], whole[n - 1])
+        if n > block:  # tick 0's block is gone
+            with pytest.raises(IndexError, match="tick order"):
+                errors[0]
+    finally:
+        measurement.IMU_BLOCK_TICKS = saved
