@@ -65,6 +65,11 @@ _AT_FDCWD = -100
 INTERRUPT_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
+class RunStopped(KeyboardInterrupt):
+    """SIGTERM in a supervised run (its time limit passed, ``sims.supervise``): its staging
+    directory keeps the log streamed so far (``partial_log``) while the rest is removed."""
+
+
 class OutputError(ValueError):
     """The output location cannot or may not be written (bad input: exit 2)."""
 
@@ -432,9 +437,12 @@ class OutputDir(_Target):
                 _usual_mode(tmp, 0o777)
                 self._check_unchanged(tmp)
                 swap_in(tmp, self.path)
-        except BaseException:
+        except BaseException as e:
             with signals_deferred():
-                shutil.rmtree(tmp, ignore_errors=True)
+                if isinstance(e, RunStopped):  # the log so far stays, for partial_log
+                    _remove_all_but(tmp, ("log.arrow", STAGING_MARKER))
+                else:
+                    shutil.rmtree(tmp, ignore_errors=True)
             raise
 
 
@@ -455,6 +463,17 @@ class OutputDir(_Target):
             what = "files planbench did not write" if foreign is None else f"{_shown(foreign)}"
             raise OutputError(f"{self.what} {self.path} gained {what} during the run; it was left "
                               f"as it is and this run's output is in {kept}")
+
+
+def _remove_all_but(folder: Path, keep: tuple) -> None:
+    """Remove what ``folder`` holds but the entries named ``keep``."""
+    for entry in folder.iterdir():
+        if entry.name not in keep:
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry, ignore_errors=True)
+            else:
+                with contextlib.suppress(OSError):
+                    entry.unlink()
 
 
 def _new_staging(parent: Path, target_name: str) -> Path:

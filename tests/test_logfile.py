@@ -265,6 +265,28 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
     np.testing.assert_array_equal(log.column("ctrl"), full.ctrl[:log.n])
 
 
+def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path):
+    """``planbench run --timeout``: the simulating process stopped at the limit (SIGTERM, then
+    its clean-up) leaves summary.json (completed false) and log.arrow, its whole chunks,
+    readable, incomplete, equal to the first rows of the same run completed."""
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.run([sys.executable, "-m", "sims.cli", "run", "loader-supply", "--duration", "300",
+                           "--timeout", "5", "--out", str(out), "--quiet"], env=env, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=180)
+    assert proc.returncode == 1, proc.stderr
+    assert "passed its time limit" in proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is False and summary["log"]["complete"] is False
+    log = read_log(out / "log.arrow")
+    assert not log.complete and log.n % logfile.CHUNK_TICKS == 0
+    assert summary["log"]["ticks"] == log.n
+    assert _staged_log(tmp_path) is None  # nothing left beside the output
+    if log.n:
+        full = runner.simulate(_setup(duration=log.n * 0.005))
+        np.testing.assert_array_equal(log.column("qpos"), full.qpos[:log.n])
+
+
 # ---------------------------------------------------------------- the disk-space refusal
 
 def test_a_log_beyond_the_free_space_is_refused_with_one_line(tmp_path, capsys, monkeypatch):
