@@ -68,16 +68,22 @@ class ChunkedSample:
       chunk: rows sampled at least at a time, so that a row-by-row reader samples once a chunk.
     """
 
-    def __init__(self, sample: Callable, t: np.ndarray, chunk: int = 4096):
+    def __init__(self, sample: Callable, t: np.ndarray, chunk: int = 4096, stored=None):
         self.sample, self.t, self.chunk = sample, t, max(1, int(chunk))
         self._held = (0, None)  # (first row, TrajectorySample) of the rows sampled last
         self._whole = None
+        # Rows sampled once and read back: an object with ``span(name, start, stop)`` (a
+        # sims.logfile.LogFile of arrays position, velocity, acceleration), or None.
+        self.stored = stored
 
     def rows(self, start: int, stop: int) -> TrajectorySample:
         """The sample at the times ``t[start:stop]`` (0 <= start <= stop <= n)."""
         first, held = self._held
         if self._whole is not None:
             return self._whole.rows(start, stop)
+        if self.stored is not None:
+            return TrajectorySample(self.t[start:stop], *(self.stored.span(name, start, stop)
+                                                          for name in ("position", "velocity", "acceleration")))
         if held is None or start < first or stop > first + held.t.size:
             first, held = start, self.sample(self.t[start:max(stop, start + self.chunk)])
             self._held = (first, held)
@@ -85,7 +91,7 @@ class ChunkedSample:
 
     def head(self, n: int) -> "ChunkedSample":
         """The sample at the first ``n`` times."""
-        return ChunkedSample(self.sample, self.t[:n], self.chunk)
+        return ChunkedSample(self.sample, self.t[:n], self.chunk, self.stored)
 
     def whole(self) -> TrajectorySample:
         """Every row, as one TrajectorySample (kept)."""

@@ -113,14 +113,25 @@ class ChunkWriter:
         lo, hi = self.written - self.base, stop - self.base
         if hi <= lo:
             return
+        self._write_rows({name: a[lo:hi] for name, a in self.buffers.items()}, stop)
+
+    def _write_rows(self, arrays: dict, stop: int) -> None:
+        """Append ``arrays`` ({name: rows}), the run's rows up to ``stop``, as a chunk."""
         columns = [pa.array(self.times[self.written:stop])]
         for name, shape in self.shapes.items():
             width = _width(shape)
             if width:
-                flat = np.ascontiguousarray(self.buffers[name][lo:hi]).reshape(-1)
+                flat = np.ascontiguousarray(arrays[name]).reshape(-1)
                 columns.append(pa.FixedSizeListArray.from_arrays(pa.array(flat), width))
         self._writer.write_batch(pa.record_batch(columns, schema=self.schema))
         self.written = stop
+
+    def append(self, arrays: dict) -> None:
+        """Append the next rows given whole ({name: (m, *shape)} of every array), as a chunk
+        of the file, past the buffer (for a writer that writes no row through it)."""
+        m = next(iter(arrays.values())).shape[0]
+        self._write_rows(arrays, self.written + m)
+        self.base = self.written - self.history
 
     def row(self, name: str, i: int) -> np.ndarray:
         """The buffer's row of run row ``i`` of the array ``name``, to write the tick's values

@@ -33,7 +33,8 @@ from tqdm import tqdm
 from planners.trajectory import ChunkedSample, Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, controller_check, divergence_check
 from sims import supervise
-from sims.logfile import CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly
+from sims.logfile import (CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly,
+                           temporary_writer)
 from sims.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
                        check_controller, check_first_command, fault_text, sample_checked)
 
@@ -291,6 +292,24 @@ def controlled_views(setup: Setup):
     return data.ctrl[ids[0]:ids[-1] + 1], adr[adr >= 0]
 
 
+def stored_reference(trajectory, times: np.ndarray) -> ChunkedSample:
+    """``trajectory`` sampled at ``times``, a chunk of CHUNK_TICKS ticks at a time, each chunk
+    stored in a temporary log (``sims.logfile.temporary_writer``) and read back from it as it
+    is asked for: the run holds a chunk, whatever its length, and samples once, before its
+    first tick (a trajectory that cannot be sampled is bad input before any physics step)."""
+    sample = partial(sample_checked, trajectory)
+    writer = None
+    for start in range(0, times.size, CHUNK_TICKS):
+        part = sample(times[start:start + CHUNK_TICKS])
+        arrays = {name: np.asarray(getattr(part, name), dtype=float)
+                  for name in ("position", "velocity", "acceleration")}
+        if writer is None:
+            shapes = {name: value.shape[1:] for name, value in arrays.items()}
+            writer = temporary_writer(shapes, times, CHUNK_TICKS, prefix="planbench-reference-")
+        writer.append(arrays)
+    return ChunkedSample(sample, times, CHUNK_TICKS, None if writer is None else writer.read_back(times.size))
+
+
 def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     """Put ``setup`` at the start of its run: the task's episode (``Task.initialize_episode``:
     its sensors and disturbance seeded from ``seed``, default ``setup.provenance.seed``), then
@@ -300,10 +319,7 @@ def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     model, data = physics.model.ptr, physics.data.ptr
     k = steps_per_tick(model, task.control_dt)
     times = task.times()
-    # Sampled a chunk of ticks at a time as it is read: a long run need not hold it whole.
-    # The first chunk now: a trajectory that cannot be sampled is bad input before the run.
-    reference = ChunkedSample(partial(sample_checked, components.trajectory), times, CHUNK_TICKS)
-    reference.rows(0, 0)
+    reference = stored_reference(components.trajectory, times)
     controller = components.controller
     check_controller(controller)
     observation = task.initialize_episode(physics, times, setup.provenance.seed if seed is None else seed)

@@ -3,6 +3,8 @@ FAST controller's plan (``PLAN_BLOCK_TICKS``) give the very numbers of the whole
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -27,17 +29,24 @@ def _spline_sample(t: np.ndarray) -> TrajectorySample:
 def test_chunked_sample_rows_are_the_whole_sample_rows(n, chunk, reads):
     t = np.linspace(0.0, 3.0, n)
     whole = _spline_sample(t)
-    lazy = ChunkedSample(_spline_sample, t, chunk)
-    for start, length in reads:
-        start = min(start, n)
-        stop = min(start + length, n)
-        part = lazy.rows(start, stop)
-        for name in ("t", "position", "velocity", "acceleration"):
-            np.testing.assert_array_equal(getattr(part, name), getattr(whole, name)[start:stop])
-    for name in ("position", "velocity", "acceleration"):
-        np.testing.assert_array_equal(getattr(lazy, name), getattr(whole, name))
-    head = lazy.head(n // 2)
-    np.testing.assert_array_equal(head.position, whole.position[:n // 2])
+    saved = runner.CHUNK_TICKS
+    runner.CHUNK_TICKS = chunk
+    try:  # sampled as it is read, and sampled once in chunks of a temporary log (the runner's)
+        samples = [ChunkedSample(_spline_sample, t, chunk),
+                   runner.stored_reference(SimpleNamespace(sample=_spline_sample), t)]
+    finally:
+        runner.CHUNK_TICKS = saved
+    for lazy in samples:
+        for start, length in reads:
+            start = min(start, n)
+            stop = min(start + length, n)
+            part = lazy.rows(start, stop)
+            for name in ("t", "position", "velocity", "acceleration"):
+                np.testing.assert_array_equal(getattr(part, name), getattr(whole, name)[start:stop])
+        head = lazy.head(n // 2)
+        for name in ("position", "velocity", "acceleration"):
+            np.testing.assert_array_equal(getattr(lazy, name), getattr(whole, name))
+        np.testing.assert_array_equal(head.position, whole.position[:n // 2])
 
 
 def _log(sensors: dict) -> dict:
