@@ -46,6 +46,78 @@ class TrajectorySample:
     velocity: np.ndarray
     acceleration: np.ndarray
 
+    def rows(self, start: int, stop: int) -> "TrajectorySample":
+        """The sample at the times ``t[start:stop]``."""
+        return TrajectorySample(self.t[start:stop], self.position[start:stop], self.velocity[start:stop],
+                                self.acceleration[start:stop])
+
+    def head(self, n: int) -> "TrajectorySample":
+        """The sample at the first ``n`` times."""
+        return self.rows(0, n)
+
+
+class ChunkedSample:
+    """A trajectory's sample at the times ``t`` (n,) s, made a chunk of rows at a time as they
+    are asked for (``rows``): a long run's reference, which need not be held whole.
+    ``position``, ``velocity`` and ``acceleration`` are TrajectorySample's whole arrays,
+    sampled (a chunk at a time) when first read and kept.
+
+    Args:
+      sample: t -> TrajectorySample, the trajectory's ``sample`` (or a wrapper of it).
+      t: (n,) the times, s.
+      chunk: rows sampled at least at a time, so that a row-by-row reader samples once a chunk.
+    """
+
+    def __init__(self, sample: Callable, t: np.ndarray, chunk: int = 4096, stored=None):
+        self.sample, self.t, self.chunk = sample, t, max(1, int(chunk))
+        self._held = (0, None)  # (first row, TrajectorySample) of the rows sampled last
+        self._whole = None
+        # Rows sampled once and read back: an object with ``span(name, start, stop)`` (a
+        # sims.logfile.LogFile of arrays position, velocity, acceleration), or None.
+        self.stored = stored
+
+    def rows(self, start: int, stop: int) -> TrajectorySample:
+        """The sample at the times ``t[start:stop]`` (0 <= start <= stop <= n)."""
+        first, held = self._held
+        if self._whole is not None:
+            return self._whole.rows(start, stop)
+        if self.stored is not None:
+            return TrajectorySample(self.t[start:stop], *(self.stored.span(name, start, stop)
+                                                          for name in ("position", "velocity", "acceleration")))
+        if held is None or start < first or stop > first + held.t.size:
+            first, held = start, self.sample(self.t[start:max(stop, start + self.chunk)])
+            self._held = (first, held)
+        return held.rows(start - first, stop - first)
+
+    def head(self, n: int) -> "ChunkedSample":
+        """The sample at the first ``n`` times."""
+        return ChunkedSample(self.sample, self.t[:n], self.chunk, self.stored)
+
+    def whole(self) -> TrajectorySample:
+        """Every row, as one TrajectorySample (kept)."""
+        if self._whole is None:
+            n = self.t.size
+            parts = [self.rows(start, min(start + self.chunk, n)) for start in range(0, n, self.chunk)]
+            if not parts:
+                self._whole = self.sample(self.t)
+            else:
+                self._whole = TrajectorySample(self.t, *(np.concatenate([getattr(p, name) for p in parts])
+                                                         for name in ("position", "velocity", "acceleration")))
+            self._held = (0, None)
+        return self._whole
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.whole().position
+
+    @property
+    def velocity(self) -> np.ndarray:
+        return self.whole().velocity
+
+    @property
+    def acceleration(self) -> np.ndarray:
+        return self.whole().acceleration
+
 
 @runtime_checkable
 class Trajectory(Protocol):

@@ -7,6 +7,7 @@ import copy
 import mujoco
 import numpy as np
 
+from planners.trajectory import TrajectorySample
 from sims.drives import load_joint, transmission_stiffness
 
 
@@ -86,7 +87,7 @@ class ServoFeedforwardController:
         if own.size:
             qpos_adr = np.concatenate([qpos_adr, model.jnt_qposadr[motors[own]]])
             dofs = np.concatenate([dofs, model.jnt_dofadr[motors[own]]])
-            reference = type(reference)(reference.t, *(np.hstack([x, x[:, own]]) for x in
+            reference = TrajectorySample(reference.t, *(np.hstack([x, x[:, own]]) for x in
                                                        (reference.position, reference.velocity,
                                                         reference.acceleration)))
         n = reference.t.size

@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import json
 import os
+import tempfile
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -103,6 +105,8 @@ class ChunkWriter:
         # chunk leaves a log of 0 ticks, readable, incomplete.
         self._writer.write_batch(pa.record_batch([pa.array([], f.type) for f in self.schema], schema=self.schema))
         self.closed = False
+        self.temporary = False  # (temporary_writer)
+        self._read = None  # the LogFile read back
 
     @property
     def end(self) -> int:
@@ -113,23 +117,53 @@ class ChunkWriter:
         """Append the buffered chunk (a full one) and move the buffer on by a chunk."""
         self._write(self.end)
         h = self.history
-        if h:
-            for a in self.buffers.values():
+        for a in self.buffers.values():
+            if h:
                 a[:h] = a[self.chunk:self.chunk + h]  # (the block's views move the block)
+            a[h:] = 0.0  # a row no tick writes reads 0, as in a fresh buffer
         self.base += self.chunk
 
     def _write(self, stop: int) -> None:
         lo, hi = self.written - self.base, stop - self.base
         if hi <= lo:
             return
+        self._write_rows({name: a[lo:hi] for name, a in self.buffers.items()}, stop)
+
+    def _write_rows(self, arrays: dict, stop: int) -> None:
+        """Append ``arrays`` ({name: rows}), the run's rows up to ``stop``, as a chunk."""
         columns = [pa.array(self.times[self.written:stop])]
         for name, shape in self.shapes.items():
             width = _width(shape)
             if width:
-                flat = np.ascontiguousarray(self.buffers[name][lo:hi]).reshape(-1)
+                flat = np.ascontiguousarray(arrays[name]).reshape(-1)
                 columns.append(pa.FixedSizeListArray.from_arrays(pa.array(flat), width))
         self._writer.write_batch(pa.record_batch(columns, schema=self.schema))
         self.written = stop
+
+    def append(self, arrays: dict) -> None:
+        """Append the next rows given whole ({name: (m, *shape)} of every array), as a chunk
+        of the file, past the buffer (for a writer that writes no row through it)."""
+        m = next(iter(arrays.values())).shape[0]
+        self._write_rows(arrays, self.written + m)
+        self.base = self.written - self.history
+
+    def row(self, name: str, i: int) -> np.ndarray:
+        """The buffer's row of run row ``i`` of the array ``name``, to write the tick's values
+        in (rows in order: the first row past the buffer appends the full chunk first)."""
+        if i >= self.end:
+            self.flush()
+        return self.buffers[name][i - self.base]
+
+    def read_back(self, rows: int) -> "LogFile":
+        """``close(rows)`` and the log read back, once (later calls return it); a temporary
+        log's file (``temporary_writer``) is then removed, the open file keeping its data."""
+        if self._read is None:
+            if not self.closed:
+                self.close(rows)
+            self._read = read_log(self.path)
+            if self.temporary:
+                remove_quietly(self.path)
+        return self._read
 
     def close(self, rows: int) -> None:
         """Write the run's rows up to ``rows`` (exclusive) not yet written, and the footer
@@ -199,6 +233,29 @@ class LogFile:
         """Each chunk's arrays in turn (``chunk``): the whole run, one chunk in memory."""
         for k in range(self.num_chunks):
             yield self.chunk(k, names)
+
+    def every(self, name: str, stride: int) -> np.ndarray:
+        """Rows 0, stride, 2 stride, ... of the array ``name``, read a chunk at a time."""
+        self._known(name)
+        parts, start = [], 0
+        for k, rows in enumerate(self.rows):
+            parts.append(self._array(self.batch(k), name)[-start % stride::stride].copy())
+            start += rows
+        shape = () if name == "t" else tuple(self.shapes[name])
+        return np.concatenate(parts) if parts else np.zeros((0, *shape))
+
+    def span(self, name: str, start: int, stop: int) -> np.ndarray:
+        """Rows ``start`` to ``stop`` (exclusive) of the array ``name``, read from the chunks
+        that hold them."""
+        self._known(name)
+        parts, first = [], 0
+        for k, rows in enumerate(self.rows):
+            if first < stop and start < first + rows:
+                part = self._array(self.batch(k), name)
+                parts.append(part[max(start - first, 0):stop - first])
+            first += rows
+        shape = () if name == "t" else tuple(self.shapes[name])
+        return np.concatenate(parts) if parts else np.zeros((0, *shape))
 
     def _known(self, name: str) -> None:
         if name != "t" and name not in self.shapes:
@@ -271,6 +328,18 @@ def read_log(path) -> LogFile:
         raise ValueError(f"{path} is an Arrow file but not a planbench log (no {_META.decode()} metadata)") from None
     shapes = {name: tuple(shape) for name, shape in meta["shapes"].items()}
     return LogFile(path, complete, shapes, schema, source, offsets, rows)
+
+
+def temporary_writer(shapes: dict, times: np.ndarray, chunk: int = CHUNK_TICKS,
+                     prefix: str = "planbench-log-") -> ChunkWriter:
+    """A ChunkWriter (no history) to a log file in a temporary directory of its own, removed
+    when the writer is dropped or read back (``ChunkWriter.read_back``): per-tick records of a
+    run's parts (the sensors' estimates, the plant's loads) kept on disk, not in memory."""
+    path = Path(tempfile.mkdtemp(prefix=prefix)) / LOG_FILE
+    writer = ChunkWriter(path, shapes, times, chunk)
+    writer.temporary = True
+    weakref.finalize(writer, remove_quietly, path)
+    return writer
 
 
 def remove_quietly(path) -> None:

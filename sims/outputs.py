@@ -39,6 +39,7 @@ import signal
 import subprocess
 import tempfile
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -62,6 +63,11 @@ _RENAME_EXCHANGE = 2
 _AT_FDCWD = -100
 #: The signals that interrupt a run (the CLI turns them into exit 128 + signal).
 INTERRUPT_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class RunStopped(KeyboardInterrupt):
+    """SIGTERM in a supervised run (its time limit passed, ``sims.supervise``): its staging
+    directory keeps the log streamed so far (``partial_log``) while the rest is removed."""
 
 
 class OutputError(ValueError):
@@ -431,9 +437,12 @@ class OutputDir(_Target):
                 _usual_mode(tmp, 0o777)
                 self._check_unchanged(tmp)
                 swap_in(tmp, self.path)
-        except BaseException:
+        except BaseException as e:
             with signals_deferred():
-                shutil.rmtree(tmp, ignore_errors=True)
+                if isinstance(e, RunStopped):  # the log so far stays, for partial_log
+                    _remove_all_but(tmp, ("log.arrow", STAGING_MARKER))
+                else:
+                    shutil.rmtree(tmp, ignore_errors=True)
             raise
 
 
@@ -454,6 +463,17 @@ class OutputDir(_Target):
             what = "files planbench did not write" if foreign is None else f"{_shown(foreign)}"
             raise OutputError(f"{self.what} {self.path} gained {what} during the run; it was left "
                               f"as it is and this run's output is in {kept}")
+
+
+def _remove_all_but(folder: Path, keep: tuple) -> None:
+    """Remove what ``folder`` holds but the entries named ``keep``."""
+    for entry in folder.iterdir():
+        if entry.name not in keep:
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry, ignore_errors=True)
+            else:
+                with contextlib.suppress(OSError):
+                    entry.unlink()
 
 
 def _new_staging(parent: Path, target_name: str) -> Path:
@@ -769,6 +789,38 @@ def _as_output_dir(out_dir, kind: str) -> OutputDir:
     return out_dir if isinstance(out_dir, OutputDir) else OutputDir(out_dir, kind=kind)
 
 
+class _StridedLog:
+    """Every ``stride``-th row of a logged array, read from the run's log file a chunk at a time
+    when written (``save_timeseries``)."""
+
+    def __init__(self, log, name: str, stride: int):
+        self.log, self.name, self.stride = log, name, stride
+        shape = () if name == "t" else tuple(log.file.shapes[name])
+        self.shape = (len(range(0, log.n, stride)), *shape)
+
+    def parts(self):
+        for start, part in self.log.chunks([self.name]):
+            yield np.ascontiguousarray(part[self.name][-start % self.stride::self.stride])
+
+
+def save_timeseries(path, arrays: dict) -> None:
+    """``np.savez_compressed(path, **arrays)``, where an array may also be a ``_StridedLog``,
+    whose rows are written as they are read from the log (a long run's arrays are never whole
+    in memory)."""
+    from numpy.lib import format as npy
+
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as archive:
+        for name, value in arrays.items():
+            with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+                if isinstance(value, _StridedLog):
+                    npy.write_array_header_1_0(member, {"descr": npy.dtype_to_descr(np.dtype(float)),
+                                                        "fortran_order": False, "shape": value.shape})
+                    for part in value.parts():
+                        member.write(part.tobytes())
+                else:
+                    npy.write_array(member, np.asanyarray(value), allow_pickle=True)
+
+
 def write_run(result, setup, out_dir, video=None, camera: str = "overview",
               quiet: bool = True, more_videos: tuple = (), staging: Path | None = None) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
@@ -809,19 +861,22 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                 log = result.log
                 stride = setup.output.output_stride
                 names = ("t", "qpos", "qvel", "ctrl", "act", "actuator_force", "sensordata")
-                if hasattr(log, "every"):  # read from the log file a chunk at a time
-                    arrays = {name: log.every(name, stride) for name in names}
+                if hasattr(log, "every"):  # from the log file (save_timeseries copies a chunk at a time)
+                    arrays = {name: log.every(name, stride) if log.file is None or log.held(name)
+                              else _StridedLog(log, name, stride) for name in names}
+                    t_every = log.every("t", stride)
                 else:
                     arrays = {name: getattr(log, name)[::stride] for name in names}
+                    t_every = arrays["t"]
                 n = log.n if hasattr(log, "every") else log.t.size
                 # (an evaluation may return its series at every tick, strided here, or already
                 # at every stride-th tick)
                 series = setup.task.evaluation.timeseries(log)
                 if stride > 1:  # every stride-th tick of the per-tick arrays
                     series = {k: v[::stride] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in series.items()}
-                    summary["timeseries_every_s"] = float(arrays["t"][1] - arrays["t"][0]) if n > stride else None
+                    summary["timeseries_every_s"] = float(t_every[1] - t_every[0]) if n > stride else None
                 arrays.update(series)
-                np.savez_compressed(tmp / "timeseries.npz", **arrays)
+                save_timeseries(tmp / "timeseries.npz", arrays)
                 setup.task.evaluation.report(log, result.checks, tmp / "report.png")
                 render = dict(speed=setup.output.video_speed, quiet=quiet, frame_qpos=setup.output.video_qpos)
                 if video is not None:

@@ -22,6 +22,7 @@ import tempfile
 import time
 import weakref
 from dataclasses import dataclass, field
+from functools import partial
 from math import isfinite
 from pathlib import Path
 
@@ -29,10 +30,11 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from planners.trajectory import Trajectory, TrajectorySample, control_ticks
+from planners.trajectory import ChunkedSample, Trajectory, TrajectorySample, control_ticks
 from sims.checks import Check, controller_check, divergence_check
 from sims import supervise
-from sims.logfile import CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly
+from sims.logfile import (CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly,
+                           temporary_writer)
 from sims.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
                        check_controller, check_first_command, fault_text, sample_checked)
 
@@ -98,7 +100,8 @@ class RunLog:
 
     Arrays: t (n,), qpos, qvel, act, ctrl, actuator_force, sensordata (n, size), mocap_pos
     and mocap_quat (n, nmocap, 3|4) when the model has mocap bodies. ``reference`` is the
-    planned motion sampled at ``t``. ``ctrl`` row i holds the controls applied from ``t[i]``;
+    planned motion sampled at ``t`` (of a simulated run, a ``ChunkedSample``: its ``rows``
+    sample a chunk of ticks, its arrays are sampled whole when first read). ``ctrl`` row i holds the controls applied from ``t[i]``;
     the last row, after which no physics runs, the controls still held there. ``contacts``
     lists (tick, geom1, geom2, distance) of every contact seen at a tick's end. ``n`` may be
     shorter than planned when the run diverged.
@@ -117,7 +120,7 @@ class RunLog:
     sensordata: np.ndarray = _Logged()
     mocap_pos: np.ndarray = _Logged()
     mocap_quat: np.ndarray = _Logged()
-    reference: TrajectorySample | None = None
+    reference: TrajectorySample | ChunkedSample | None = None
     contacts: list = field(default_factory=list)
     warnings: dict = field(default_factory=dict)
     diverged_at: float | None = None
@@ -157,9 +160,7 @@ class RunLog:
         if self.file is None or self.held(name):
             value = getattr(self, name)
             return value if value is None else value[::stride]
-        parts = [part[name][-start % stride::stride].copy() for start, part in self.chunks([name])]
-        shape = () if name == "t" else tuple(self.file.shapes[name])
-        return np.concatenate(parts) if parts else np.zeros((0, *shape))
+        return self.file.every(name, stride)
 
 
 @dataclass
@@ -263,7 +264,7 @@ class Episode:
     context. ``start_episode`` makes it."""
 
     times: np.ndarray
-    reference: TrajectorySample
+    reference: ChunkedSample
     observation: dict
     context: ControlContext
     steps_per_tick: int
@@ -297,6 +298,24 @@ def controlled_views(setup: Setup):
     return data.ctrl[ids[0]:ids[-1] + 1], adr[adr >= 0]
 
 
+def stored_reference(trajectory, times: np.ndarray) -> ChunkedSample:
+    """``trajectory`` sampled at ``times``, a chunk of CHUNK_TICKS ticks at a time, each chunk
+    stored in a temporary log (``sims.logfile.temporary_writer``) and read back from it as it
+    is asked for: the run holds a chunk, whatever its length, and samples once, before its
+    first tick (a trajectory that cannot be sampled is bad input before any physics step)."""
+    sample = partial(sample_checked, trajectory)
+    writer = None
+    for start in range(0, times.size, CHUNK_TICKS):
+        part = sample(times[start:start + CHUNK_TICKS])
+        arrays = {name: np.asarray(getattr(part, name), dtype=float)
+                  for name in ("position", "velocity", "acceleration")}
+        if writer is None:
+            shapes = {name: value.shape[1:] for name, value in arrays.items()}
+            writer = temporary_writer(shapes, times, CHUNK_TICKS, prefix="planbench-reference-")
+        writer.append(arrays)
+    return ChunkedSample(sample, times, CHUNK_TICKS, None if writer is None else writer.read_back(times.size))
+
+
 def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     """Put ``setup`` at the start of its run: the task's episode (``Task.initialize_episode``:
     its sensors and disturbance seeded from ``seed``, default ``setup.provenance.seed``), then
@@ -306,7 +325,7 @@ def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     model, data = physics.model.ptr, physics.data.ptr
     k = steps_per_tick(model, task.control_dt)
     times = task.times()
-    reference = sample_checked(components.trajectory, times)
+    reference = stored_reference(components.trajectory, times)
     controller = components.controller
     check_controller(controller)
     observation = task.initialize_episode(physics, times, setup.provenance.seed if seed is None else seed)
@@ -454,9 +473,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     if temporary:  # the open file keeps the data until the log is dropped
         remove_quietly(log_path)
     if last < n - 1:
-        r = log.reference
-        log.reference = TrajectorySample(r.t[: last + 1], r.position[: last + 1],
-                                         r.velocity[: last + 1], r.acceleration[: last + 1])
+        log.reference = log.reference.head(last + 1)
     if not log.warnings:
         log.warnings = warning_counts(data)
     return log

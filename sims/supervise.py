@@ -126,10 +126,11 @@ def _child(work, board: _Board, write_fd: int, parent: int) -> None:
         # killed by the same Ctrl-C: a broken pipe) is its consequence, not a fault.
         if not signalled:
             signalled.append(signum)
-            raise KeyboardInterrupt
+            # SIGTERM: the parent's time limit (``_stop``); the log so far is kept.
+            raise RunStopped if signum == signal.SIGTERM else KeyboardInterrupt
 
     try:
-        from sims.outputs import INTERRUPT_SIGNALS
+        from sims.outputs import INTERRUPT_SIGNALS, RunStopped
 
         for s in INTERRUPT_SIGNALS:
             signal.signal(s, interrupted)

@@ -32,7 +32,7 @@ from typing import Any, Callable, Protocol, runtime_checkable
 import mujoco
 import numpy as np
 
-from planners.trajectory import Trajectory, TrajectorySample
+from planners.trajectory import ChunkedSample, Trajectory, TrajectorySample
 
 
 class PluginError(ValueError):
@@ -401,7 +401,9 @@ class ControlContext:
       trajectory: what the planner returned (loader, hexapod, FAST); None for the antenna,
         whose planner is online: its ideal joint path is computed from the true ship motion,
         which no controller can know.
-      reference: the trajectory sampled at every control tick (None with it).
+      reference: the trajectory sampled at every control tick (None with it): a
+        ``planners.trajectory.ChunkedSample``, whose ``rows(start, stop)`` samples those ticks
+        only and whose ``position``, ``velocity``, ``acceleration`` are the whole arrays.
       control_dt: the control period, s.
       command: the commands (``ctrl``) of the actuators this controller drives, in the
         order of ``actuators``: write it every tick, or return the vector from ``__call__``.
@@ -421,7 +423,7 @@ class ControlContext:
     nominal_physics: Callable
     problem: Any
     trajectory: Trajectory
-    reference: TrajectorySample
+    reference: TrajectorySample | ChunkedSample
     control_dt: float
     command: np.ndarray
     setpoint: np.ndarray

@@ -50,7 +50,7 @@ def estimate_errors(result, setup, skip_s: float = 2.0):
     for k, (body, name) in enumerate((("cabin", "cabin"), ("platform", "feed_platform"))):
         adr = model.jnt_qposadr[model.body_jntadr[model.body(name).id]]
         position, quat = log.qpos[start:n, adr:adr + 3], log.qpos[start:n, adr + 3:adr + 7]
-        estimate = setup.task.sensors.estimate_log[start:n, k]
+        estimate = setup.task.sensors.estimate_log(n).span("estimate", start, n)[:, k]
         position_error = np.linalg.norm(estimate[:, :3] - position, axis=1)
         attitude_error = (Rotation.from_matrix(estimate[:, 3:].reshape(-1, 3, 3))
                           * Rotation.from_quat(quat[:, [1, 2, 3, 0]]).inv()).magnitude()

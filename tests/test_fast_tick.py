@@ -113,10 +113,10 @@ def test_the_sensors_tick_reads_what_the_vectorized_one_did():
         np.testing.assert_array_equal(np.stack([obs["cabin_imu_gyro"], obs["platform_imu_gyro"]]), gyro)
         f = sensors.filters
         origins = f.position - np.einsum("bij,bj->bi", f.rotation, f.imu_offsets)
-        assert_same(sensors.estimate_log[tick, :, :3], origins, 400.0)
-        np.testing.assert_array_equal(sensors.estimate_log[tick, :, 3:], f.rotation.reshape(2, 9))
-        np.testing.assert_array_equal(obs["cabin_estimate_position"], sensors.estimate_log[tick, 0, :3])
-        np.testing.assert_array_equal(obs["platform_estimate_rotation"].ravel(), sensors.estimate_log[tick, 1, 3:])
+        assert_same(sensors.estimates.row("estimate", tick)[:, :3], origins, 400.0)
+        np.testing.assert_array_equal(sensors.estimates.row("estimate", tick)[:, 3:], f.rotation.reshape(2, 9))
+        np.testing.assert_array_equal(obs["cabin_estimate_position"], sensors.estimates.row("estimate", tick)[0, :3])
+        np.testing.assert_array_equal(obs["platform_estimate_rotation"].ravel(), sensors.estimates.row("estimate", tick)[1, 3:])
         np.testing.assert_array_equal(obs["platform_estimate_velocity"], f.velocity[1])
         np.testing.assert_array_equal(obs["ab_angles"], data.qpos[physics.ab_qpos])
         np.testing.assert_array_equal(obs["leg_positions"], data.qpos[physics.leg_qpos])
@@ -209,7 +209,8 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
         runs.append([model.actuator_gainprm[:, :3].copy(), model.actuator_biasprm[:, :3].copy(),
                      model.tendon_lengthspring.copy(), model.tendon_stiffness.copy(), model.tendon_damping.copy(),
                      model.body_mass.copy(), model.dof_damping.copy(), data.xfrc_applied.copy(),
-                     loads.tension_log.copy(), loads.force.copy(), data.qpos.copy()])
+                     loads.log(times.size).column("tension"), loads.log(times.size).column("force"),
+                     data.qpos.copy()])
     for ours, theirs in zip(*runs):
         np.testing.assert_array_equal(ours, theirs)
 

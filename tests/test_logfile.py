@@ -76,6 +76,45 @@ def test_every_row_arrives_at_every_chunk_boundary(tmp_path_factory, n, chunk, h
     assert rows == n
 
 
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(0, 30), chunk=st.integers(1, 7), start=st.integers(0, 35), length=st.integers(0, 35))
+def test_a_temporary_log_s_rows_and_spans(n, chunk, start, length):
+    """Rows written through ``row`` (a temporary log) read back; any span of them is the
+    whole array's slice; the file is gone once read back."""
+    writer = logfile.temporary_writer(SHAPES, np.arange(n) * 0.01, chunk=chunk)
+    for i in range(n):
+        writer.row("qpos", i)[:] = [i, -i, 0.5 * i]
+        writer.row("mocap_pos", i)[:] = np.arange(6).reshape(2, 3) + i
+    log = writer.read_back(n)
+    assert log.complete and log.n == n and not writer.path.exists()
+    for name in ("qpos", "mocap_pos", "act", "t"):
+        np.testing.assert_array_equal(log.span(name, start, start + length), log.column(name)[start:start + length])
+    np.testing.assert_array_equal(log.column("qpos")[:, 1], -np.arange(n))
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(1, 30), chunk=st.integers(1, 7), stride=st.integers(1, 5))
+def test_a_timeseries_copied_from_the_log_is_savez_s(tmp_path_factory, n, chunk, stride):
+    """timeseries.npz with the log's arrays copied a chunk at a time holds what
+    np.savez_compressed writes of the whole arrays, in the same order."""
+    writer = logfile.temporary_writer(SHAPES, np.arange(n) * 0.01, chunk=chunk)
+    for i in range(n):
+        writer.row("qpos", i)[:] = [i, -i, 0.5 * i]
+        writer.row("mocap_pos", i)[:] = np.arange(6).reshape(2, 3) * i
+    log = runner.RunLog(file=writer.read_back(n))
+    folder = tmp_path_factory.mktemp("npz")
+    names = ("t", "qpos", "act", "mocap_pos")
+    series = {"names": np.array(["a", "bc"]), "series": np.arange(7.0) / 3}
+    outputs.save_timeseries(folder / "streamed.npz", {**{k: outputs._StridedLog(log, k, stride) for k in names},
+                                                      **series})
+    np.savez_compressed(folder / "whole.npz", **{k: log.file.column(k)[::stride] for k in names}, **series)
+    streamed, whole = np.load(folder / "streamed.npz"), np.load(folder / "whole.npz")
+    assert list(streamed.keys()) == list(whole.keys())
+    for key in whole.keys():
+        assert streamed[key].dtype == whole[key].dtype
+        np.testing.assert_array_equal(streamed[key], whole[key])
+
+
 @pytest.mark.parametrize("n, chunk", [(1, 4), (4, 4), (8, 4), (9, 4)])
 def test_one_tick_one_chunk_and_chunk_multiples(tmp_path, n, chunk):
     _write(tmp_path / "log.arrow", n, chunk, 2)
@@ -236,6 +275,28 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
     full = runner.simulate(_setup(duration=log.n * 0.005))
     np.testing.assert_array_equal(log.column("qpos"), full.qpos[:log.n])
     np.testing.assert_array_equal(log.column("ctrl"), full.ctrl[:log.n])
+
+
+def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path):
+    """``planbench run --timeout``: the simulating process stopped at the limit (SIGTERM, then
+    its clean-up) leaves summary.json (completed false) and log.arrow, its whole chunks,
+    readable, incomplete, equal to the first rows of the same run completed."""
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.run([sys.executable, "-m", "sims.cli", "run", "loader-supply", "--duration", "300",
+                           "--timeout", "5", "--out", str(out), "--quiet"], env=env, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=180)
+    assert proc.returncode == 1, proc.stderr
+    assert "passed its time limit" in proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is False and summary["log"]["complete"] is False
+    log = read_log(out / "log.arrow")
+    assert not log.complete and log.n % logfile.CHUNK_TICKS == 0
+    assert summary["log"]["ticks"] == log.n
+    assert _staged_log(tmp_path) is None  # nothing left beside the output
+    if log.n:
+        full = runner.simulate(_setup(duration=log.n * 0.005))
+        np.testing.assert_array_equal(log.column("qpos"), full.qpos[:log.n])
 
 
 # ---------------------------------------------------------------- the disk-space refusal

@@ -113,6 +113,27 @@ def parked_command(physics: "FastPhysics", state) -> np.ndarray:
     return command
 
 
+#: Ticks of the plan's per-tick arrays the controller computes at a time (FastController
+#: holds one such block, whatever the run's length).
+PLAN_BLOCK_TICKS = 4096
+#: Ticks before the present one a block keeps: a fix's time lies a few ticks back.
+PLAN_HISTORY_TICKS = 256
+
+
+@dataclass
+class PlanRows:
+    """The controller's plan at the ticks ``start`` on (``FastController._plan_rows``)."""
+
+    start: int
+    state: object  # planners.fast.plan.FastPlanSample
+    l0_ff: np.ndarray
+    r_platform: np.ndarray
+    p_platform: np.ndarray
+    ab_reference: np.ndarray
+    ab_setpoint: np.ndarray
+    legs_plan: np.ndarray | None
+
+
 class FastController:
     """Winches, A-B rotator, multi-beam rotation and Stewart stabilizer (see the module doc).
 
@@ -141,14 +162,9 @@ class FastController:
                 raise ParamError(f"ControllerOptions.{name} = {getattr(o, name):g} Hz is not below half the "
                                  f"control rate, {0.5 / control_dt:g} Hz")
         nominal = context.nominal_physics()
-        self.state = state = fast_plan.reference_state(context.reference)
+        self.reference = context.reference
+        self.tower_tops = nominal.tower_tops
         specs = {s.name: s for s in context.sensors}
-        # Winch feed-forward: the unstretched lengths that give the planned chords under the
-        # planned tensions (stretch and sag).
-        self.l0_ff = winch_feedforward(state, nominal.tower_tops)
-        self.r_platform = np.einsum("nij,njk->nik", state.cabin_rotation,
-                                    fast.ab_rotation(state.theta_a, state.theta_b, g.alpha))
-        self.p_platform = state.feed - np.einsum("nij,j->ni", self.r_platform, g.r_s_feed)
         self.nominal_legs = fast.stewart_leg_lengths()
         # s between two total-station fixes (a whole number of ticks)
         fused = "platform_estimate" in specs
@@ -177,9 +193,7 @@ class FastController:
         self._leg_gain = control_dt / o.leg_integral_s
         self._leg_target = np.zeros(6)
         self.dt = control_dt
-        self.ab_reference = np.column_stack([state.theta_a, state.theta_b])
-        kp_ab, _ = nominal.drive_gains(self.ab_ids)
-        self.ab_setpoint = self.ab_reference - ab_gravity_torque(state) / kp_ab
+        self._kp_ab, _ = nominal.drive_gains(self.ab_ids)
         # The fused measurement system (sims.fast.measurement.FusedSensors): the cable loop on
         # the cabin's fused estimate at its fixes' rate, the stabilizer closed on the
         # platform's; otherwise the idealized pair of cabin-pose measurements.
@@ -189,19 +203,63 @@ class FastController:
         self.command = command = context.command
         # The tick's writes through views where the actuators are runs (FastPhysics' are).
         self._cables, self._ab, self._legs = index_view(self.cable_ids), index_view(self.ab_ids), index_view(self.leg_ids)
-        self._last_row = self.l0_ff.shape[0] - 1
+        self._last_row = self.reference.t.shape[0] - 1
         self._count_key = "cabin_rtk_count" if fused else "cabin_pose_ts_count"
+        self._load_plan(0)
         command[self.cable_ids] = self.l0_ff[0]
         command[self.ab_ids] = self.ab_setpoint[0]
         command[self.leg_ids] = 0.0
-        command[self.multifeed_id] = state.multifeed[0]
+        command[self.multifeed_id] = self.state.multifeed[0]
+
+    def _plan_rows(self, start: int, stop: int) -> PlanRows:
+        """The plan's per-tick arrays at the ticks ``start`` to ``stop`` (exclusive): the
+        reference's state (the cabin pose, A-B angles, tensions that go with it), the winch
+        feed-forward (the unstretched lengths that give the planned chords under the planned
+        tensions: stretch and sag), the platform's planned pose, the A-B angles and their
+        servo set-points (less the gravity droop), the legs' planned lengths (fused path)."""
+        g = fast.FAST
+        state = fast_plan.reference_state(self.reference.rows(start, stop))
+        r_platform = np.einsum("nij,njk->nik", state.cabin_rotation,
+                               fast.ab_rotation(state.theta_a, state.theta_b, g.alpha))
+        p_platform = state.feed - np.einsum("nij,j->ni", r_platform, g.r_s_feed)
+        ab_reference = np.column_stack([state.theta_a, state.theta_b])
+        legs_plan = None
+        if self.fused:
+            r_base = r_platform  # the base (AB) frame's planned rotation is the platform's
+            p_base = state.cabin_origin + np.einsum("nij,j->ni", state.cabin_rotation, g.ab_center)
+            position = np.einsum("nji,nj->ni", r_base, p_platform - p_base)
+            rotation = np.einsum("nji,njk->nik", r_base, r_platform)
+            legs_plan = leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
+                                    rotation) - self.nominal_legs
+        return PlanRows(start, state, winch_feedforward(state, self.tower_tops), r_platform, p_platform,
+                        ab_reference, ab_reference - ab_gravity_torque(state) / self._kp_ab, legs_plan)
+
+    def _load_plan(self, tick: int) -> None:
+        """Hold the plan's rows from PLAN_HISTORY_TICKS before ``tick`` to PLAN_BLOCK_TICKS
+        after it (the run's last row at most): the arrays the ticks index (``state``,
+        ``l0_ff``, ...) are these rows, tick ``i`` at row ``i - plan_start``."""
+        start = max(0, tick - PLAN_HISTORY_TICKS)
+        rows = self._plan_rows(start, min(tick + PLAN_BLOCK_TICKS, self._last_row + 1))
+        self.plan_start, self._plan_end = rows.start, rows.start + rows.l0_ff.shape[0]
+        self.state, self.l0_ff = rows.state, rows.l0_ff
+        self.r_platform, self.p_platform = rows.r_platform, rows.p_platform
+        self.ab_reference, self.ab_setpoint, self.legs_plan = rows.ab_reference, rows.ab_setpoint, rows.legs_plan
+
+    def _planned_cabin(self, tick: int):
+        """(origin (3,), rotation (3, 3)) of the planned cabin pose at ``tick``, which may lie
+        before the rows held (an old fix's time): then from the plan's row computed alone."""
+        row = tick - self.plan_start
+        if row >= 0:
+            s = self.state
+            return s.cabin_origin[row], s.cabin_rotation[row]
+        s = self._plan_rows(tick, tick + 1).state
+        return s.cabin_origin[0], s.cabin_rotation[0]
 
     def _cable_feedback(self, obs) -> None:
-        s = self.state
-        j = int(round(obs["cabin_pose_ts_time"][0] / self.dt))
+        origin, rotation = self._planned_cabin(int(round(obs["cabin_pose_ts_time"][0] / self.dt)))
         pos, rot = obs["cabin_pose_ts_position"], obs["cabin_pose_ts_rotation"]
         # Rotation error: the small rotation that turns the measured attitude to the planned one.
-        self._pid(np.concatenate([s.cabin_origin[j] - pos, vee(s.cabin_rotation[j] @ rot.T)]), self.pose_dt)
+        self._pid(np.concatenate([origin - pos, vee(rotation @ rot.T)]), self.pose_dt)
 
     def _pid(self, error: np.ndarray, dt: float) -> None:
         """The cable loop's pose correction from the cabin's pose error (6,) (planned less
@@ -216,17 +274,10 @@ class FastController:
         self.correction = o.kp * error + o.kd * self.derivative + o.ki * self.integral
 
     def _setup_fused(self, specs, control_dt: float) -> None:
-        """The fused path's plan and gains: the legs' planned lengths along the plan (the
-        planned platform pose in the planned base frame), the legs' Jacobian at the nominal
-        pose, dl = J dx for a platform motion dx = (dp, dtheta) in the base frame (J = -A^T,
+        """The fused path's gains (its plan, the legs' planned lengths: ``_plan_rows``): the
+        legs' Jacobian at the nominal pose, dl = J dx for a platform motion dx = (dp, dtheta) in the base frame (J = -A^T,
         A the structure matrix, planners.legs), and the integral gain 2 pi f dt."""
-        s, g = self.state, fast.FAST
-        r_base = np.einsum("nij,njk->nik", s.cabin_rotation, fast.ab_rotation(s.theta_a, s.theta_b, g.alpha))
-        p_base = s.cabin_origin + np.einsum("nij,j->ni", s.cabin_rotation, g.ab_center)
-        position = np.einsum("nji,nj->ni", r_base, self.p_platform - p_base)
-        rotation = np.einsum("nji,njk->nik", r_base, self.r_platform)
-        self.legs_plan = leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
-                                     rotation) - self.nominal_legs
+        g = fast.FAST
         self.platform_jacobian = -structure_matrix(fast.STEWART.base_anchors, fast.STEWART.platform_anchors,
                                                    g.r_ab_s, np.eye(3)).T
         self._platform_gain = 2 * math.pi * self.options.platform_bandwidth_hz * control_dt
@@ -236,9 +287,9 @@ class FastController:
     def _fused_cable_feedback(self, obs, tick: int) -> None:
         """Integral (and optional proportional-derivative) action on the cabin's fused
         estimate, at each GPS/RTK fix's arrival: the estimate of the present tick."""
-        s = self.state
+        s, row = self.state, tick - self.plan_start
         pos, rot = obs["cabin_estimate_position"], obs["cabin_estimate_rotation"]
-        self._pid(np.concatenate([s.cabin_origin[tick] - pos, vee(s.cabin_rotation[tick] @ rot.T)]),
+        self._pid(np.concatenate([s.cabin_origin[row] - pos, vee(s.cabin_rotation[row] @ rot.T)]),
                   self.cabin_fix_dt)
 
     def _fused_stewart_legs(self, obs, nxt: int) -> np.ndarray:
@@ -267,8 +318,12 @@ class FastController:
         self.command[self._legs] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
 
     def __call__(self, tick: int, obs) -> None:
-        s, command = self.state, self.command
         nxt = tick + 1 if tick < self._last_row else self._last_row
+        if nxt >= self._plan_end:
+            self._load_plan(tick)
+        s, command = self.state, self.command
+        # the plan's rows of this tick and the next (``_load_plan``)
+        row, nxt = tick - self.plan_start, nxt - self.plan_start
         count = int(obs[self._count_key][0])
         if count != self.seen:
             self.seen = count
@@ -278,12 +333,12 @@ class FastController:
                 self._cable_feedback(obs)
             # Cable lengths for the pose correction dx: dL = -A^T dx (planners.legs), at the
             # planned pose (it moves by millimetres between two updates).
-            a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[tick],
-                                 s.cabin_rotation[tick])
+            a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[row],
+                                 s.cabin_rotation[row])
             self.length_correction = -a.T @ self.correction
         command[self._cables] = self.l0_ff[nxt] + self.length_correction
         # A-B rotator: position servo with integral action on the encoder error.
-        self.ab_integral += self._ab_gain * (self.ab_reference[tick] - obs["ab_angles"])
+        self.ab_integral += self._ab_gain * (self.ab_reference[row] - obs["ab_angles"])
         command[self._ab] = self.ab_setpoint[nxt] + self.ab_integral
         command[self.multifeed_id] = s.multifeed[nxt]
         if self.fused:
@@ -301,9 +356,9 @@ class FastController:
         """Leg length changes (6,) that put the feed platform at its planned pose for the end of
         the tick, from the estimated cabin pose and the A-B encoders (inverse kinematics)."""
         s = self.state
-        j = int(round(obs["cabin_pose_time"][0] / self.dt))
+        origin, rotation = self._planned_cabin(int(round(obs["cabin_pose_time"][0] / self.dt)))
         pos, rot = obs["cabin_pose_position"], obs["cabin_pose_rotation"]
-        deviation = np.concatenate([pos - s.cabin_origin[j], vee(rot @ s.cabin_rotation[j].T)])
+        deviation = np.concatenate([pos - origin, vee(rot @ rotation.T)])
         alpha, beta = self._tracker_gains
         predicted = self.stewart_deviation + self.stewart_rate * self.dt
         residual = deviation - predicted

@@ -23,6 +23,7 @@ from sims.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICI
                                cable_drag_force, catenary_tension, chord_factor, end_fraction, index_view,
                                max_cable_segments,
                                moment_sum, node_mass_factor, tangent_stiffness)
+from sims.logfile import temporary_writer
 from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
 
 
@@ -173,9 +174,10 @@ class CableLoads:
         self.measured = measured
         self._directions = None
         self.speed = None
-        self.force = None  # (n, 3) wind force on cabin and cables, N (logged)
         self.tension = None  # (6,) the catenary tensions of the current tick, N
-        self.tension_log = None  # (n, 6) per tick, before the actuator's force clamp
+        # Per tick, streamed to a file of their own (``log``): "tension" (6,) N, before the
+        # actuator's force clamp; "force" (3,) N, the wind's on cabin and cables.
+        self.records = None
 
     def reset(self, physics: FastPhysics, times: np.ndarray, rng: np.random.Generator) -> None:
         if self.measured is None:
@@ -186,8 +188,7 @@ class CableLoads:
             if self._directions is not None:
                 self.direction = self._directions[0]
         self.still_air = not np.any(self.speed)  # the speeds are known for the whole run
-        self.force = np.zeros((times.size, 3))
-        self.tension_log = np.zeros((times.size, 6))
+        self.records = temporary_writer({"tension": (6,), "force": (3,)}, times, prefix="planbench-loads-")
         model, data = physics.model.ptr, physics.data.ptr
         self._model, self._data = model, data
         self._cables = physics.cable_ids
@@ -205,6 +206,12 @@ class CableLoads:
         self.tension = catenary_tension(chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60,
                                         ea=self.ea, weight=self.weight)
         self.apply(physics)
+
+    def log(self, rows: int):
+        """The per-tick records of the run's first ``rows`` ticks (a ``sims.logfile.LogFile``:
+        "tension" (rows, 6) N, "force" (rows, 3) N; a tick with no wind has zero force), their
+        file closed the first time."""
+        return self.records.read_back(rows)
 
     def _geometry(self):
         data = self._data
@@ -224,7 +231,7 @@ class CableLoads:
         t = catenary_tension(chord, l0, span, self.tension, iterations=1, ea=self.ea, weight=self.weight)
         self.tension = t
         if tick is not None:
-            self.tension_log[tick] = t
+            self.records.row("tension", tick)[:] = t
         k = tangent_stiffness(t, span, l0, self.ea, self.weight)
         g = chord_factor(t, span, self.ea, self.weight)
         ids = self._cables
@@ -242,7 +249,7 @@ class CableLoads:
             # Cables: the normal component of the wind on each chord, half the drag at the anchor.
             cable_drag = cable_drag_force(u * self.direction, vectors, 0.5 * chord)
             force, torque = self._cabin_drag(u)
-            self.force[tick] = cable_drag.sum(axis=0) + force
+            self.records.row("force", tick)[:] = cable_drag.sum(axis=0) + force
             anchor_force += cable_drag
         self._xfrc[:3] = anchor_force.sum(axis=0) + force
         self._xfrc[3:] = moment_sum(arms, anchor_force) + torque
@@ -396,7 +403,7 @@ class ChainCableLoads(CableLoads):
             model.tendon_lengthspring[self._passive] = rest[self._passive_cable, None]
             self.tension = np.maximum(self._k * (data.ten_length[self._first] - rest), 0.0)
         if tick is not None:
-            self.tension_log[tick] = self.tension
+            self.records.row("tension", tick)[:] = self.tension
         u = 0.0 if tick is None else float(self.speed[tick])
         scale = u * abs(u)  # drag goes with u |u|
         if u != 0.0:
@@ -405,7 +412,7 @@ class ChainCableLoads(CableLoads):
             else:
                 np.multiply(self._node_drag, scale, out=self._node_force)
                 data.xfrc_applied[self._node_ids, :3] = self._node_force
-            np.multiply(self._total_drag, scale, out=self.force[tick])
+            np.multiply(self._total_drag, scale, out=self.records.row("force", tick))
         np.add(self._static_wrench, scale * self._drag_wrench, out=self._xfrc)
 
     def _refresh(self, rest: np.ndarray) -> None:

@@ -42,6 +42,7 @@ import scipy.signal
 
 from planners.rotations import skew, vee
 from sims.fast.physics import CONTROL_DT, PHYSICS_DT, index_view, moment_sum
+from sims.logfile import temporary_writer
 from sims.params import ParamError, Params, param
 from sims.task import Sensors, SensorSpec
 
@@ -320,6 +321,58 @@ def steady_state_gain(phi: np.ndarray, g: np.ndarray, white: np.ndarray, walk: n
     r = np.diag(np.maximum(measurement_var, VARIANCE_FLOOR))
     p = scipy.linalg.solve_discrete_are(phi_m.T, h.T, q_m, r)
     return p @ h.T @ np.linalg.inv(h @ p @ h.T + r)
+
+
+class ImuErrors:
+    """The two IMUs' errors at each of a run's ``n`` ticks, (2, 3) a tick: white noise
+    (``white`` 1 sigma), plus a turn-on bias (``bias``), plus a random walk (steps of ``walk``
+    1 sigma), drawn from ``rng`` as ``normal(0, white, (n, 2, 3)) + normal(0, bias, (1, 2, 3))
+    + cumsum(normal(0, walk, (n, 2, 3)), axis=0)`` draws them (the same numbers, ``rng`` left
+    where those draws leave it), made IMU_BLOCK_TICKS ticks at a time as the ticks are read in
+    order (``errors[tick]``): a run holds one block, whatever its length."""
+
+    def __init__(self, rng: np.random.Generator, n: int, white: float, bias: float, walk: float):
+        self.n, self.white, self.walk = n, white, walk
+        self._white_rng = self._skip(rng, n, white)  # a copy at the white noise's first draw
+        self.bias = rng.normal(0.0, bias, (1, 2, 3))
+        self._walk_rng = self._skip(rng, n, walk)
+        self._walk_sum = np.zeros((1, 2, 3))  # the walk at the last tick made
+        self.start, self._rows = 0, np.zeros((0, 2, 3))
+
+    @staticmethod
+    def _skip(rng: np.random.Generator, n: int, sigma: float) -> np.random.Generator:
+        """A copy of ``rng`` as it is, and ``rng`` moved past n ticks' draws (a block at a time)."""
+        copy = np.random.Generator(type(rng.bit_generator)())
+        copy.bit_generator.state = rng.bit_generator.state
+        for start in range(0, n, IMU_BLOCK_TICKS):
+            rng.normal(0.0, sigma, (min(IMU_BLOCK_TICKS, n - start), 2, 3))
+        return copy
+
+    def __getitem__(self, tick: int) -> np.ndarray:
+        row = tick - self.start
+        if row < 0 or row >= self._rows.shape[0]:
+            self._advance(tick)
+            row = tick - self.start
+        return self._rows[row]
+
+    def _advance(self, tick: int) -> None:
+        end = self.start + self._rows.shape[0]
+        if not end <= tick < self.n:
+            raise IndexError(f"IMU errors are made in tick order: tick {tick} after ticks up to {end - 1} "
+                             f"of {self.n}")
+        while True:  # (ticks skipped are made and dropped: the draws stay in order)
+            m = min(IMU_BLOCK_TICKS, self.n - end)
+            steps = self._walk_rng.normal(0.0, self.walk, (m, 2, 3))
+            walk = np.cumsum(np.concatenate([self._walk_sum, steps]), axis=0)[1:]
+            self._walk_sum = walk[-1:]
+            self._rows = (self._white_rng.normal(0.0, self.white, (m, 2, 3)) + self.bias) + walk
+            self.start, end = end, end + m
+            if tick < end:
+                return
+
+
+#: Ticks of IMU errors made at a time (ImuErrors).
+IMU_BLOCK_TICKS = 4096
 
 
 def gauss_markov(rng: np.random.Generator, shape: tuple, sigma: float, correlation_s: float, dt: float) -> np.ndarray:
@@ -649,13 +702,12 @@ class FusedSensors(Sensors):
         n = times.size
         self._data = data = physics.data.ptr
         rng = np.random.default_rng([seed, 0xFA58])
-        shape = (n, 2, 3)
         # IMU errors per tick: white noise, and a bias = turn-on + random walk.
         dt = self.dt
-        self.accel_error = (rng.normal(0.0, o.imu_accel_noise / math.sqrt(dt), shape) + rng.normal(0.0, o.imu_accel_bias, (1, 2, 3))
-                            + np.cumsum(rng.normal(0.0, o.imu_accel_bias_walk * math.sqrt(dt), shape), axis=0))
-        self.gyro_error = (rng.normal(0.0, o.imu_gyro_noise / math.sqrt(dt), shape) + rng.normal(0.0, o.imu_gyro_bias, (1, 2, 3))
-                           + np.cumsum(rng.normal(0.0, o.imu_gyro_bias_walk * math.sqrt(dt), shape), axis=0))
+        self.accel_error = ImuErrors(rng, n, o.imu_accel_noise / math.sqrt(dt), o.imu_accel_bias,
+                                     o.imu_accel_bias_walk * math.sqrt(dt))
+        self.gyro_error = ImuErrors(rng, n, o.imu_gyro_noise / math.sqrt(dt), o.imu_gyro_bias,
+                                    o.imu_gyro_bias_walk * math.sqrt(dt))
         # Fix errors per fix (rows: fixes; points; coordinates): white, common slow, per-point slow.
         self.fix_error = {}
         for b in self.BODIES:
@@ -667,7 +719,8 @@ class FusedSensors(Sensors):
                                  + gauss_markov(rng, (m, 3, 3), point, tau, fix_dt))
         self._last_velocity = np.zeros((2, 3))
         self.pending = {b: deque() for b in self.BODIES}  # (arrival tick, points (3, 3), taken at tick)
-        self.estimate_log = np.zeros((n, 2, 12))  # per tick: position (3) and rotation (9) of each body
+        # Per tick: position (3) and rotation (9) of each body, streamed to a file of its own.
+        self.estimates = temporary_writer({"estimate": (2, 12)}, times, prefix="planbench-estimates-")
         obs = {}
         # The readings of both bodies in (2, ...) arrays; the observation's arrays are views.
         self._accel, self._gyro = np.zeros((2, 3)), np.zeros((2, 3))
@@ -714,6 +767,12 @@ class FusedSensors(Sensors):
         self(0, physics)
         return obs
 
+    def estimate_log(self, rows: int):
+        """The estimates of the run's first ``rows`` ticks (a ``sims.logfile.LogFile`` whose
+        array ``estimate`` is (rows, 2, 12): per tick the position (3) and rotation (9) of each
+        body), their file closed the first time."""
+        return self.estimates.read_back(rows)
+
     def __call__(self, tick: int, physics) -> None:
         data, dt = self._data, self.dt
         # The IMUs: the tick's specific force from the velocity increment, and the rate, in
@@ -758,7 +817,7 @@ class FusedSensors(Sensors):
                 count_obs[0] += 1
         (cabin, platform), (cabin_rotation, platform_rotation) = f.body_origins(), f._rotation
         self._estimate_flat[:] = cabin + cabin_rotation + platform + platform_rotation
-        self.estimate_log[tick] = self._estimate
+        self.estimates.row("estimate", tick)[:] = self._estimate
         cabin, platform = f._velocity
         self._velocity_flat[:] = cabin + platform
         self._time[0] = tick * dt
@@ -782,32 +841,41 @@ def make_sensors(physics, options: SensorOptions, control_dt: float = CONTROL_DT
 
 
 def floats_per_tick(options: SensorOptions, control_dt: float = CONTROL_DT) -> float:
-    """Doubles per control tick that the sensors of ``options`` preallocate. Ideal: the true
-    cabin pose (3 + 9) and the noise of their two measurements (2 x (3 + 9)). Fused: the IMUs'
-    errors (2 x (3 + 3)), the estimates' log (2 x 12), and the fixes' errors (9 a fix, and one
-    fix more per body: a run has n // every + 1)."""
+    """Doubles per control tick that the sensors of ``options`` keep, in memory or in a file.
+    Ideal: the true cabin pose (3 + 9) and the noise of their two measurements (2 x (3 + 9)).
+    Fused: the fixes' errors (9 a fix, and one fix more per body: a run has n // every + 1) and
+    the estimates' log (2 x 12), streamed to a file of its own (``FusedSensors.estimates``);
+    the IMUs' errors are made a block of ticks at a time (``ImuErrors``)."""
     if options.system == "ideal":
         return 36.0
     fixes = sum(1.0 / _ticks(1.0 / rate, control_dt, 1) for rate in (options.rtk_rate_hz, options.ts_rate_hz))
-    return 12.0 + 24.0 + 9.0 * fixes + 1.0
+    return 24.0 + 9.0 * fixes + 1.0
 
 
-def estimate_errors(sensors: FusedSensors, physics, qpos: np.ndarray) -> dict:
-    """The fused estimates' RMS errors against the true bodies over a run's logged ``qpos``
-    (n, nq) (all rows but the last, where no sensor read): {"cabin_mm", "cabin_deg",
-    "platform_mm", "platform_deg"}; position of the body frame's origin, attitude the angle
-    of the estimated rotation times the true one's inverse."""
+def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
+    """The fused estimates' RMS errors against the true bodies over a run's log (a
+    ``sims.runner.RunLog``; all rows but the last, where no sensor read), read a chunk at a
+    time: {"cabin_mm", "cabin_deg", "platform_mm", "platform_deg"}; position of the body
+    frame's origin, attitude the angle of the estimated rotation times the true one's
+    inverse."""
     from scipy.spatial.transform import Rotation
 
     model = physics.model.ptr
-    n = qpos.shape[0] - 1
+    n = log.n - 1
+    estimates = sensors.estimate_log(n)
+    bodies = (("cabin", "cabin"), ("platform", "feed_platform"))
+    adrs = [model.jnt_qposadr[model.body_jntadr[model.body(name).id]] for _, name in bodies]
+    position, attitude = [[], []], [[], []]  # per body, per chunk: the ticks' errors, m and rad
+    for start, rows in log.chunks(["qpos"]):
+        qpos = rows["qpos"][:max(n - start, 0)]
+        estimate = estimates.span("estimate", start, start + qpos.shape[0])
+        for k, adr in enumerate(adrs):
+            position[k].append(np.linalg.norm(estimate[:, k, :3] - qpos[:, adr:adr + 3], axis=1))
+            attitude[k].append((Rotation.from_matrix(estimate[:, k, 3:].reshape(-1, 3, 3))
+                                * Rotation.from_quat(qpos[:, adr + 3:adr + 7], scalar_first=True).inv()).magnitude())
     out = {}
-    for k, (body, name) in enumerate((("cabin", "cabin"), ("platform", "feed_platform"))):
-        adr = model.jnt_qposadr[model.body_jntadr[model.body(name).id]]
-        estimate = sensors.estimate_log[:n, k]
-        position = np.linalg.norm(estimate[:, :3] - qpos[:n, adr:adr + 3], axis=1)
-        attitude = (Rotation.from_matrix(estimate[:, 3:].reshape(-1, 3, 3))
-                    * Rotation.from_quat(qpos[:n, adr + 3:adr + 7], scalar_first=True).inv()).magnitude()
-        out[f"{body}_mm"] = 1e3 * float(np.sqrt(np.mean(position**2)))
-        out[f"{body}_deg"] = float(np.degrees(np.sqrt(np.mean(attitude**2))))
+    for k, (body, _) in enumerate(bodies):
+        p, a = np.concatenate(position[k]), np.concatenate(attitude[k])
+        out[f"{body}_mm"] = 1e3 * float(np.sqrt(np.mean(p**2)))
+        out[f"{body}_deg"] = float(np.degrees(np.sqrt(np.mean(a**2))))
     return out

@@ -212,18 +212,16 @@ WIND_AZIMUTH_DEG = 0.0
 #: lumped straight cables have their lowest at 0.30 Hz). models/fast/README.md, "The cables".
 DEFAULT_CABLE_SEGMENTS = 2
 
-#: Doubles per tick that a FAST run preallocates besides the runner's log and its sensors: the
-#: controller's plan state at every tick (FastPlanSample less its t: 53, of which the feed, its
-#: velocity and acceleration and the multi-feed angle, 10, are views of the reference: 43), its
-#: winch feed-forward (6), platform rotation and position (9 + 3), A-B reference and set-point
-#: (2 + 2), the fused stabilizer's planned legs (6): 71; the plant's wind speed, wind force and
-#: catenary tensions (1 + 3 + 6).
-PER_TICK_FLOATS = 71 + 10
+#: Doubles per tick that a FAST run keeps besides the runner's log and its sensors' records: the
+#: plant's wind speed (1, in memory), wind force and catenary tensions (3 + 6, streamed to a
+#: file of their own: sims.fast.loads.CableLoads.log). (The controller holds its plan's per-tick
+#: arrays a block of ticks at a time: sims.fast.controller.PLAN_BLOCK_TICKS.)
+PER_TICK_FLOATS = 10
 
 
 def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: SensorOptions = SensorOptions(),
                        control_dt: float = CONTROL_DT) -> float:
-    """Bytes a FAST run preallocates per control tick: the runner's log of the compiled model
+    """Bytes a FAST run keeps per control tick, in memory or on disk: the runner's log of the compiled model
     (13 planned channels; the discretized cables add their nodes' joints), PER_TICK_FLOATS and
     the sensors' (``sims.fast.measurement.floats_per_tick``)."""
     return run_limits.floats(run_limits.runlog_floats_per_tick(_compiled(cable_segments), len(fp.PLAN_LABELS))

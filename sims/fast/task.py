@@ -225,11 +225,13 @@ def observing_mask(plan: fp.FastPlan, segment_index: np.ndarray) -> np.ndarray:
     return observing[segment_index]
 
 
-def _hold_last(per_tick: np.ndarray, n: int) -> np.ndarray:
-    """The first n rows of a per-tick log of the plant's loads, the last one held: the runner
-    applies no loads after its last tick."""
-    out = per_tick[:n].copy()
-    out[n - 1] = out[max(n - 2, 0)]
+def _hold_last_every(log, name: str, n: int, stride: int) -> np.ndarray:
+    """Rows 0, stride, 2 stride, ... of the first n rows of a per-tick log of the plant's loads
+    (a ``sims.logfile.LogFile`` of n rows), the last one held: the runner applies no loads
+    after its last tick."""
+    out = log.every(name, stride)
+    if (n - 1) % stride == 0:
+        out[-1] = log.span(name, max(n - 2, 0), max(n - 2, 0) + 1)[0]
     return out
 
 
@@ -277,9 +279,10 @@ class FastEvaluation:
         # commands; the plant's tower tops may differ).
         towers = p.tower_tops if self.planned_tower_tops is None else self.planned_tower_tops
         unstretched = winch_feedforward(state, towers)
-        law = self.loads.tension_log[start:start + m].copy()
+        loads = self.loads.log(n)
+        law = loads.span("tension", start, start + m)
         if start + m == n:  # the runner applies no loads after its last tick: the last one held
-            law[m - 1] = self.loads.tension_log[max(n - 2, 0)]
+            law[m - 1] = loads.span("tension", max(n - 2, 0), max(n - 2, 0) + 1)[0]
         return {
             "feed_goal": goal_feed,
             "feed_planned": reference.position[:, :3],
@@ -321,9 +324,7 @@ class FastEvaluation:
 
         for start, rows in log.chunks(("t", "sensordata", "qpos", "qvel", "act", "ctrl", "actuator_force")):
             m = rows["t"].shape[0]
-            reference = type(r)(r.t[start:start + m], r.position[start:start + m], r.velocity[start:start + m],
-                                r.acceleration[start:start + m])
-            s = self._rows_series(rows, reference, start, n)
+            s = self._rows_series(rows, r.rows(start, start + m), start, n)
             for key in scalars:
                 scalars[key].append(s[key])
             for key, value in s.items():
@@ -410,14 +411,13 @@ class FastEvaluation:
             "ab_error_max_arcsec": ab_error.round(2).tolist(),
             "stewart_leg_max_mm": 1e3 * float(ext["leg_abs"][0]),
         })
-        if isinstance(self.sensors, FusedSensors):  # (qpos read whole for this, then let go)
-            qpos = log.file.column("qpos") if log.file is not None and not log.held("qpos") else log.qpos
-            metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, qpos)
-            del qpos
+        if isinstance(self.sensors, FusedSensors):
+            metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, log)
         if self.loads.mean_speed > 0:
             wind = self.loads.speed[:n]
-            metrics.update({"wind_speed_std_m_s": float(np.std(wind)),
-                            "wind_force_peak_N": float(np.linalg.norm(self.loads.force[:n], axis=1).max())})
+            peak = max(float(np.linalg.norm(part["force"], axis=1).max(initial=0.0))
+                       for part in self.loads.log(n).chunks(["force"]))  # (the max of the chunks' maxima)
+            metrics.update({"wind_speed_std_m_s": float(np.std(wind)), "wind_force_peak_N": peak})
         return checks, metrics
 
     def timeseries(self, log: RunLog) -> dict:
@@ -445,7 +445,7 @@ class FastEvaluation:
         }
         if self.loads.mean_speed > 0:
             out["wind_speed"] = self.loads.speed[:n][::self.stride]
-            out["wind_force"] = _hold_last(self.loads.force, n)[::self.stride]
+            out["wind_force"] = _hold_last_every(self.loads.log(n), "force", n, self.stride)
         return out
 
     def report(self, log: RunLog, checks, path) -> None:
