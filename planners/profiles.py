@@ -62,7 +62,7 @@ u0 and u1). For a rest-to-rest move this is v = (a T - sqrt(a^2 T^2 - 8 a d)) / 
 cruise speed (hence the lowest peak speed, the gentlest on the speed limit) of any profile of
 the family with that duration and distance: a weaker pulse leaves less time to cruise and needs
 a faster cruise. The other natural choice, the lowest peak acceleration (the Rubin hexapod's
-rule, planners.hexapod), gives the opposite, the highest cruise speed; it is not used here.
+rule, planbench.planners.hexapod), gives the opposite, the highest cruise speed; it is not used here.
 A move with nonzero boundary speeds can also be too slow: slowing down (to rest at the most) and
 speeding up again covers at least h(v_lowest) (``LimitError``; the profiles never reverse).
 
@@ -75,7 +75,7 @@ API
 * ``Profile(durations, accel, p0=0, v0=0, label="s")``: piece durations (s) and the
   acceleration at every break (m/s^2), linear in between; ``Profile.from_breaks``. ``duration``,
   ``evaluate(t, side)`` -> ``ProfileSample`` (position, velocity, acceleration, jerk, shaped as
-  t), ``sample(t)`` -> ``planners.trajectory.TrajectorySample`` with (n, 1) arrays (a
+  t), ``sample(t)`` -> ``planbench.planners.trajectory.TrajectorySample`` with (n, 1) arrays (a
   single-channel ``Trajectory``), ``then``/``concatenate`` (end to end), ``with_start``.
 * ``velocity_change(v0, v1, a_max)``, ``cruise(velocity, duration)``,
   ``min_move_time(distance, v_max, a_max, v0=0, v1=0)`` (s),
@@ -87,7 +87,7 @@ planned on the limit. A pulse shorter than the resolution of the absolute break 
 ``move_in_time``'s duration is exact to the last bit where the sum of the pieces allows it (the
 round-off of the sum is moved into the longest piece).
 Every number given (distances, speeds, limits, durations, accelerations, sample times) must be
-finite and within +/-``planners.trajectory.MAX_MAGNITUDE``, and so must a profile's break
+finite and within +/-``planbench.planners.trajectory.MAX_MAGNITUDE``, and so must a profile's break
 times, positions, velocities and jerks (a ``PlanningError`` names the value and the limit).
 """
 
@@ -98,8 +98,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.errors import LimitError, PlanningError
-from planners.trajectory import TrajectorySample, check_values, fmt_number, sample_times
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.trajectory import TrajectorySample, check_values, fmt_number, sample_times
 
 __all__ = [
     "Profile",
@@ -287,7 +287,7 @@ class Profile:
     def sample(self, t) -> TrajectorySample:
         """The Trajectory protocol: t (n,) s -> (n, 1) position, velocity, acceleration.
 
-        ``t``: a number or a 1-D array of finite times (``planners.trajectory.sample_times``).
+        ``t``: a number or a 1-D array of finite times (``planbench.planners.trajectory.sample_times``).
         """
         t = sample_times(t)
         s = self.evaluate(t)
@@ -469,7 +469,7 @@ _fmt = fmt_number  # a number as Python writes a float (no ``np.float64(...)``)
 
 
 def _finite(name: str, value, unit: str) -> float:
-    """One finite number within +/-MAX_MAGNITUDE (``planners.trajectory.check_values``)."""
+    """One finite number within +/-MAX_MAGNITUDE (``planbench.planners.trajectory.check_values``)."""
     try:
         x = float(value)
     except (TypeError, ValueError):

@@ -24,7 +24,7 @@ from typing import Callable, Protocol, Sequence, runtime_checkable
 
 import numpy as np
 
-from planners.errors import PlanningError
+from planbench.planners.errors import PlanningError
 
 #: The largest magnitude a planner accepts for any input number (module docstring).
 MAX_MAGNITUDE = 1e150
@@ -73,7 +73,7 @@ class ChunkedSample:
         self._held = (0, None)  # (first row, TrajectorySample) of the rows sampled last
         self._whole = None
         # Rows sampled once and read back: an object with ``span(name, start, stop)`` (a
-        # sims.logfile.LogFile of arrays position, velocity, acceleration), or None.
+        # planbench.logfile.LogFile of arrays position, velocity, acceleration), or None.
         self.stored = stored
 
     def rows(self, start: int, stop: int) -> TrajectorySample:

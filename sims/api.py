@@ -1,21 +1,21 @@
 """planbench from Python: run a scenario with your own planner or controller objects.
 
-    from sims import api
+    from planbench import api
 
     result = api.run("loader-supply", controller=MyController(), params={"seed": 1, "payload_mass": 50.0})
     print(result.passed, [(c.name, c.value, c.limit) for c in result.checks])
 
-What the objects must provide is the Task contract (``sims.task``): a controller has
+What the objects must provide is the Task contract (``planbench.task``): a controller has
 ``reset(context)`` and ``__call__(tick, observation)``; a planner ``plan(problem)`` returning a
-``planners.trajectory.Trajectory`` (the antenna's: ``reset(problem)`` and
+``planbench.planners.trajectory.Trajectory`` (the antenna's: ``reset(problem)`` and
 ``step(t, attitude)``). ``planbench run NAME --controller MODULE:FACTORY`` does the same from
-the command line (``sims.plugins``).
+the command line (``planbench.plugins``).
 """
 
 from __future__ import annotations
 
-from sims import outputs, pipeline, runner, scenarios
-from sims.task import check_controller, check_planner
+from planbench import outputs, pipeline, runner, scenarios
+from planbench.task import check_controller, check_planner
 
 
 def run(scenario: str, *, planner=None, controller=None, params=None, plant=None,
@@ -37,8 +37,8 @@ def run(scenario: str, *, planner=None, controller=None, params=None, plant=None
       quiet: no progress bars.
 
     Raises:
-      sims.task.PluginError: a planner or controller that breaks the Task contract (before
-        anything runs), sims.params.ParamError (a ValueError) for bad parameters. A
+      planbench.task.PluginError: a planner or controller that breaks the Task contract (before
+        anything runs), planbench.params.ParamError (a ValueError) for bad parameters. A
         controller that raises during the run does not raise here: the run ends and its
         ``controller_errors`` check fails with the message.
     """

@@ -31,7 +31,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from sims import pipeline, scenarios
+from planbench import pipeline, scenarios
 
 REPEATS = 5
 
@@ -47,7 +47,7 @@ def best_time(function, repeats: int = REPEATS):
 
 
 def benchmarks() -> list[tuple[str, int]]:
-    """(scenario, runs) of every scenario tagged "benchmark" (sims.scenarios), with its
+    """(scenario, runs) of every scenario tagged "benchmark" (planbench.scenarios), with its
     mechanism's ``benchmark_runs``."""
     return [(s.name, record.benchmark_runs) for record in scenarios.mechanisms()
             for s in record.tagged(scenarios.BENCHMARK)]
@@ -176,7 +176,7 @@ elevation = [30.0, 90.0]
 def campaign_throughput(repeats: int = 2) -> list[dict]:
     """Runs per second of the same 8-run campaign (CAMPAIGN_SPEC) on the local engine with 1
     and 2 workers and on Ray with 2 CPUs, each timed from the first run sent to the last row
-    written (sims.campaign.Outcome.engine_wall_s), on engines in two states:
+    written (planbench.campaign.Outcome.engine_wall_s), on engines in two states:
 
       started  the engine's workers start with the campaign: a local campaign's own pool, as
                ``planbench sweep`` starts it (once the spec is read; what is left of the
@@ -193,8 +193,8 @@ def campaign_throughput(repeats: int = 2) -> list[dict]:
     import contextlib
     import tempfile
 
-    from sims import campaign
-    from sims.campaign.engines import LocalEngine, ray_available
+    from planbench import campaign
+    from planbench.campaign.engines import LocalEngine, ray_available
 
     outcomes: dict = {}
     with tempfile.TemporaryDirectory(prefix="planbench-bench-") as tmp:
@@ -278,7 +278,7 @@ def planner_only_throughput(workers: int = 2, samples: int = PLAN_SAMPLES) -> di
     skipped rows)."""
     import tempfile
 
-    from sims import campaign
+    from planbench import campaign
 
     text = re.sub(r"(?m)^samples = .*$", f"samples = {samples}", PLAN_CAMPAIGN.read_text())
     with tempfile.TemporaryDirectory(prefix="planbench-bench-") as tmp:
@@ -306,7 +306,7 @@ SIX_HOURS_S = 6 * 3600.0
 #: The child that ``peak_memory`` runs: the command line, which writes at its exit the larger of
 #: its own memory's high-water mark (VmHWM, of its own address space: ru_maxrss of an exec'd
 #: child would count the pages it held, as its parent's fork, before exec) and that of the
-#: processes it forked and reaped (the run itself runs in one: sims.supervise).
+#: processes it forked and reaped (the run itself runs in one: planbench.supervise).
 _PEAK_CHILD = """\
 import atexit, resource, sys
 
@@ -320,7 +320,7 @@ def _peak():
     sys.stderr.write(f"PEAK_KB {max(own, forked)}\\n")
 
 atexit.register(_peak)
-from sims.cli import main
+from planbench.cli import main
 sys.exit(main(sys.argv[1:]))
 """
 

@@ -25,7 +25,7 @@ import sys
 import threading
 from pathlib import Path
 
-import sims  # noqa: F401  (chooses the OpenGL back end before mujoco is imported)
+import planbench  # noqa: F401  (chooses the OpenGL back end before mujoco is imported)
 
 EXIT_OK, EXIT_CHECK_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -86,8 +86,8 @@ def _flag(name: str) -> str:
 
 def scenario_parser(command: str, scenario, source: str) -> argparse.ArgumentParser:
     """The parser of ``planbench run|plan SOURCE``: the scenario's own parameters as flags,
-    derived from their declarations (sims.params), and ``--set KEY=VALUE`` for any of them."""
-    from sims.params import describe
+    derived from their declarations (planbench.params), and ``--set KEY=VALUE`` for any of them."""
+    from planbench.params import describe
 
     cls = type(scenario.params)
     scalar = [d for d in cls.declarations() if d[1].scalar]
@@ -143,8 +143,8 @@ NAME is a scenario of `planbench list`; FILE.toml a scenario file (scenario = NA
 def _resolve_source(command: str, argv: list[str]):
     """(Source, parsed options, resolved params, resolved plant) of ``planbench run|plan
     SOURCE ...``; ``--set plant.KEY=VALUE`` sets a field of the plant's uncertainty."""
-    from sims import scenarios, scenario_files
-    from sims.params import ParamError, set_overrides
+    from planbench import scenarios, scenario_files
+    from planbench.params import ParamError, set_overrides
 
     get, names = ((scenarios.get, scenarios.SCENARIOS) if command == "run" else
                   (scenarios.get_plan, {**scenarios.SCENARIOS, **scenarios.PLANS}))
@@ -175,7 +175,7 @@ def _resolve_source(command: str, argv: list[str]):
 
 
 def cmd_list(args) -> int:
-    from sims.scenarios import SCENARIOS
+    from planbench.scenarios import SCENARIOS
 
     width = max(len(n) for n in SCENARIOS)
     for s in SCENARIOS.values():
@@ -218,7 +218,7 @@ def _scenario_help(command: str, argv: list[str]) -> int | None:
 
 
 def _timeout(raw: str | None) -> float | None:
-    """``--timeout SECONDS``: a finite number > 0 (None: the default, sims.supervise)."""
+    """``--timeout SECONDS``: a finite number > 0 (None: the default, planbench.supervise)."""
     if raw is None:
         return None
     try:
@@ -237,12 +237,12 @@ def _plugin_names(plugins: dict) -> str:
 def _write_unfinished(out, scenario, params, plugins: dict, check, partial=None) -> None:
     """summary.json of a run that did not complete (it hung or its process ended): passed
     false, the one check that says why; no timeseries. ``partial``: the log the run had
-    streamed when it ended (``sims.outputs.partial_log``), moved in as log.arrow: it has
-    no footer and reads as incomplete (``sims.logfile.read_log``)."""
+    streamed when it ended (``planbench.outputs.partial_log``), moved in as log.arrow: it has
+    no footer and reads as incomplete (``planbench.logfile.read_log``)."""
     import json
 
-    from sims.logfile import LOG_FILE, read_log
-    from sims.outputs import software_versions
+    from planbench.logfile import LOG_FILE, read_log
+    from planbench.outputs import software_versions
 
     summary = {"scenario": scenario.name, "passed": False, "seed": getattr(params, "seed", None),
                "completed": False, "parameters": params.to_dict(), "versions": software_versions(),
@@ -263,9 +263,9 @@ def _write_unfinished(out, scenario, params, plugins: dict, check, partial=None)
 
 
 def cmd_run(argv: list[str]) -> int:
-    from sims import outputs, pipeline, supervise
-    from sims import plugins as plugins_module
-    from sims.checks import Check
+    from planbench import outputs, pipeline, supervise
+    from planbench import plugins as plugins_module
+    from planbench.checks import Check
 
     shown = _scenario_help("run", argv)
     if shown is not None:
@@ -330,7 +330,7 @@ def cmd_run(argv: list[str]) -> int:
 
 
 def cmd_plan(argv: list[str]) -> int:
-    from sims import outputs, plans
+    from planbench import outputs, plans
 
     shown = _scenario_help("plan", argv)
     if shown is not None:
@@ -344,7 +344,7 @@ def cmd_plan(argv: list[str]) -> int:
 
 
 def cmd_bench(args) -> int:
-    from sims import bench
+    from planbench import bench
 
     print(bench.format_table(bench.run_all()))
     for text in bench.planner_benchmarks():
@@ -359,8 +359,8 @@ def cmd_bench(args) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from sims import campaign
-    from sims.params import ParamError
+    from planbench import campaign
+    from planbench.params import ParamError
 
     out = args.out if args.out is not None else Path("results") / Path(args.spec).stem
     try:
@@ -368,7 +368,7 @@ def cmd_sweep(args) -> int:
                                  rerun_worst=args.rerun_worst, quiet=args.quiet)
     except ParamError as e:
         raise BadInput(str(e)) from None
-    from sims.campaign.report import format_summary
+    from planbench.campaign.report import format_summary
 
     print(format_summary(outcome.summary))
     o = outcome.summary["overall"]
@@ -379,17 +379,17 @@ def cmd_sweep(args) -> int:
 
 
 def _demo_root(raw: str) -> Path:
-    """The demo's directory: validated as a run's output is (sims.outputs.OutputRoot: never
+    """The demo's directory: validated as a run's output is (planbench.outputs.OutputRoot: never
     the root, the current or the home directory, nor one holding files planbench did not
     write), created if missing, never replaced itself (only the scenarios' directories
     inside it are)."""
-    from sims import outputs, scenarios
+    from planbench import outputs, scenarios
 
     return outputs.OutputRoot(raw, "demo --out", inner=tuple(s.name for s in scenarios.tagged(scenarios.DEMO))).path
 
 
 def cmd_demo(args) -> int:
-    from sims import outputs, pipeline, scenarios
+    from planbench import outputs, pipeline, scenarios
 
     root = _demo_root(args.out)
     demo = scenarios.tagged(scenarios.DEMO)
@@ -434,7 +434,7 @@ class _Interrupt:
         self._old = {}
 
     def __enter__(self):
-        from sims.outputs import INTERRUPT_SIGNALS  # the ones its clean-ups defer
+        from planbench.outputs import INTERRUPT_SIGNALS  # the ones its clean-ups defer
 
         if threading.current_thread() is threading.main_thread():
             self._old = {s: signal.signal(s, self._handle) for s in INTERRUPT_SIGNALS}
@@ -453,9 +453,9 @@ class _Interrupt:
 
 def main(argv=None) -> int:
     """Run the CLI; returns the exit code (0, 1, 2, or 130 / 128 + signal on an interrupt)."""
-    from planners.errors import PlanningError
-    from sims.outputs import OutputError
-    from sims.task import PluginError
+    from planbench.planners.errors import PlanningError
+    from planbench.outputs import OutputError
+    from planbench.task import PluginError
 
     with _Interrupt() as interrupt:
         try:

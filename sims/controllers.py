@@ -7,8 +7,8 @@ import copy
 import mujoco
 import numpy as np
 
-from planners.trajectory import TrajectorySample
-from sims.drives import load_joint, transmission_stiffness
+from planbench.planners.trajectory import TrajectorySample
+from planbench.drives import load_joint, transmission_stiffness
 
 
 
@@ -34,7 +34,7 @@ class ServoFeedforwardController:
     It drives every actuator of its command (``ControlContext.actuators``, found in the model
     by name), one per channel of its reference: the trajectory's channels must be those
     actuators, in that order (checked in ``reset``). It reads the task's observation
-    (``sims.task``): ``joint_positions`` (the encoders, for the integral action) and
+    (``planbench.task``): ``joint_positions`` (the encoders, for the integral action) and
     ``setpoints`` (the drives' set-points), in that order.
 
     Args:
@@ -66,7 +66,7 @@ class ServoFeedforwardController:
     def joint_addresses(model, actuators: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(qpos addresses, dof addresses) of the joints the actuators (indices) finally move:
         through a drive train's compliant transmission, the load's joints
-        (``sims.drives.load_joint``)."""
+        (``planbench.drives.load_joint``)."""
         joints = np.array([load_joint(model, int(a)) for a in actuators])
         return model.jnt_qposadr[joints].copy(), model.jnt_dofadr[joints].copy()
 

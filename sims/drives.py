@@ -26,7 +26,7 @@ bandwidth and damping against the inertia it moves. Each MuJoCo step is one samp
 drive's loops; the current loop, kilohertz-fast in every drive here, is taken as ideal (a
 torque that follows its demand within the step).
 
-The encoder the controller reads (``sims.task.JointEncoders``' ``resolution``) counts in
+The encoder the controller reads (``planbench.task.JointEncoders``' ``resolution``) counts in
 steps of ``encoder_resolution``: the load's position where the machine has an encoder on the
 load (the hexapod's struts, the antenna's axes), the motor's over N where it has motor encoders
 only (the loader).
@@ -41,8 +41,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from planners.errors import LimitError
-from sims.params import param
+from planbench.planners.errors import LimitError
+from planbench.params import param
 
 #: Mass and inertia of a motor body (kg, kg m^2): the rotor's inertia is the dof's armature;
 #: MuJoCo needs a moving body to have some mass of its own.
@@ -142,7 +142,7 @@ class DriveTrain:
 
 
 def torque_constant_error(motors: str):
-    """The plant-uncertainty field (``sims.params.param``) of the torque constant of
+    """The plant-uncertainty field (``planbench.params.param``) of the torque constant of
     ``motors`` (in words) against their datasheet's, for ``DriveTrain.with_errors``."""
     return param(0.0, f"as-built drives: {motors}' torque constant relative to the datasheet's (every force the "
                  "drive makes scales with it)", "fraction", low=-0.1, high=0.1,

@@ -1,7 +1,7 @@
 """Each mechanism as a ``dm_control.rl.control.Environment``: a thin adapter over its Task.
 
 The adapter (``TaskAdapter``) is the runner's loop with the agent in the controller's place:
-each episode starts from the task's initial state (``sims.task.Task``: its
+each episode starts from the task's initial state (``planbench.task.Task``: its
 ``initialize_episode``, the sensors and the disturbance seeded from a fresh seed drawn from the
 adapter's ``random``, as dm_control's suite tasks draw theirs; a disturbance whose random state
 sets the start, the antenna's sea, draws a new sea and its start from it), and each action is one control
@@ -26,8 +26,8 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
 
-from sims import runner
-from sims.task import sample_checked
+from planbench import runner
+from planbench.task import sample_checked
 
 #: Episode seeds are drawn from [0, this).
 SEED_RANGE = 2**31 - 1
@@ -136,7 +136,7 @@ def make(scenario: str, random=None, **params) -> control.Environment:
     its Setup built with its parameters overridden by ``params`` (e.g. ``duration``, ``seed``,
     ``wind``: ``planbench run NAME --help``), the reward its mechanism declares. ``random``:
     the episodes' random state (None: from the ``seed`` parameter)."""
-    from sims import scenarios
+    from planbench import scenarios
 
     spec = scenarios.get(scenario)
     setup = spec.build(spec.resolve(params))
@@ -170,10 +170,10 @@ def fast_environment(duration: float = 60.0, wind: float | None = None, seed: in
                      cable_segments: int | None = None) -> control.Environment:
     """FAST's feed support: ``duration`` s of tracking 3C 286 (no switch: the episode starts
     on the source at rest), in ``wind`` m/s, seeded by ``seed``, on the cables of
-    ``cable_segments`` (None: each the default of sims.fast.FastParams). The action is every
+    ``cable_segments`` (None: each the default of planbench.fast.FastParams). The action is every
     actuator's ctrl: the six winches' unstretched lengths (m), the A-B set-points (rad), the
     six Stewart legs' set-point rates (m/s) and the multi-beam angle (rad)."""
-    from sims import fast
+    from planbench import fast
 
     params = fast.FastParams(**_given(wind=wind, seed=seed, cable_segments=cable_segments))
     setup = fast.build(fast.observation_plan(duration), params)

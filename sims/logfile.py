@@ -1,6 +1,6 @@
 """A run's log on disk: the state at every control tick, streamed in chunks as the run goes.
 
-The runner (``sims.runner.simulate``) copies each tick's state into a fixed-size chunk buffer
+The runner (``planbench.runner.simulate``) copies each tick's state into a fixed-size chunk buffer
 (``ChunkWriter``: CHUNK_TICKS rows) and appends every full chunk to ``log.arrow``, an Arrow
 IPC *file* (https://arrow.apache.org/docs/format/Columnar.html#ipc-file-format): one record
 batch per chunk, written with plain ``write`` calls as soon as the chunk is full. The memory a

@@ -66,7 +66,7 @@ INTERRUPT_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 class RunStopped(KeyboardInterrupt):
-    """SIGTERM in a supervised run (its time limit passed, ``sims.supervise``): its staging
+    """SIGTERM in a supervised run (its time limit passed, ``planbench.supervise``): its staging
     directory keeps the log streamed so far (``partial_log``) while the rest is removed."""
 
 
@@ -329,7 +329,7 @@ def _written_by_planbench(entry: Path) -> bool:
     return entry.is_file() and entry.suffix.lower() in VIDEO_SUFFIXES and is_planbench_video(entry)
 
 
-#: A campaign directory's state file (sims.campaign.store.STATE).
+#: A campaign directory's state file (planbench.campaign.store.STATE).
 CAMPAIGN_STATE = "planbench-campaign.json"
 
 
@@ -760,8 +760,8 @@ def software_versions() -> dict:
 
 
 def read_log(path):
-    """A run's log (``DIR/log.arrow`` or DIR): ``sims.logfile.read_log``."""
-    from sims.logfile import read_log as read
+    """A run's log (``DIR/log.arrow`` or DIR): ``planbench.logfile.read_log``."""
+    from planbench.logfile import read_log as read
 
     return read(path)
 
@@ -825,7 +825,7 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
               quiet: bool = True, more_videos: tuple = (), staging: Path | None = None) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
 
-    ``staging``: the staging directory of ``out_dir`` the caller holds (``sims.pipeline``
+    ``staging``: the staging directory of ``out_dir`` the caller holds (``planbench.pipeline``
     opens it before the run, whose log streams into it: ``log.arrow``); the caller's
     ``out_dir.staging()`` swaps it in. None: a staging directory is made and swapped in here,
     and the log, streamed elsewhere, is copied into it a chunk at a time.
@@ -837,7 +837,7 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
     ``more_videos``: (file name, camera) pairs of further videos inside ``out_dir`` (the
     demo's close-ups). Returns the summary.
     """
-    from sims.render import render_video
+    from planbench.render import render_video
 
     target = _as_output_dir(out_dir, "run")
     if video is not None and not isinstance(video, VideoFile):

@@ -28,7 +28,7 @@ import typing
 from dataclasses import dataclass, field
 from typing import Any
 
-from planners.errors import LimitError
+from planbench.planners.errors import LimitError
 
 
 class ParamError(LimitError):
@@ -275,7 +275,7 @@ class Params:
         for f in dataclasses.fields(self):
             declared = f.metadata.get("declared")
             if declared is None:
-                raise TypeError(f"{type(self).__name__}.{f.name} is not declared with sims.params.param")
+                raise TypeError(f"{type(self).__name__}.{f.name} is not declared with planbench.params.param")
             object.__setattr__(self, f.name, _convert(hints[f.name], getattr(self, f.name), f.name, declared))
         self.check()
 
@@ -364,7 +364,7 @@ class ScenarioParams(Params):
     def log_bytes_per_tick(self) -> float:
         """Bytes a run of these parameters holds per control tick: the runner's log and what
         the task's sensors, disturbance and reference controller keep per tick. The check of
-        the run's length (``sims.run_limits.check_duration``) multiplies it by the ticks; each
+        the run's length (``planbench.run_limits.check_duration``) multiplies it by the ticks; each
         mechanism's scenario parameters define it."""
         raise NotImplementedError(f"{type(self).__name__} does not say its log's bytes per control tick")
 
@@ -538,8 +538,8 @@ def markdown_table(cls: type[Params]) -> str:
 
 def readme_tables() -> str:
     """The README's parameter tables, one per Params class of the registered scenarios
-    (``python -m sims.params`` prints them; tests/test_scenario_params.py keeps the README equal)."""
-    from sims import scenarios
+    (``python -m planbench.params`` prints them; tests/test_scenario_params.py keeps the README equal)."""
+    from planbench import scenarios
 
     by_class = {}
     for s in [*scenarios.SCENARIOS.values(), *scenarios.PLANS.values()]:
@@ -556,6 +556,6 @@ def readme_tables() -> str:
 
 
 if __name__ == "__main__":
-    from sims.params import readme_tables as tables  # the module's own classes, not __main__'s
+    from planbench.params import readme_tables as tables  # the module's own classes, not __main__'s
 
     print(tables())

@@ -1,8 +1,8 @@
 """One run, from its scenario to its files: build, simulate and evaluate, write.
 
 ``execute`` is the only place a run is put together: ``planbench run``, ``planbench demo``,
-the Python API (``sims.api.run``), a campaign's workers, ``--rerun-worst`` and ``planbench
-bench`` all call it. It makes the plug-ins from their ``MODULE:FACTORY`` (``sims.plugins``)
+the Python API (``planbench.api.run``), a campaign's workers, ``--rerun-worst`` and ``planbench
+bench`` all call it. It makes the plug-ins from their ``MODULE:FACTORY`` (``planbench.plugins``)
 and records them in the run's provenance (summary.json's "plugins").
 """
 
@@ -12,8 +12,8 @@ import contextlib
 import tempfile
 from typing import Callable
 
-from sims import run_limits, runner
-from sims.logfile import LOG_FILE
+from planbench import run_limits, runner
+from planbench.logfile import LOG_FILE
 
 
 def build(scenario, params, plant=None, planner=None, controller=None) -> runner.Setup:
@@ -30,19 +30,19 @@ def execute(scenario, params, plant=None, *, plugins: dict | None = None, planne
     """Build, run and (with ``out``) write one run of ``scenario``; returns (setup, result).
 
     Args:
-      scenario: a ``sims.scenarios.Scenario``.
+      scenario: a ``planbench.scenarios.Scenario``.
       params, plant: its resolved parameters and plant (None: nominal).
       plugins: {role: MODULE:FACTORY} of a user's planner or controller, made here.
       planner, controller: objects instead (the Python API); not with a plug-in of the role.
-      out: an output directory (``sims.outputs.OutputDir`` or a path) or None to write nothing.
-      video: a video file (``sims.outputs.VideoFile`` or a path), with ``out``.
+      out: an output directory (``planbench.outputs.OutputDir`` or a path) or None to write nothing.
+      video: a video file (``planbench.outputs.VideoFile`` or a path), with ``out``.
       camera: of the video (None: the scenario's). more_videos: (file name, camera) pairs.
       profile: time the loop's parts (``runner.simulate``'s ``profile``).
       on_built: (setup) -> None, called after the build, before the first physics step.
       on_judged: (result) -> None, called once the run is judged, before anything is written.
     """
-    from sims import outputs, supervise
-    from sims import plugins as plugin_module
+    from planbench import outputs, supervise
+    from planbench import plugins as plugin_module
 
     plugins = dict(plugins or {})
     given = {"planner": planner, "controller": controller}
@@ -79,7 +79,7 @@ def execute(scenario, params, plant=None, *, plugins: dict | None = None, planne
 def check_log_space(setup: runner.Setup, params, directory) -> None:
     """A RunLimitError (bad input) before the first physics step if the run's log would not
     fit in the free space where it streams: ``directory`` (the output directory's place) or,
-    None, the temporary directory (``sims.run_limits.log_space_limit``)."""
+    None, the temporary directory (``planbench.run_limits.log_space_limit``)."""
     per_tick = getattr(params, "log_bytes_per_tick", None)
     if per_tick is None:
         return

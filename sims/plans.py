@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from planners.trajectory import control_ticks
-from sims.outputs import OutputDir
-from sims.report import plan_plot
+from planbench.planners.trajectory import control_ticks
+from planbench.outputs import OutputDir
+from planbench.report import plan_plot
 
 PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
 MAX_PLAN_SAMPLES = 60_000  # longer plans are sampled coarser (a 300 s plan at 5 ms)

@@ -1,4 +1,4 @@
-"""Editing a mechanism's MjSpec for plant uncertainty (sims.params.PlantParams).
+"""Editing a mechanism's MjSpec for plant uncertainty (planbench.params.PlantParams).
 
 A perturbed plant is the nominal MJCF with some quantities changed before compiling, so that
 MuJoCo derives everything else (subtree masses, the mass matrix at qpos0, invweights) from the

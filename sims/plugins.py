@@ -4,7 +4,7 @@
 importable module (``my_package.controllers``) or a path to a ``.py`` file
 (``examples/loader/pd_controller.py``); ``FACTORY`` a callable in it (a class or a function, dots for
 nested attributes) that takes no arguments and returns the controller or the planner. What a
-controller and a planner must provide is the Task contract (``sims.task``); a plug-in that
+controller and a planner must provide is the Task contract (``planbench.task``); a plug-in that
 breaks it is refused with one line (``PluginError``) before the run starts.
 """
 
@@ -16,8 +16,8 @@ import importlib.util
 import sys
 from pathlib import Path
 
-from sims import supervise
-from sims.task import PluginError, _callable_with, check_controller, check_planner, fault_text
+from planbench import supervise
+from planbench.task import PluginError, _callable_with, check_controller, check_planner, fault_text
 
 
 def is_file(module_name: str) -> bool:

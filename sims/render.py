@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from sims.outputs import VIDEO_TAG
+from planbench.outputs import VIDEO_TAG
 
 mediapy.set_ffmpeg(imageio_ffmpeg.get_ffmpeg_exe())
 
@@ -55,7 +55,7 @@ def render_video(model: mujoco.MjModel, log, path, camera: str = "overview", spe
     qpos = log.qpos[ticks] if frame_qpos is None else frame_qpos(log, ticks)
     renderer = mujoco.Renderer(model, height=height, width=width)
     try:
-        # The tag is planbench's proof that it may replace this file later (sims.outputs).
+        # The tag is planbench's proof that it may replace this file later (planbench.outputs).
         with mediapy.VideoWriter(path, shape=(height, width), fps=fps, codec="h264", qp=20,
                                  ffmpeg_args=["-metadata", f"comment={VIDEO_TAG}"]) as writer:
             for frame, i in enumerate(tqdm(ticks, unit="frame", disable=quiet, delay=2.0,

@@ -8,15 +8,15 @@ Duration:
   * at least one control tick of the scenario: a shorter run takes no physics step and its
     checks would pass on the initial state alone;
   * its log must fit on disk. The runner streams the log to a file as the run goes
-    (``sims.logfile``: t, qpos, qvel, act, ctrl, actuator_force, sensordata, mocap, in
+    (``planbench.logfile``: t, qpos, qvel, act, ctrl, actuator_force, sensordata, mocap, in
     chunks), in the output directory's staging directory (``planbench run``) or the temporary
     directory (a run that writes nothing). Each mechanism states its bytes per tick (its
-    package's ``log_bytes_per_tick``, e.g. ``sims.loader.log_bytes_per_tick``: the log's
+    package's ``log_bytes_per_tick``, e.g. ``planbench.loader.log_bytes_per_tick``: the log's
     columns and the reference, controller and disturbance arrays kept per tick, an upper
     bound of the file's size; tests/test_run_options.py measures them). A run whose estimate
     exceeds the free space where its log goes (``log_space_limit``) is refused: by the
     parameters' check against the current directory's file system (``planbench run``'s
-    default ``results/``), and again by ``sims.pipeline.execute`` against the output's
+    default ``results/``), and again by ``planbench.pipeline.execute`` against the output's
     (or the temporary directory's) before the first physics step.
 
 Angles (wave heading, wind direction, a wind file's directions): refused beyond
@@ -32,11 +32,11 @@ import os
 import shutil
 from pathlib import Path
 
-from sims.params import ParamError
+from planbench.params import ParamError
 
 #: Angle options are refused beyond +- this, deg (one turn either way).
 ANGLE_LIMIT_DEG = 360.0
-#: The range of an angle parameter (``sims.params.param`` keywords).
+#: The range of an angle parameter (``planbench.params.param`` keywords).
 ANGLE = dict(unit="deg", low=-ANGLE_LIMIT_DEG, high=ANGLE_LIMIT_DEG,
              reason="one turn either way; angles are not wrapped")
 
@@ -85,7 +85,7 @@ def format_bytes(n: float) -> str:
 
 
 def runlog_floats_per_tick(model, channels: int) -> int:
-    """Doubles per tick of ``sims.runner.RunLog`` for a compiled model: t, qpos (nq), qvel
+    """Doubles per tick of ``planbench.runner.RunLog`` for a compiled model: t, qpos (nq), qvel
     (nv), act (na), ctrl and actuator_force (nu each), sensordata, mocap_pos and mocap_quat
     (3 + 4 per mocap body), streamed to the log file, and what stays in memory per tick:
     the reference's position, velocity and acceleration (``channels`` each) and two arrays of

@@ -1,10 +1,10 @@
 """The runner: the control loop around MuJoCo, shared by every mechanism.
 
-Per control tick it updates the task's sensors (``sims.task.Sensors``: the observation),
+Per control tick it updates the task's sensors (``planbench.task.Sensors``: the observation),
 calls the controller once with that observation (it writes or returns the actuator commands;
-it never gets the physics, ``sims.task``), applies the disturbance, lets MuJoCo take ``k``
+it never gets the physics, ``planbench.task``), applies the disturbance, lets MuJoCo take ``k``
 physics steps with ``mj_step(model, data, nstep=k)`` and copies the state into the log's
-chunk buffer, which streams to disk a chunk at a time (``sims.logfile``). Everything else (the
+chunk buffer, which streams to disk a chunk at a time (``planbench.logfile``). Everything else (the
 planned motion, checks, rendering) works before or after the loop, on whole arrays or on the
 log's chunks (``RunLog.chunks``).
 
@@ -30,12 +30,12 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from planners.trajectory import ChunkedSample, Trajectory, TrajectorySample, control_ticks
-from sims.checks import Check, controller_check, divergence_check
-from sims import supervise
-from sims.logfile import (CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly,
+from planbench.planners.trajectory import ChunkedSample, Trajectory, TrajectorySample, control_ticks
+from planbench.checks import Check, controller_check, divergence_check
+from planbench import supervise
+from planbench.logfile import (CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly,
                            temporary_writer)
-from sims.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
+from planbench.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
                        check_controller, check_first_command, fault_text, sample_checked)
 
 #: The arrays of MuJoCo's state that the log records with one ``mj_getState`` a tick, in its
@@ -57,11 +57,11 @@ class Setup:
 
     Attributes:
       physics: a ``dm_control.mujoco.Physics`` of the scene, at the task's initial state.
-      task: the ``sims.task.Task`` (problem, sensors, disturbance, evaluation, timing),
+      task: the ``planbench.task.Task`` (problem, sensors, disturbance, evaluation, timing),
         attached to ``physics`` (its initial state recorded).
-      components: the planner, the trajectory and the controller (``sims.task.Components``).
-      output: how the files are written (``sims.task.Output``).
-      provenance: seed, parameters, plant and plug-ins (``sims.task.Provenance``).
+      components: the planner, the trajectory and the controller (``planbench.task.Components``).
+      output: how the files are written (``planbench.task.Output``).
+      provenance: seed, parameters, plant and plug-ins (``planbench.task.Provenance``).
     """
 
     physics: object
@@ -106,7 +106,7 @@ class RunLog:
     lists (tick, geom1, geom2, distance) of every contact seen at a tick's end. ``n`` may be
     shorter than planned when the run diverged.
 
-    A simulated run's arrays live in its log file (``file``, a ``sims.logfile.LogFile``,
+    A simulated run's arrays live in its log file (``file``, a ``planbench.logfile.LogFile``,
     streamed to disk as the run went): each is read whole on first use; ``file.chunks()``
     reads them a chunk at a time.
     """
@@ -259,7 +259,7 @@ def _bad_command(model, ctrl: np.ndarray, t: float) -> str:
 
 @dataclass
 class Episode:
-    """A run's start, shared by ``simulate`` and the dm_control environments (``sims.envs``):
+    """A run's start, shared by ``simulate`` and the dm_control environments (``planbench.envs``):
     the control ticks, the reference sampled at them, the observation and the controller's
     context. ``start_episode`` makes it."""
 
@@ -300,7 +300,7 @@ def controlled_views(setup: Setup):
 
 def stored_reference(trajectory, times: np.ndarray) -> ChunkedSample:
     """``trajectory`` sampled at ``times``, a chunk of CHUNK_TICKS ticks at a time, each chunk
-    stored in a temporary log (``sims.logfile.temporary_writer``) and read back from it as it
+    stored in a temporary log (``planbench.logfile.temporary_writer``) and read back from it as it
     is asked for: the run holds a chunk, whatever its length, and samples once, before its
     first tick (a trajectory that cannot be sampled is bad input before any physics step)."""
     sample = partial(sample_checked, trajectory)
@@ -358,7 +358,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     ``physics_wall_s``); the rest of ``loop_wall_s`` is the testbed's own cost (sensors,
     disturbance, logging). Off, the loop reads no clock per tick.
 
-    The log streams to ``log_path`` (``sims.logfile``: a chunk of ``chunk_ticks`` ticks at a
+    The log streams to ``log_path`` (``planbench.logfile``: a chunk of ``chunk_ticks`` ticks at a
     time; complete, with its footer, when this returns). None: to a temporary file, removed
     from the file system once the run is over (the returned log keeps it open)."""
     physics = setup.physics
@@ -400,7 +400,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     record(0)
     initial_ctrl = ctrl_now.copy()
     task = setup.task
-    observe, before_step = task.observe, task.before_step  # the same tick as sims.envs'
+    observe, before_step = task.observe, task.before_step  # the same tick as planbench.envs'
     command_now = context.command
     contacts = []  # (tick, geoms (ncon, 2), distances (ncon,)) of every tick with contacts
     bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,

@@ -21,8 +21,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from sims.params import ParamError, Params, field_types, parse_value, set_overrides
-from sims.plugins import is_file, split_spec
+from planbench.params import ParamError, Params, field_types, parse_value, set_overrides
+from planbench.plugins import is_file, split_spec
 
 TOP_LEVEL_KEYS = ("scenario", "planner", "controller", "parameters", "plant")
 
@@ -133,7 +133,7 @@ def _beside(path: Path, name: str) -> str:
 
 def overrides_from_flags(cls, flags: dict, assignments: list[str]) -> dict:
     """The command line's values: ``--KEY VALUE`` flags (text) and ``--set KEY=VALUE``,
-    parsed by each field's type (sims.params.parse_value)."""
+    parsed by each field's type (planbench.params.parse_value)."""
     types = field_types(cls)
     out = {key: parse_value(types[key], text, "--" + key.replace("_", "-")) for key, text in flags.items()}
     out.update(set_overrides(cls, assignments))

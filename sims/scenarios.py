@@ -9,7 +9,7 @@ as in MuJoCo Menagerie) the first time it is asked, as dm_control's suite builds
 from its domain modules; the tuple is the folders of models/ that hold a scene.xml (and those
 of the roots that ``PLANBENCH_MECHANISMS`` names), so a fifth mechanism is its own folders
 (models/<name>/ and sims/<name>/) and nothing else. ``planbench list``, ``run``, ``plan``,
-``demo``, ``bench`` and the environments (``sims.envs``) all come from here.
+``demo``, ``bench`` and the environments (``planbench.envs``) all come from here.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from typing import Callable
 
 from dm_control.utils import containers
 
-import models
+from planbench import models
 
 #: The tags of a scenario: ``planbench demo`` runs those tagged DEMO, ``planbench bench`` times
 #: those tagged BENCHMARK.
@@ -36,7 +36,7 @@ class Scenario:
     Attributes:
       name: CLI name.
       summary: one line for ``planbench list``.
-      params: the scenario's parameters with its defaults (a ``sims.params.Params``: typed,
+      params: the scenario's parameters with its defaults (a ``planbench.params.Params``: typed,
         ranged and validated; ``planbench run NAME --set KEY=VALUE`` and scenario files
         override them).
       build: (params, planner=None, controller=None) -> runner.Setup; None for the defaults
@@ -50,14 +50,14 @@ class Scenario:
       demo_cameras: cameras of further videos that ``planbench demo`` renders (NAME-CAMERA.mp4).
       control_dt: the control period, s (one tick: the shortest run).
       online_planner: the scenario's planner is an online one (the antenna's: ``reset`` and
-        ``step``, sims.task.OnlinePlanner), not a ``plan(problem)`` that returns a Trajectory.
+        ``step``, planbench.task.OnlinePlanner), not a ``plan(problem)`` that returns a Trajectory.
       judge_plans: optional (list of params, planner=None) -> one list of checks per params:
         the run's planner checks on the planned trajectory alone, no physics, vectorized
         over the list (planner-only campaigns, ``mode = "plan"``).
       plan_columns: optional module with ``supports(base, axis paths)``, ``validate(base,
         paths, values, n)`` and ``judge(poses)``: a planner-only campaign's chunks validated
-        and judged as columns (sims.hexapod.plan_columns); None: run by run.
-      plant: the nominal plant (an instance of the mechanism's ``sims.params.PlantParams``:
+        and judged as columns (planbench.hexapod.plan_columns); None: run by run.
+      plant: the nominal plant (an instance of the mechanism's ``planbench.params.PlantParams``:
         its plant-uncertainty fields at their nominal values); ``build(..., plant=...)`` takes
         a perturbed one. None: the mechanism declares no plant uncertainty.
       tags: DEMO, BENCHMARK or neither (a plan-only entry has none).
@@ -98,7 +98,7 @@ class Scenario:
         """The nominal plant with ``overrides`` (a scenario file's or a campaign's [plant]
         table) applied and validated; a ParamError names a bad key, or says that this
         scenario's mechanism declares no plant uncertainty."""
-        from sims.params import ParamError
+        from planbench.params import ParamError
 
         if self.plant is None:
             if overrides:
@@ -115,7 +115,7 @@ class Mechanism:
       name: its folders' name (models/<name>/, sims/<name>/).
       scenarios: its runnable scenarios, each with its tags.
       reward: (setup) -> (physics, tick, adapter) -> reward in (0, 1], of its dm_control
-        environment (``sims.envs``).
+        environment (``planbench.envs``).
       plans: plan-only entries (``planbench plan``), no physics.
       benchmark_runs: how many runs ``planbench bench`` takes the best of.
     """
@@ -141,8 +141,8 @@ class Mechanism:
 
 
 def _import_mechanism(name: str):
-    import planners
-    import sims
+    from planbench import planners
+    import planbench
 
     # A mechanism of a root PLANBENCH_MECHANISMS names: its sims/ and planners/ folders
     # are searched after the project's own (as a namespace package's portions).

@@ -130,7 +130,7 @@ def _child(work, board: _Board, write_fd: int, parent: int) -> None:
             raise RunStopped if signum == signal.SIGTERM else KeyboardInterrupt
 
     try:
-        from sims.outputs import INTERRUPT_SIGNALS, RunStopped
+        from planbench.outputs import INTERRUPT_SIGNALS, RunStopped
 
         for s in INTERRUPT_SIGNALS:
             signal.signal(s, interrupted)
@@ -164,9 +164,9 @@ def _child(work, board: _Board, write_fd: int, parent: int) -> None:
 
 def _one_line(e: BaseException) -> bool:
     """Errors the CLI prints as one line (bad input, plug-in faults), not as a traceback."""
-    from planners.errors import PlanningError
-    from sims.outputs import OutputError
-    from sims.task import PluginError
+    from planbench.planners.errors import PlanningError
+    from planbench.outputs import OutputError
+    from planbench.task import PluginError
 
     return isinstance(e, (PlanningError, OutputError, PluginError, ValueError, SystemExit))
 

@@ -6,7 +6,7 @@ evaluation. The runner drives every run the same way (README.md, "Your own plann
 
 * The **planner** gets the task's planning problem, a typed object (``planning_problem`` of
   each mechanism: key points and limits, start and target poses, the satellite and the
-  IMU's update interval, sources and times), and returns a ``planners.trajectory.Trajectory``
+  IMU's update interval, sources and times), and returns a ``planbench.planners.trajectory.Trajectory``
   (loader, hexapod, FAST) or, for the antenna, is an online planner that returns the joint
   solution for each attitude the controller hands it (``OnlinePlanner``).
 * The **controller** gets a ``ControlContext`` once (the nominal model, the trajectory and its
@@ -32,7 +32,7 @@ from typing import Any, Callable, Protocol, runtime_checkable
 import mujoco
 import numpy as np
 
-from planners.trajectory import ChunkedSample, Trajectory, TrajectorySample
+from planbench.planners.trajectory import ChunkedSample, Trajectory, TrajectorySample
 
 
 class PluginError(ValueError):
@@ -240,11 +240,11 @@ class Disturbance(Protocol):
 
 @runtime_checkable
 class Evaluation(Protocol):
-    """How a task judges a run, from its log (``sims.runner.RunLog``) and the task's own
+    """How a task judges a run, from its log (``planbench.runner.RunLog``) and the task's own
     records: never from a planner's or controller's internals."""
 
     def evaluate(self, log) -> tuple[list, dict]:
-        """(checks, metrics): the task's checks (``sims.checks.Check``) and its figures."""
+        """(checks, metrics): the task's checks (``planbench.checks.Check``) and its figures."""
 
     def timeseries(self, log) -> dict:
         """{name: array}: what timeseries.npz keeps besides the log."""
@@ -308,8 +308,8 @@ class Task:
         mujoco.mj_forward(model, data)
 
     def times(self) -> np.ndarray:
-        """The control ticks' times, s (``planners.trajectory.control_ticks``)."""
-        from planners.trajectory import control_ticks
+        """The control ticks' times, s (``planbench.planners.trajectory.control_ticks``)."""
+        from planbench.planners.trajectory import control_ticks
 
         return control_ticks(self.duration, self.control_dt)
 
@@ -372,9 +372,9 @@ class Provenance:
 
     Attributes:
       seed: the episode's seed (sensors, disturbance).
-      params: the scenario's parameters (sims.params) the run was built from, None for a task
+      params: the scenario's parameters (planbench.params) the run was built from, None for a task
         built by hand; the result records them resolved.
-      plant: the plant's uncertainty (sims.params.PlantParams) the physics was built with,
+      plant: the plant's uncertainty (planbench.params.PlantParams) the physics was built with,
         None for a mechanism without one.
       plugins: the ``MODULE:FACTORY`` of a user's planner or controller, by role.
     """
@@ -402,7 +402,7 @@ class ControlContext:
         whose planner is online: its ideal joint path is computed from the true ship motion,
         which no controller can know.
       reference: the trajectory sampled at every control tick (None with it): a
-        ``planners.trajectory.ChunkedSample``, whose ``rows(start, stop)`` samples those ticks
+        ``planbench.planners.trajectory.ChunkedSample``, whose ``rows(start, stop)`` samples those ticks
         only and whose ``position``, ``velocity``, ``acceleration`` are the whole arrays.
       control_dt: the control period, s.
       command: the commands (``ctrl``) of the actuators this controller drives, in the
@@ -661,13 +661,13 @@ def nominal_copy(physics) -> Callable:
 
 def plan_checked(planner, problem, labels) -> Trajectory:
     """``planner.plan(problem)``, checked to keep the contract (``check_planner``,
-    ``check_trajectory`` with the task's channel ``labels``). A ``planners.errors.PlanningError``
+    ``check_trajectory`` with the task's channel ``labels``). A ``planbench.planners.errors.PlanningError``
     (a problem the planner cannot plan) passes through; any other exception becomes a
     PluginError naming the planner."""
-    from planners.errors import PlanningError
+    from planbench.planners.errors import PlanningError
 
     check_planner(planner, online=False)
-    from sims import supervise
+    from planbench import supervise
 
     supervise.phase(f"the planner's plan ({type(planner).__name__})")
     try:

@@ -21,7 +21,7 @@ from typing import Callable
 
 import numpy as np
 
-from sims.run_limits import ANGLE_LIMIT_DEG
+from planbench.run_limits import ANGLE_LIMIT_DEG
 
 AIR_DENSITY = 1.2  # kg/m^3; about 1.0 at Rubin's 2700 m and FAST's 1000 m: conservative
 #: Largest mean wind speed accepted, m/s: the reference wind speed V_ref of IEC 61400-1
@@ -29,7 +29,7 @@ AIR_DENSITY = 1.2  # kg/m^3; about 1.0 at Rubin's 2700 m and FAST's 1000 m: cons
 #: standard whose Kaimal turbulence model this module uses. Beyond it the turbulence model
 #: (and any telescope) is outside its range.
 MAX_MEAN_SPEED_M_S = 50.0
-#: The range of a mean wind speed parameter (``sims.params.param`` keywords), m/s.
+#: The range of a mean wind speed parameter (``planbench.params.param`` keywords), m/s.
 MEAN_SPEED = dict(unit="m/s", low=0.0, high=MAX_MEAN_SPEED_M_S,
                   reason="IEC 61400-1 class I reference speed, the Kaimal model's range")
 IEC_KAIMAL_LENGTH = 8.1 * 42.0  # m, IEC 61400-1 longitudinal integral scale above 60 m hub

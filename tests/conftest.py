@@ -3,7 +3,7 @@ import os
 # Offscreen rendering without a display; sims/__init__.py picks EGL or OSMesa. It must run
 # before any test module imports mujoco, which fixes its GL back end on import.
 os.environ.setdefault("MPLBACKEND", "Agg")
-import sims  # noqa: E402,F401
+import planbench  # noqa: E402,F401
 
 from hypothesis import settings  # noqa: E402
 

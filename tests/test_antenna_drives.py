@@ -1,4 +1,4 @@
-"""The ship antenna's pedestal as built (sims.antenna.params.as_built): each axis's drive train,
+"""The ship antenna's pedestal as built (planbench.antenna.params.as_built): each axis's drive train,
 the mast's bending mode and the axis encoders against their definitions."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import mujoco
 import numpy as np
 import pytest
 
-import models
-from sims import scenarios
-from sims.antenna import params as antenna_params
-from sims.antenna.physics import AntennaPhysics
+from planbench import models
+from planbench import scenarios
+from planbench.antenna import params as antenna_params
+from planbench.antenna.physics import AntennaPhysics
 
 JOINTS = antenna_params.JOINTS
 
@@ -70,7 +70,7 @@ def test_the_controller_reads_17_bit_axis_encoders():
     setup = scenario.build(scenario.resolve(duration=0.1))
     spec = next(s for s in setup.task.sensors.specs if s.name == "joint_positions")
     assert spec.resolution == pytest.approx(2 * math.pi / 2**17)
-    from sims import runner
+    from planbench import runner
 
     episode = runner.start_episode(setup)
     counts = episode.observation["joint_positions"] / spec.resolution
@@ -82,7 +82,7 @@ def test_the_plants_drive_train_errors_edit_their_elements():
     gear_backlash_error the gears' dead band (not the belt's: it has none), and
     torque_constant_error every force the drive makes: its loop gains (the peak current stays,
     so the torque limit scales too)."""
-    from sims.antenna.params import AntennaPlant
+    from planbench.antenna.params import AntennaPlant
 
     nominal = AntennaPhysics.load(drives="as-built").model.ptr
     model = AntennaPhysics.load(AntennaPlant(transmission_stiffness_error=-0.3, gear_backlash_error=2.0,

@@ -10,11 +10,11 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
-from sims import runner
-from sims.antenna import sensors as antenna_sensors
-from sims.antenna import task as antenna_task
-from sims.antenna.controller import AntennaController
-from sims.antenna.params import AntennaSeaParams, ImuModel, _exp_so3
+from planbench import runner
+from planbench.antenna import sensors as antenna_sensors
+from planbench.antenna import task as antenna_task
+from planbench.antenna.controller import AntennaController
+from planbench.antenna.params import AntennaSeaParams, ImuModel, _exp_so3
 
 LOGGED = ("qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata")
 

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import models
+from planbench import models
 
 G = 9.81
 DEG = np.pi / 180

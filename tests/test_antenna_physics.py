@@ -6,10 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from planners import antenna as ant
-from planners.errors import PlanningError
-from sims import antenna, runner
-from sims.antenna.ship_motion import PaperShipMotion
+from planbench.planners import antenna as ant
+from planbench.planners.errors import PlanningError
+from planbench import antenna, runner
+from planbench.antenna.ship_motion import PaperShipMotion
 
 
 def _run(params, duration, antenna_options=antenna.AntennaOptions(), **options):
@@ -168,7 +168,7 @@ def test_dm_control_environment_with_an_imu_driven_controller():
     sample it asks the paper's planner for the joint angles of N = R^T eTs and drives the
     set-points there over one IMU period; that holds the satellite in the default sea.
     Doing nothing lets the ship carry the dish off it."""
-    from sims.envs import antenna_environment
+    from planbench.envs import antenna_environment
 
     env = antenna_environment(duration=2.0)
     step = env.reset()
@@ -208,7 +208,7 @@ def test_a_half_turn_to_the_start_attitude_plans():
     # attitude to the start one a half turn, which the matrix log refused.
     import numpy as np
 
-    from sims import scenarios
+    from planbench import scenarios
 
     scenario = scenarios.get("antenna-paper-motion")
     params = scenario.resolve(satellite_lon=None, satellite_look=(223.49, 60.0, -28.8), ship_heading=180.0,
@@ -216,8 +216,8 @@ def test_a_half_turn_to_the_start_attitude_plans():
     trajectory = scenario.plan(params)
     assert np.all(np.isfinite(trajectory.sample(np.array([0.0, 5.0])).position))
     # The start angles give the attitude the ship at heading 180 deg needs (eq. 1).
-    import planners.antenna as ant
-    from sims import antenna
+    import planbench.planners.antenna as ant
+    from planbench import antenna
 
     look = antenna.satellite_of(params)
     motion, satellite = antenna.motion_of(params), ant.satellite_attitude(*look)

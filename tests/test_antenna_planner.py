@@ -8,10 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from planners import antenna as ant
-from planners.errors import LimitError, PlanningError
-from planners.antenna.geostationary import look_angles
-from sims.antenna.ship_motion import PaperShipMotion
+from planbench.planners import antenna as ant
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.antenna.geostationary import look_angles
+from planbench.antenna.ship_motion import PaperShipMotion
 
 DEG = np.pi / 180
 angles = st.floats(-np.pi, np.pi, allow_nan=False)

@@ -1,4 +1,4 @@
-"""Plant uncertainty of the ship antenna (sims.antenna.AntennaPlant): each field edits exactly its
+"""Plant uncertainty of the ship antenna (planbench.antenna.AntennaPlant): each field edits exactly its
 part of the compiled model (or the IMU's true error), the planner and the controller keep the
 nominal model and the IMU's datasheet, the nominal plant runs as before, short runs show each
 perturbation acting as computed by hand, and bad values are refused."""
@@ -12,13 +12,13 @@ import mujoco
 import numpy as np
 import pytest
 
-import models
+from planbench import models
 from model_diff import changed_fields
 from plant_model import assert_edits_only
-from sims.antenna import params as antenna_params
-from sims import antenna, api, runner, scenarios
-from sims.antenna.ship_motion import world_from_ship
-from sims.params import ParamError
+from planbench.antenna import params as antenna_params
+from planbench import antenna, api, runner, scenarios
+from planbench.antenna.ship_motion import world_from_ship
+from planbench.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("antenna-sea-state")
@@ -48,7 +48,7 @@ def test_every_antenna_scenario_declares_the_nominal_antenna_plant():
 
 
 def test_the_readme_documents_every_plant_field():
-    from sims.params import markdown_table
+    from planbench.params import markdown_table
 
     assert markdown_table(antenna.AntennaPlant) in (ROOT / "models/antenna/README.md").read_text()
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planners import antenna as ant
-from planners.errors import PlanningError
-from sims import scenarios
-from sims.task import RecordingPlanner, StepTimeError
+from planbench.planners import antenna as ant
+from planbench.planners.errors import PlanningError
+from planbench import scenarios
+from planbench.task import RecordingPlanner, StepTimeError
 
 
 def _problem():
@@ -54,7 +54,7 @@ def test_increasing_steps_are_accepted():
 def test_our_controller_steps_at_increasing_times_after_the_start():
     scenario = scenarios.get("antenna-paper-motion")
     params = type(scenario.params).from_mapping({"duration": 2.0}, base=scenario.params)
-    from sims import runner
+    from planbench import runner
 
     setup = scenario.build(params)
     result = runner.run(scenario.name, setup)

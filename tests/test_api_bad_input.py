@@ -1,10 +1,10 @@
 """Issue 12, part 6: the Python API refuses bad input up front, naming the value and the limit.
 
-Every planner raises a ``PlanningError`` (a ``ValueError`` subclass, ``planners.errors``) whose
+Every planner raises a ``PlanningError`` (a ``ValueError`` subclass, ``planbench.planners.errors``) whose
 message names the offending value (and its row, joint or axis) and the limit it breaks, before
 any planning is done. Key points exactly on a joint limit are accepted: the B-spline's check
 between key points allows its own round-off, ``limit_tolerance`` = 64 eps max |P| per joint
-(``planners.bspline``, "Joint limits and round-off"), and nothing more.
+(``planbench.planners.bspline``, "Joint limits and round-off"), and nothing more.
 """
 
 from __future__ import annotations
@@ -16,17 +16,17 @@ import pytest
 from hypothesis import example, given, settings, strategies as st
 from scipy.interpolate import CubicSpline
 
-from planners import antenna, fast, hexapod, loader
-from planners.fast import plan as fast_plan
-from planners import profiles
-from planners.loader.bspline import CubicBSplineTrajectory
-from planners.errors import LimitError, PlanningError
-from planners.trajectory import MAX_MAGNITUDE, sample_times
+from planbench.planners import antenna, fast, hexapod, loader
+from planbench.planners.fast import plan as fast_plan
+from planbench.planners import profiles
+from planbench.planners.loader.bspline import CubicBSplineTrajectory
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.trajectory import MAX_MAGNITUDE, sample_times
 
 NAN, INF = float("nan"), float("inf")
 LIMIT = "1e+150"  # MAX_MAGNITUDE as the messages write it
 EPS = np.finfo(float).eps
-ULPS = 64  # the documented round-off allowance: 64 (eps max |P| + eta), planners.bspline
+ULPS = 64  # the documented round-off allowance: 64 (eps max |P| + eta), planbench.planners.bspline
 
 
 def raises_named(call, *fragments, kind=PlanningError):

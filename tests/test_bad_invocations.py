@@ -18,8 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from sims.cli import main
-from sims.outputs import MANIFEST
+from planbench.cli import main
+from planbench.outputs import MANIFEST
 from tests.test_outputs import _chattr, snapshot
 
 LONG_NAME = "n" * 300
@@ -210,7 +210,7 @@ def test_bad_invocation_as_a_process(argv, scene):
     argv = [a.replace("{tmp}", str(scene)) for a in argv]
     before = snapshot(scene)
     root = Path(__file__).resolve().parents[1]
-    proc = subprocess.run([sys.executable, "-m", "sims.cli", *argv], capture_output=True, text=True,
+    proc = subprocess.run([sys.executable, "-m", "planbench.cli", *argv], capture_output=True, text=True,
                           cwd=scene, env={**os.environ, "PYTHONPATH": str(root)})
     assert proc.returncode == 2 and len(proc.stderr.splitlines()) == 1, proc.stderr
     assert "Traceback" not in proc.stderr and proc.stdout == ""

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sims import bench
+from planbench import bench
 
 
 def test_peak_memory_is_the_childs_own_not_its_parents(tmp_path, monkeypatch):

@@ -6,9 +6,9 @@ from hypothesis import given, strategies as st
 from hypothesis.extra import numpy as hnp
 from scipy.interpolate import CubicSpline
 
-from planners.loader.bspline import CubicBSplineTrajectory, solve_control_points
-from planners.errors import LimitError, PlanningError
-from planners.loader import TABLE1, TABLE1_TIMES, direct_plan, supply_plan, table1_to_si
+from planbench.planners.loader.bspline import CubicBSplineTrajectory, solve_control_points
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.loader import TABLE1, TABLE1_TIMES, direct_plan, supply_plan, table1_to_si
 
 # Eq. (11) of the paper: theta2(t) piecewise, rows a3, a2, a1, a0 per segment (deg, s).
 EQ11 = np.array([
@@ -137,7 +137,7 @@ def test_mismatched_joint_counts_rejected():
 def test_key_point_outside_joint_limit_names_joint_and_limit():
     keys = table1_to_si(TABLE1).copy()
     keys[2, 4] = np.deg2rad(80.0)  # wrist_yaw beyond its 1.2 rad limit
-    from models import loader_spec
+    from planbench.models import loader_spec
 
     spec = loader_spec()
     with pytest.raises(LimitError, match=r"wrist_yaw = 1\.39626 is beyond its upper limit 1\.2"):

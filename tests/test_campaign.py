@@ -23,12 +23,12 @@ import pyarrow.parquet as pq
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from sims import cli
-from sims.campaign import report, spec as spec_module
-from sims.campaign.store import CampaignDir
-from sims.params import ParamError
+from planbench import cli
+from planbench.campaign import report, spec as spec_module
+from planbench.campaign.store import CampaignDir
+from planbench.params import ParamError
 
-PLANBENCH = [sys.executable, "-m", "sims.cli"]
+PLANBENCH = [sys.executable, "-m", "planbench.cli"]
 
 SPEC = """\
 scenario = "hexapod-sync-move"
@@ -179,7 +179,7 @@ def test_sigkill_then_resume_loses_and_duplicates_nothing(local_campaign, tmp_pa
 
 def test_a_run_that_raises_is_a_row_not_a_crash(tmp_path, capsys):
     _write(tmp_path / "bad_planner.py", """
-from planners.hexapod import PaperMovePlanner
+from planbench.planners.hexapod import PaperMovePlanner
 
 class Picky(PaperMovePlanner):
     def plan(self, problem):
@@ -210,7 +210,7 @@ duration = 1.0
 def test_a_worker_that_dies_costs_only_its_run(tmp_path):
     planner = _write(tmp_path / "fatal_planner.py", """
 import os
-from planners.hexapod import PaperMovePlanner
+from planbench.planners.hexapod import PaperMovePlanner
 
 class Fatal(PaperMovePlanner):
     def plan(self, problem):
@@ -264,7 +264,7 @@ class _PoolThatBreaksOnSubmit:
 
 
 def test_a_pool_that_breaks_between_submits_loses_no_run(tmp_path, monkeypatch):
-    from sims.campaign import engines
+    from planbench.campaign import engines
     monkeypatch.setattr(engines.cf, "ProcessPoolExecutor", _PoolThatBreaksOnSubmit)
     _PoolThatBreaksOnSubmit.pools = 0
     spec = _write(tmp_path / "spec.toml", """
@@ -349,7 +349,7 @@ def test_an_invalid_combination_is_refused_or_skipped(tmp_path):
                              "--quiet"], capture_output=True, text=True, timeout=120)
     assert result.returncode == 2 and "run 1" in result.stderr and not (tmp_path / "out").exists()
     spec = spec_module.load(_write(tmp_path / "skip.toml", 'invalid = "skip"\n' + text))
-    from sims.campaign import context_of, tasks_of, worker
+    from planbench.campaign import context_of, tasks_of, worker
 
     result = worker.run_chunk(context_of(spec), tasks_of(spec, spec.runs())[1:])
     assert result["rows"][0]["status"] == "invalid" and "zero length" in result["rows"][0]["error"]
@@ -466,7 +466,7 @@ def test_a_perturbed_run_repeats_from_its_summary(tmp_path, capsys):
 
 
 def test_saved_outputs_only_when_asked(tmp_path):
-    from sims.campaign import context_of, tasks_of, worker
+    from planbench.campaign import context_of, tasks_of, worker
 
     text = ('scenario = "loader-supply"\n{save}[parameters]\nduration = 0.2\n[grid]\npayload_mass = [40.0]\n')
     saved = spec_module.load(_write(tmp_path / "saved.toml", text.format(save='save = ["timeseries"]\n')))
@@ -496,7 +496,7 @@ invalid = "skip"
     assert table.num_rows == 120 and set(table.column("status").to_pylist()) == {"passed"}
     assert not (out / "runs").exists() or not any((out / "runs").iterdir())  # no physics, no run outputs
     # Each row is the judge's verdict on that run's own plan.
-    from sims.hexapod.plan_checks import judge_plans
+    from planbench.hexapod.plan_checks import judge_plans
 
     loaded = spec_module.load(spec)
     run = loaded.runs()[70]
@@ -508,8 +508,8 @@ invalid = "skip"
 
 
 def test_a_pool_held_across_campaigns_serves_each_and_ends_with_its_block(tmp_path):
-    from sims import campaign
-    from sims.campaign.engines import LocalEngine
+    from planbench import campaign
+    from planbench.campaign.engines import LocalEngine
 
     spec = _write(tmp_path / "spec.toml", """
 scenario = "hexapod-sync-move"
@@ -519,7 +519,7 @@ invalid = "skip"
 [random]
 "moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
 """)
-    from sims.campaign import context_of, worker
+    from planbench.campaign import context_of, worker
 
     loaded = spec_module.load(spec)  # the rows computed here, in one chunk, for reference
     own = worker.run_columns(context_of(loaded), worker.ColumnTask(loaded.columns(np.arange(loaded.size))))["table"]

@@ -1,5 +1,5 @@
-"""The columnar path of planner-only campaigns (sims.campaign: ``worker.ColumnTask``,
-``sims.hexapod.plan_columns``) against the run-by-run path: the same rows, run for run."""
+"""The columnar path of planner-only campaigns (planbench.campaign: ``worker.ColumnTask``,
+``planbench.hexapod.plan_columns``) against the run-by-run path: the same rows, run for run."""
 
 from __future__ import annotations
 
@@ -10,11 +10,11 @@ import pyarrow.parquet as pq
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from sims import campaign, cli
-from sims.campaign import spec as spec_module, worker
-from sims.campaign.spec import run_seeds
-from sims.hexapod.params import _POSE_HIGH, _POSE_LOW
-from sims.params import ParamError
+from planbench import campaign, cli
+from planbench.campaign import spec as spec_module, worker
+from planbench.campaign.spec import run_seeds
+from planbench.hexapod.params import _POSE_HIGH, _POSE_LOW
+from planbench.params import ParamError
 
 AXES = [f"start_pose[{i}]" for i in range(6)] + [f"moves[0].target[{i}]" for i in range(6)]
 
@@ -139,7 +139,7 @@ def test_rare_findings_are_validated_run_by_run(tmp_path):
                  extra='[parameters]\nstart_pose = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n'
                        'moves = [{ target = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0] }]')
     assert campaign.columnar(spec)
-    from sims.hexapod import plan_columns
+    from planbench.hexapod import plan_columns
 
     paths = [("moves", 0, "target", 0)]
     messages, unsure, _ = plan_columns.validate(spec.base_params, paths, [np.array([0.0, 1.0])], 2)
@@ -171,7 +171,7 @@ def test_which_campaigns_take_the_columnar_path(tmp_path):
     assert campaign.columnar(spec_of(""))
     assert not campaign.columnar(spec_of("", mode="simulate"))
     assert not campaign.columnar(spec_of("[grid]\nwind = [0.0, 1.0]"))  # an axis the columns do not take
-    assert not campaign.columnar(spec_of('planner = "planners.hexapod:PaperMovePlanner"'))
+    assert not campaign.columnar(spec_of('planner = "planbench.planners.hexapod:PaperMovePlanner"'))
 
 
 @pytest.fixture(scope="module")

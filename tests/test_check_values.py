@@ -2,7 +2,7 @@
 
 A check is only as good as the code computing its value. For each
 registered scenario these tests produce the outputs the public way (the scenario's
-``build(scenario.resolve(...))``, ``sims.runner.run``, ``sims.outputs.write_run`` into a fresh
+``build(scenario.resolve(...))``, ``planbench.runner.run``, ``planbench.outputs.write_run`` into a fresh
 directory), then read back ONLY ``summary.json``, ``timeseries.npz`` and the compiled MuJoCo
 model, and recompute each check's value from the logged physics (qpos, qvel, act, ctrl,
 actuator_force, sensordata) with MuJoCo's own kinematics and actuator model
@@ -42,16 +42,16 @@ import mujoco
 import numpy as np
 import pytest
 
-from planners import antenna as ant
-from planners.fast import plan as fp
-from planners.fast import sky as sky
-from planners import hexapod as hexapod_planner
-from planners.antenna.geostationary import look_angles
-from sims import antenna as antenna_sim
-from sims import fast as fast_sim
-from sims.fast import physics as fast_physics
-from sims import hexapod as sim_hexapod
-from sims import outputs, runner, scenarios
+from planbench.planners import antenna as ant
+from planbench.planners.fast import plan as fp
+from planbench.planners.fast import sky as sky
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.antenna.geostationary import look_angles
+from planbench import antenna as antenna_sim
+from planbench import fast as fast_sim
+from planbench.fast import physics as fast_physics
+from planbench import hexapod as sim_hexapod
+from planbench import outputs, runner, scenarios
 
 EXACT = 1e-9
 KIN = 1e-7
@@ -887,7 +887,7 @@ def test_paper_weights_split_a_shared_axis_by_their_ratio(axis, share):
 
 def _paper_step():
     """Theta0 and the attitudes N(0), N(dT) of the paper's section 5.1 (eq. 15-16)."""
-    from sims.antenna.ship_motion import PaperShipMotion
+    from planbench.antenna.ship_motion import PaperShipMotion
 
     ship = PaperShipMotion().sample(np.array([0.0, 0.01]))
     az, el, pol = np.radians([223.49, 60.0, -28.8])
@@ -958,7 +958,7 @@ PAPER_TABLE1 = np.array([
 def test_loader_plans_pass_the_papers_key_points():
     """The supply plan passes Table 1's six key points at its times (mm -> m, deg -> rad by
     hand); the direct move joins P2 at 0 s to P3 at 2.5 s."""
-    from planners import loader as loader_planner
+    from planbench.planners import loader as loader_planner
 
     times = np.arange(6) * 0.5
     keys = np.column_stack([PAPER_TABLE1[:, 0] / 1000.0, PAPER_TABLE1[:, 1:] * (np.pi / 180.0)])

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from planners.trajectory import ChunkedSample, TrajectorySample
-from sims import runner
-from sims.fast import FastTrackingParams, build_scenario
-from sims.fast import controller as fast_controller
+from planbench.planners.trajectory import ChunkedSample, TrajectorySample
+from planbench import runner
+from planbench.fast import FastTrackingParams, build_scenario
+from planbench.fast import controller as fast_controller
 
 
 def _spline_sample(t: np.ndarray) -> TrajectorySample:
@@ -73,7 +73,7 @@ def test_fast_controller_in_small_plan_blocks_runs_the_same(monkeypatch, system)
 def test_imu_errors_in_blocks_are_the_whole_run_s_draws(n, block, seed, stride):
     """ImuErrors, read every ``stride``-th tick in blocks of ``block`` ticks: the numbers of the
     whole arrays drawn at once, and the generator left where those draws leave it."""
-    from sims.fast import measurement
+    from planbench.fast import measurement
 
     white, bias, walk = 1e-3, 1e-2, 1e-4
     rng = np.random.default_rng(seed)

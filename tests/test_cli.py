@@ -10,7 +10,7 @@ import pytest
 
 
 def planbench(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "sims.cli", *map(str, args)],
+    return subprocess.run([sys.executable, "-m", "planbench.cli", *map(str, args)],
                           capture_output=True, text=True, cwd=cwd, timeout=300)
 
 

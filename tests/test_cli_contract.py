@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from sims.cli import main
+from planbench.cli import main
 from tests.test_bad_invocations import scene  # noqa: F401  (the fixture)
 from tests.test_outputs import snapshot
 
@@ -26,7 +26,7 @@ PLAN_SPEC = ('scenario = "loader-supply"\nmode = "plan"\nseed = 1\nsamples = 3\n
 
 
 def _summary(**changes) -> str:
-    from sims import scenarios
+    from planbench import scenarios
 
     data = {"scenario": "loader-supply", "seed": 0, "parameters": scenarios.get("loader-supply").params.to_dict(),
             "plugins": {}}
@@ -94,10 +94,10 @@ def test_bad_input_is_one_line(argv, files, expected, scene, capsys):  # noqa: F
 
 
 def test_a_multi_line_toml_value_is_still_one_value():
-    from sims.params import parse_value, field_types
-    from sims.hexapod import HexapodParams  # noqa: F401
+    from planbench.params import parse_value, field_types
+    from planbench.hexapod import HexapodParams  # noqa: F401
 
-    from sims import scenarios
+    from planbench import scenarios
 
     cls = type(scenarios.get("hexapod-sync-move").params)
     moves = parse_value(field_types(cls)["moves"], "[\n{target=[0,0,0.01,0,0,0]}\n]", "--set moves")
@@ -106,7 +106,7 @@ def test_a_multi_line_toml_value_is_still_one_value():
 
 def _fake_demo(monkeypatch):
     """cmd_demo with every scenario's build and run replaced: only its outputs' rules act."""
-    from sims import outputs, runner, scenarios
+    from planbench import outputs, runner, scenarios
 
     calls = []
     for name, s in list(scenarios.SCENARIOS.items()):
@@ -130,14 +130,14 @@ def _fake_demo(monkeypatch):
 
     monkeypatch.setattr(runner, "run", run)
     monkeypatch.setattr(outputs, "write_run", write_run)
-    monkeypatch.setattr("sims.pipeline.check_log_space", lambda *args: None)
-    monkeypatch.setattr("sims.cli.format_checks", lambda rows: "")
+    monkeypatch.setattr("planbench.pipeline.check_log_space", lambda *args: None)
+    monkeypatch.setattr("planbench.cli.format_checks", lambda rows: "")
     return calls
 
 
 def test_demo_twice_into_results_and_beside_other_outputs(tmp_path, monkeypatch, capsys):
     """make demo twice: results/ of an earlier demo, a run's and a campaign's directories in it."""
-    from sims import scenarios
+    from planbench import scenarios
 
     monkeypatch.chdir(tmp_path)
     calls = _fake_demo(monkeypatch)
@@ -158,7 +158,7 @@ SIM_SPEC = 'scenario = "loader-supply"\nseeds = 8\n'
 
 def _sweep(tmp_path, **kw):
     (tmp_path / "sim.toml").write_text(SIM_SPEC)
-    return subprocess.Popen([sys.executable, "-m", "sims.cli", "sweep", "sim.toml", "--out", "c", "--quiet",
+    return subprocess.Popen([sys.executable, "-m", "planbench.cli", "sweep", "sim.toml", "--out", "c", "--quiet",
                              "--workers", "2"], cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)},
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planners.antenna import JOINT_LABELS
-from sims import runner, scenarios
-from sims.antenna import AntennaController
-from sims.plugins import PluginError
+from planbench.planners.antenna import JOINT_LABELS
+from planbench import runner, scenarios
+from planbench.antenna import AntennaController
+from planbench.plugins import PluginError
 
 DECK = ("heave", "yaw", "pitch", "roll")
 
@@ -84,9 +84,9 @@ def test_other_controllers_drive_every_actuator(name):
 def test_the_servo_controller_finds_its_drives_by_name():
     """ServoFeedforwardController on a command that is not the model's first actuators (the
     antenna's four joints, actuators 4 ... 7) reads those drives' gains, not the deck's."""
-    from planners.trajectory import TrajectorySample
-    from sims.controllers import ServoFeedforwardController
-    from sims.task import ControlContext
+    from planbench.planners.trajectory import TrajectorySample
+    from planbench.controllers import ServoFeedforwardController
+    from planbench.task import ControlContext
 
     setup = build("antenna-paper-motion", None)
     model = setup.physics.model.ptr
@@ -109,9 +109,9 @@ def test_the_servo_controller_refuses_a_reference_that_is_not_its_command(channe
     trajectory is refused by name in reset, not driven onto the wrong joints."""
     from types import SimpleNamespace
 
-    from planners.trajectory import TrajectorySample
-    from sims.controllers import ServoFeedforwardController
-    from sims.task import ControlContext
+    from planbench.planners.trajectory import TrajectorySample
+    from planbench.controllers import ServoFeedforwardController
+    from planbench.task import ControlContext
 
     setup = build("antenna-paper-motion", None)
     n = 3

@@ -1,4 +1,4 @@
-"""The drive-train elements of ``sims.drives`` against first principles, on a one-axis model: a
+"""The drive-train elements of ``planbench.drives`` against first principles, on a one-axis model: a
 load of mass M on a slide, driven through a motor, a compliant transmission with backlash,
 friction and the drive's PD loops."""
 
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from hypothesis import example, given, settings, strategies as st
 
-from sims import drives
-from sims.task import JointEncoders
+from planbench import drives
+from planbench.task import JointEncoders
 
 LOAD_MASS = 50.0  # kg
 DT = 0.0005  # s
@@ -181,9 +181,9 @@ def test_counted_encoders_read_straight_from_the_buffer_as_from_a_copy(positions
 def test_the_servo_feedforward_through_a_drive_train_is_the_load_s_plus_the_rotor_s():
     """Inverse dynamics on a model with a drive train as built: the motor moves with its load,
     so the feed-forward is (M + J N^2) a, not a force stretching the transmission."""
-    from planners.trajectory import TrajectorySample
-    from sims.controllers import ServoFeedforwardController
-    from sims.task import ControlContext
+    from planbench.planners.trajectory import TrajectorySample
+    from planbench.controllers import ServoFeedforwardController
+    from planbench.task import ControlContext
 
     train = drive()
     model = axis_model(train)

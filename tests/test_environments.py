@@ -1,5 +1,5 @@
 """dm_env's own conformance suite (``dm_env.test_utils.EnvironmentTestMixin``) for the
-dm_control Environment of every registered scenario (``sims.envs.make``), with an action sequence that holds the actuators where
+dm_control Environment of every registered scenario (``planbench.envs.make``), with an action sequence that holds the actuators where
 the episode starts and runs to the end of the episode, so the contract around LAST and the
 next FIRST is checked too."""
 
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from dm_env import test_utils
 
-from sims import envs, runner, scenarios
+from planbench import envs, runner, scenarios
 
 
 class _Conformance(test_utils.EnvironmentTestMixin):
@@ -124,7 +124,7 @@ def test_each_sea_state_episode_has_its_own_sea():
     on that seed's sea (another deck attitude at t = 0, the antenna pointing at the satellite
     through it, its drives at rest on the start), and the seed the scenario was built with
     starts where a run starts."""
-    from sims.antenna import pointing_errors
+    from planbench.antenna import pointing_errors
 
     env = envs.make("antenna-sea-state", duration=EPISODE_S, seed=3)
     physics, task = env.physics, env.task

@@ -7,8 +7,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from sims import scenarios
-from sims.cli import main
+from planbench import scenarios
+from planbench.cli import main
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -90,7 +90,7 @@ def test_fast_straight_switch_keeps_the_observation(tmp_path):
     summary, checks = run(tmp_path, "fast-source-switch", "planner", "fast/straight_switch_planner.py:StraightSwitch",
                           "--duration", "180")
     assert summary["passed"] and summary["metrics"]["observing_s"] > 50.0
-    assert summary["components"]["trajectory"] == "planners.fast.plan.FastPlan"
+    assert summary["components"]["trajectory"] == "planbench.planners.fast.plan.FastPlan"
 
 
 def test_every_mechanism_has_examples_and_each_plug_in_is_run_here():

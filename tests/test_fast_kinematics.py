@@ -9,9 +9,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from planners import fast
-from planners.errors import LimitError
-from planners.legs import structure_matrix
+from planbench.planners import fast
+from planbench.planners.errors import LimitError
+from planbench.planners.legs import structure_matrix
 
 DEG = math.pi / 180
 angles = st.floats(-math.pi, math.pi, allow_nan=False)

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from sims import runner
-from sims.fast import FastTrackingParams, build_scenario
-from sims.fast import measurement
-from sims.fast.measurement import SensorOptions, error_model, steady_state_gain
-from sims.params import ParamError
+from planbench import runner
+from planbench.fast import FastTrackingParams, build_scenario
+from planbench.fast import measurement
+from planbench.fast.measurement import SensorOptions, error_model, steady_state_gain
+from planbench.params import ParamError
 
 #: Published fused errors (REFERENCE.md: Li M.-H. et al., RAA 20, 140, 2020), RMS.
 CABIN_MM, CABIN_DEG = 14.56, 0.095

@@ -1,4 +1,4 @@
-"""models/fast against the planner (planners.fast) and against hand calculations."""
+"""models/fast against the planner (planbench.planners.fast) and against hand calculations."""
 
 import functools
 import math
@@ -10,10 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-import models
-from planners import fast
-from sims.fast import physics as fp
-from sims.fast.physics import FastPhysics
+from planbench import models
+from planbench.planners import fast
+from planbench.fast import physics as fp
+from planbench.fast.physics import FastPhysics
 
 G = fast.FAST
 
@@ -56,7 +56,7 @@ def test_feed_equals_eq1_at_random_rotator_angles(theta_a, theta_b, multifeed):
 
 
 def test_stewart_joint_sites_equal_the_planner_geometry(physics):
-    """Leg lengths between the model's joint sites equal planners.fast.stewart_leg_lengths, at
+    """Leg lengths between the model's joint sites equal planbench.planners.fast.stewart_leg_lengths, at
     the nominal pose and with the platform displaced and turned in the AB frame."""
     model, data = physics.model.ptr, physics.data.ptr
     base = [model.site(f"base_joint{i}").id for i in range(1, 7)]
@@ -89,7 +89,7 @@ def test_masses_and_centre_of_mass_equal_the_planner(physics):
     assert ab_mass == pytest.approx(G.ab_mass)
     centre = physics.data.site_xpos[physics.model.site("ab_center").id]
     np.testing.assert_allclose(ab_com - centre, G.ab_com, atol=1e-5)
-    # The tilted part moves the centre of mass as planners.fast.cabin_com_at says.
+    # The tilted part moves the centre of mass as planbench.planners.fast.cabin_com_at says.
     r_ab = fast.ab_rotation(0.3, -0.2)
     physics.set_configuration([0, 0, -155.65], np.eye(3), 0.3, -0.2)
     _, com = physics.subtree_mass(cabin)

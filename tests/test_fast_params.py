@@ -5,9 +5,9 @@ import re
 
 import pytest
 
-from sims import fast
-from sims.params import ParamError
-from sims.wind import MAX_DIRECTION_DEG, MeasuredWind, WindFileError
+from planbench import fast
+from planbench.params import ParamError
+from planbench.wind import MAX_DIRECTION_DEG, MeasuredWind, WindFileError
 
 RADEC = [202.78, 30.51]
 
@@ -49,7 +49,7 @@ def test_wind_file_direction_beyond_one_turn_is_refused(tmp_path, direction, ok)
 
 def test_dut1_reaches_the_plan():
     """UT1 - UTC = +0.5 s: the transit, hence the default observation's start, 0.5 s earlier in UTC."""
-    from planners.fast import sky
+    from planbench.planners.fast import sky
 
     a = fast.goal_plan(fast.FastTrackingParams(tracking=60.0))
     b = fast.goal_plan(fast.FastTrackingParams(tracking=60.0, dut1=0.5))

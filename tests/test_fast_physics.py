@@ -7,16 +7,16 @@ import mujoco
 import numpy as np
 import pytest
 
-from planners import fast
-from planners.fast import plan as fplan
-from sims import fast as fast_sim
-from sims import runner
-from sims.fast import physics as fast_physics
-from sims.fast.measurement import SensorOptions
-from sims.fast import loads as fast_loads
-from sims.fast.controller import ControllerOptions, FastController, winch_feedforward
-from sims.fast.loads import CableLoads
-from sims.fast.physics import FastPhysics, tangent_stiffness
+from planbench.planners import fast
+from planbench.planners.fast import plan as fplan
+from planbench import fast as fast_sim
+from planbench import runner
+from planbench.fast import physics as fast_physics
+from planbench.fast.measurement import SensorOptions
+from planbench.fast import loads as fast_loads
+from planbench.fast.controller import ControllerOptions, FastController, winch_feedforward
+from planbench.fast.loads import CableLoads
+from planbench.fast.physics import FastPhysics, tangent_stiffness
 
 #: The idealized cabin-pose measurements (the earlier sensors: tests of the statics and of the
 #: chains that want the feed still to a millimetre).
@@ -195,7 +195,7 @@ def test_dm_control_environment_with_the_winch_feedforward():
     """A user's controller in the Environment: the observed feed-forward lengths and the
     planned A-B angles hold the feed within millimetres on the lumped cables, whose law the
     feed-forward inverts; paying the winches out by 1 m drops it."""
-    from sims.envs import fast_environment
+    from planbench.envs import fast_environment
 
     env = fast_environment(duration=5.0, wind=0.0, cable_segments=0)
     reference = env.task.reference
@@ -283,8 +283,8 @@ def test_a_bad_control_rate_is_named(overrides, words):
 def test_a_controller_bandwidth_beyond_the_control_rate_is_refused_before_the_run():
     """ControllerOptions cannot know the run's rate: the controller's reset compares them,
     before any physics step (bad input, not a failed run)."""
-    from sims.fast import FastTrackingParams, build_scenario
-    from sims.task import PluginError
+    from planbench.fast import FastTrackingParams, build_scenario
+    from planbench.task import PluginError
 
     setup = build_scenario(FastTrackingParams(duration=1.0),
                            controller=FastController(ControllerOptions(platform_bandwidth_hz=30.0)))
@@ -296,7 +296,7 @@ def test_a_controller_bandwidth_beyond_the_control_rate_is_refused_before_the_ru
 def test_long_runs_write_every_tenth_tick(tmp_path):
     import json
 
-    from sims import outputs
+    from planbench import outputs
 
     plan = fast_sim.observation_plan(200.0)
     stride = fast_sim.build(plan, fast_sim.FastParams()).output.output_stride  # 204 s > 120 s: 10 Hz
@@ -460,7 +460,7 @@ def test_the_chains_slow_refresh_changes_nothing_that_is_judged():
     weights' moment every GEOMETRY_S (0.1 s); refreshed every tick instead, the first
     20 s of fast-tracking at 8 m/s (the descent from park at up to 0.4 m/s, the fastest the
     winches and the cabin move) gives the same checks within 1e-3 of their values."""
-    from sims.fast import FastTrackingParams, build_scenario
+    from planbench.fast import FastTrackingParams, build_scenario
 
     values = []
     for seconds in (fast_loads.ChainCableLoads.GEOMETRY_S, 0.0):

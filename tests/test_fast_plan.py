@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from planners import fast
-from planners.fast import plan as fp
-from planners import profiles as prof
-from planners.errors import LimitError
-from sims import fast as fast_sims
+from planbench.planners import fast
+from planbench.planners.fast import plan as fp
+from planbench.planners import profiles as prof
+from planbench.planners.errors import LimitError
+from planbench import fast as fast_sims
 
 
 @pytest.fixture(scope="module")
@@ -169,7 +169,7 @@ def test_shorter_t2_breaks_a_t_max():
 
 
 def test_multifeed_rotation_follows_the_parallactic_angle_and_stays_c1(switch_plan):
-    from planners.fast import sky as fast_sky
+    from planbench.planners.fast import sky as fast_sky
 
     plan = switch_plan
     t = np.arange(0.0, plan.duration, 0.01)

@@ -1,4 +1,4 @@
-"""Plant uncertainty of FAST (sims.fast.FastPlant): each field edits exactly its part of the
+"""Plant uncertainty of FAST (planbench.fast.FastPlant): each field edits exactly its part of the
 compiled model or the plant's cable physics, the planner and the controller keep the nominal
 model and its feed-forward the nominal constants, the nominal plant runs as before, short runs
 show each perturbation acting as computed by hand, and bad values are refused."""
@@ -16,12 +16,12 @@ import pytest
 
 from model_diff import changed_fields
 from plant_model import assert_edits_only
-from planners import fast
-from sims import api, fast as fast_sim, runner, scenarios
-from sims.fast import physics as fast_physics
-from sims.fast.params import CABIN_BODIES, FastPlant
-from sims.fast.physics import CABLE_EA, CABLE_WEIGHT, FastPhysics
-from sims.params import ParamError
+from planbench.planners import fast
+from planbench import api, fast as fast_sim, runner, scenarios
+from planbench.fast import physics as fast_physics
+from planbench.fast.params import CABIN_BODIES, FastPlant
+from planbench.fast.physics import CABLE_EA, CABLE_WEIGHT, FastPhysics
+from planbench.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("fast-tracking")
@@ -67,7 +67,7 @@ def test_every_fast_scenario_declares_the_nominal_fast_plant():
 
 
 def test_the_readme_documents_every_plant_field():
-    from sims.params import markdown_table
+    from planbench.params import markdown_table
 
     assert markdown_table(FastPlant) in (ROOT / "models/fast/README.md").read_text()
 

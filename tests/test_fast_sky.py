@@ -23,8 +23,8 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from planners.fast import sky as fs
-from planners.errors import LimitError, PlanningError
+from planbench.planners.fast import sky as fs
+from planbench.planners.errors import LimitError, PlanningError
 
 DEG = math.pi / 180
 ARCSEC = DEG / 3600

@@ -14,11 +14,11 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
-from planners.legs import cross, leg_vectors, structure_matrix
-from sims.fast import FastTrackingParams, build_scenario
-from sims.fast.measurement import FusedPoses
-from sims.fast.physics import _LEVI_CIVITA, index_view
-from sims import runner
+from planbench.planners.legs import cross, leg_vectors, structure_matrix
+from planbench.fast import FastTrackingParams, build_scenario
+from planbench.fast.measurement import FusedPoses
+from planbench.fast.physics import _LEVI_CIVITA, index_view
+from planbench import runner
 
 
 def _einsum_pairs_first_and_third() -> bool:
@@ -152,7 +152,7 @@ def test_an_index_view_indexes_the_elements_of_its_indices(scattered, start, ste
 
 
 def _structure_matrix_with_np_cross(anchors, points, position, rotation):
-    """planners.legs.structure_matrix as it was written first: np.cross, leg_vectors."""
+    """planbench.planners.legs.structure_matrix as it was written first: np.cross, leg_vectors."""
     vectors = leg_vectors(anchors, points, position, rotation)
     units = vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
     arms = np.einsum("...jk,nk->...nj", np.asarray(rotation, dtype=float), np.asarray(points, dtype=float))
@@ -163,7 +163,7 @@ def _structure_matrix_with_np_cross(anchors, points, position, rotation):
 @given(arrays(float, (6, 3), elements=st.floats(-300.0, 300.0)), arrays(float, (6, 3), elements=st.floats(-10.0, 10.0)),
        st.integers(0, 3), arrays(float, (3, 3), elements=st.floats(-1.0, 1.0)), st.floats(-1.0, 1.0))
 def test_the_structure_matrix_and_cross_are_np_cross_s_arithmetic(anchors, points, batch, angles, scale):
-    """structure_matrix with planners.legs.cross: the same matrix, to the bit and in the same
+    """structure_matrix with planbench.planners.legs.cross: the same matrix, to the bit and in the same
     memory layout (its transpose feeds matmul), for one pose and for a batch; cross itself
     against np.cross."""
     from scipy.spatial.transform import Rotation
@@ -184,7 +184,7 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
     (indexing, as before): after ticks of winch commands moving and wind, the same actuator
     laws, spring rest lengths, stiffnesses and dampings, node and anchor masses, node damping,
     applied forces and tensions, to the bit."""
-    from sims.fast import ChainCableLoads, FastPhysics
+    from planbench.fast import ChainCableLoads, FastPhysics
 
     times = np.arange(40) * 0.02
     runs = []
@@ -218,8 +218,8 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
 def _vectorized_correct(f: FusedPoses, body: int, measured: np.ndarray, at_tick: int) -> None:
     """A fix's correction on numpy arrays (the earlier implementation): the fit by
     small_rotation_fit in the world frame, K y, then Phi^k of it."""
-    from planners.rotations import skew
-    from sims.fast.measurement import BA, BG, P, TH, V, _orthonormal, small_rotation_fit
+    from planbench.planners.rotations import skew
+    from planbench.fast.measurement import BA, BG, P, TH, V, _orthonormal, small_rotation_fit
 
     samples = f._samples[body]
     _, position, estimated = samples.popleft()

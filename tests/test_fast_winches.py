@@ -1,4 +1,4 @@
-"""FAST's winches as built (sims.fast.loads.Winches): each rope within its drive's speed and
+"""FAST's winches as built (planbench.fast.loads.Winches): each rope within its drive's speed and
 acceleration, at its command whenever the limits allow; and any action inside the dm_env
 action spec is one the drives can follow."""
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from sims import envs
-from sims.fast.loads import WINCH_MAX_ACCEL, WINCH_MAX_SPEED, Winches
+from planbench import envs
+from planbench.fast.loads import WINCH_MAX_ACCEL, WINCH_MAX_SPEED, Winches
 
 DT = 0.02
 

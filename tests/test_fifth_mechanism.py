@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import models
+from planbench import models
 
 ROOT = Path(__file__).resolve().parents[1]
 PENDULUM = ROOT / "tests" / "mechanisms" / "pendulum"
@@ -30,9 +30,9 @@ GRAVITY_TORQUE = 2.0 * 9.81 * 0.5
 
 
 def planbench(*args, cwd, check=True, **env):
-    """``python -m sims.cli ARGS`` with the pendulum's root in PLANBENCH_MECHANISMS."""
+    """``python -m planbench.cli ARGS`` with the pendulum's root in PLANBENCH_MECHANISMS."""
     environ = {**os.environ, models.ROOTS_VARIABLE: str(PENDULUM), "PYTHONPATH": str(ROOT), **env}
-    done = subprocess.run([sys.executable, "-m", "sims.cli", *args], cwd=cwd, env=environ,
+    done = subprocess.run([sys.executable, "-m", "planbench.cli", *args], cwd=cwd, env=environ,
                           capture_output=True, text=True, timeout=600)
     if check:
         assert done.returncode == 0, done.stderr
@@ -49,7 +49,7 @@ def python(code: str, cwd):
 
 def test_it_is_listed_and_runs_to_a_pass_that_holds_by_hand(tmp_path):
     assert "pendulum-swing" in planbench("list", cwd=tmp_path).stdout
-    assert "pendulum" not in subprocess.run([sys.executable, "-m", "sims.cli", "list"], cwd=tmp_path,
+    assert "pendulum" not in subprocess.run([sys.executable, "-m", "planbench.cli", "list"], cwd=tmp_path,
                                             env={**os.environ, "PYTHONPATH": str(ROOT)},
                                             capture_output=True, text=True, check=True).stdout
     planbench("run", "pendulum-swing", "--goal", "1.2", "--out", "run", "--quiet", cwd=tmp_path)
@@ -86,7 +86,7 @@ def test_the_dm_control_environment_holds_the_start_and_rewards_tracking(tmp_pat
     out = python(
         "import numpy as np\n"
         "from dm_env import test_utils\n"
-        "from sims.envs import make\n"
+        "from planbench.envs import make\n"
         "env = make('pendulum-swing')\n"
         "step = env.reset()\n"
         "assert set(step.observation) >= {'joint_positions', 'setpoints', 'reference_positions'}\n"

@@ -1,4 +1,4 @@
-"""The hexapod's struts as built (sims.hexapod.physics.STRUT_DRIVE): the model's drive-train
+"""The hexapod's struts as built (planbench.hexapod.physics.STRUT_DRIVE): the model's drive-train
 elements against their definitions, the start in static equilibrium through the screws'
 compliance, and the counting encoders."""
 
@@ -10,11 +10,11 @@ import mujoco
 import numpy as np
 import pytest
 
-from planners.hexapod import STRUT_LABELS
-from sims import runner, scenarios
-from sims import hexapod as sim_hexapod
-from sims.drives import transmission_stiffness
-from sims.hexapod import physics as hexapod_physics
+from planbench.planners.hexapod import STRUT_LABELS
+from planbench import runner, scenarios
+from planbench import hexapod as sim_hexapod
+from planbench.drives import transmission_stiffness
+from planbench.hexapod import physics as hexapod_physics
 
 DRIVE = hexapod_physics.STRUT_DRIVE
 

@@ -4,7 +4,7 @@ moves and the hexapod-space speeds, the following error's window, the wind's sig
 "How the hexapod is judged").
 
 Each rule is judged both ways a user meets it: by a run (``HexapodEvaluation``) and by the
-planner-only judge (``sims.hexapod.plan_checks``). Runs are short and windless unless wind is
+planner-only judge (``planbench.hexapod.plan_checks``). Runs are short and windless unless wind is
 the point.
 """
 
@@ -18,11 +18,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from planners import hexapod as hp
-from planners.trajectory import TrajectorySample
-from sims import runner, scenarios
-from sims import hexapod as sh
-from sims.hexapod.plan_checks import judge_plans
+from planbench.planners import hexapod as hp
+from planbench.planners.trajectory import TrajectorySample
+from planbench import runner, scenarios
+from planbench import hexapod as sh
+from planbench.hexapod.plan_checks import judge_plans
 
 DT = sh.CONTROL_DT
 ARRIVAL_CHECKS = ("arrival_spread", "arrival_vs_own_time")

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-import models
-from planners import hexapod
-from planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
-from sims.hexapod import HexapodController, HexapodPhysics, top_end_rotation
-from planners.trajectory import TrajectorySample
+from planbench import models
+from planbench.planners import hexapod
+from planbench.planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
+from planbench.hexapod import HexapodController, HexapodPhysics, top_end_rotation
+from planbench.planners.trajectory import TrajectorySample
 
 G = 9.81
 
@@ -88,9 +88,9 @@ class _Still:
 
 def _hold(physics, seconds):
     """HexapodController holding the start for ``seconds``, run by the runner."""
-    from sims import hexapod as hexapod_sim
-    from sims import runner
-    from sims.task import Components, Task
+    from planbench import hexapod as hexapod_sim
+    from planbench import runner
+    from planbench.task import Components, Task
 
     controller = HexapodController()
     task = Task(problem=None, sensors=hexapod_sim.sensors(physics), evaluation=None, control_dt=0.005,

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from planners.trajectory import TrajectorySample
-from sims import runner, scenarios
-from sims import hexapod as sim_hexapod
-from sims.wind import AIR_DENSITY, kaimal_spectrum, wind_speed_series
+from planbench.planners.trajectory import TrajectorySample
+from planbench import runner, scenarios
+from planbench import hexapod as sim_hexapod
+from planbench.wind import AIR_DENSITY, kaimal_spectrum, wind_speed_series
 
 EXPECTED = {"strut_velocity", "strut_accel", "hexapod_speed", "following_error", "pose_error_final",
             "strut_force", "stroke", "simulation_warnings", "controller_errors"}
@@ -65,7 +65,7 @@ def test_wind_loads_the_camera_with_its_drag():
     assert abs(u.mean() - WIND_M_S) < 3 * 0.14 * (0.75 * WIND_M_S + 5.6)
     assert u.std() > 0.05
     # The per-tick scalar drag equals drag_force with the camera's silhouette at that tick.
-    from sims.wind import cylinder_projected_area, drag_force
+    from planbench.wind import cylinder_projected_area, drag_force
 
     physics = setup.physics
     axis = physics.data.geom_xmat[physics.model.ptr.geom("camera_body").id].reshape(3, 3)[:, 2]
@@ -162,7 +162,7 @@ def test_elevation_outside_the_range_is_refused(elevation):
 
 
 def test_dm_control_environment_steps():
-    from sims.envs import hexapod_environment
+    from planbench.envs import hexapod_environment
 
     env = hexapod_environment(elevation_deg=45.0)
     step = env.reset()

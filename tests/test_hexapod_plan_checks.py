@@ -1,4 +1,4 @@
-"""Planner-only checks of hexapod runs (sims.hexapod.plan_checks): against a run's own checks,
+"""Planner-only checks of hexapod runs (planbench.hexapod.plan_checks): against a run's own checks,
 against sampling every tick, bad plans, batches against single runs, random moves."""
 
 from __future__ import annotations
@@ -8,12 +8,12 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from planners import hexapod as hp
-from planners.trajectory import TrajectorySample
-from sims import api, scenarios
-from sims.hexapod import HexapodMove, HexapodParams, pose_mm_deg, pose_si, problems
-from sims.hexapod.plan_checks import judge_plans, judge_trajectories
-from sims.params import ParamError
+from planbench.planners import hexapod as hp
+from planbench.planners.trajectory import TrajectorySample
+from planbench import api, scenarios
+from planbench.hexapod import HexapodMove, HexapodParams, pose_mm_deg, pose_si, problems
+from planbench.hexapod.plan_checks import judge_plans, judge_trajectories
+from planbench.params import ParamError
 
 #: The checks that judge a limit the paper's generator keeps by construction.
 KEPT = ("arrival_spread", "arrival_vs_own_time", "strut_velocity", "strut_accel", "plan_stroke",
@@ -223,7 +223,7 @@ def test_random_valid_moves_pass_the_limits_the_generator_keeps(params):
 @given(st.lists(st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.just(0.0), st.just(-0.0)),
                          min_size=6, max_size=6), min_size=1, max_size=20))
 def test_max_of_the_last_axis_is_numpys(rows):
-    from sims.hexapod.plan_checks import _max_last
+    from planbench.hexapod.plan_checks import _max_last
 
     values = np.array(rows)
     np.testing.assert_array_equal(_max_last(values), values.max(axis=-1))
@@ -233,7 +233,7 @@ def test_max_of_the_last_axis_is_numpys(rows):
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(1, 40))
 def test_the_nearest_anchor_is_the_argmin_of_the_distances(seed, count):
-    from sims.hexapod.plan_checks import _Anchors
+    from planbench.hexapod.plan_checks import _Anchors
 
     rng = np.random.default_rng(seed)
     start, target = hp.random_poses(count, rng), hp.random_poses(count, rng)

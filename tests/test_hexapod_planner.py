@@ -12,8 +12,8 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from planners.errors import LimitError, PlanningError
-from planners.hexapod import (
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.hexapod import (
     CONTROL_DT,
     RUBIN_CAMERA,
     RUBIN_LIMITS,
@@ -35,7 +35,7 @@ from planners.hexapod import (
     strut_min_time,
     strut_positions,
 )
-from planners.legs import component_norm, leg_vector_components, leg_vectors, structure_matrix
+from planbench.planners.legs import component_norm, leg_vector_components, leg_vectors, structure_matrix
 
 UM = 1e-6
 DT = CONTROL_DT
@@ -1011,7 +1011,7 @@ def test_sample_before_start_holds_start():
 
 
 def test_bad_geometry_raises():
-    from planners.hexapod import HexapodGeometry, HexapodLimits
+    from planbench.planners.hexapod import HexapodGeometry, HexapodLimits
     with pytest.raises(PlanningError):
         HexapodGeometry(BASE[:5], MIRROR[:5], PIVOT)
     with pytest.raises(PlanningError):
@@ -1045,8 +1045,8 @@ def test_random_single_moves(start, target, sync):
 
 def test_a_pose_change_below_the_struts_round_off_is_a_move_of_zero_length():
     # Found by hypothesis: rz = 5e-222 deg changes no strut length, and its plan had duration 0.
-    from sims.hexapod import HexapodMove, HexapodParams
-    from sims.params import ParamError
+    from planbench.hexapod import HexapodMove, HexapodParams
+    from planbench.params import ParamError
 
     with pytest.raises(ParamError, match=r"moves\[0\]\.target equals the pose before it \(no strut length changes\)"):
         HexapodParams(moves=(HexapodMove((0.0, 0.0, 0.0, 0.0, 0.0, 5.0165313870954834e-222), False),))

@@ -1,4 +1,4 @@
-"""Plant uncertainty of the camera hexapod (sims.hexapod.HexapodPlant): each field edits exactly
+"""Plant uncertainty of the camera hexapod (planbench.hexapod.HexapodPlant): each field edits exactly
 its part of the compiled model, the controller keeps the nominal model, the nominal plant runs as
 before, short runs show each perturbation acting as computed by hand, and bad values are refused."""
 
@@ -15,10 +15,10 @@ from hypothesis import strategies as st
 
 from model_diff import changed_fields
 from plant_model import assert_edits_only
-from planners import hexapod as hexapod_planner
-from planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
-from sims import api, hexapod, runner, scenarios
-from sims.params import ParamError
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
+from planbench import api, hexapod, runner, scenarios
+from planbench.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("hexapod-sync-move")
@@ -58,7 +58,7 @@ def test_every_hexapod_scenario_declares_the_nominal_hexapod_plant():
 
 
 def test_the_readme_documents_every_plant_field():
-    from sims.params import markdown_table
+    from planbench.params import markdown_table
 
     assert markdown_table(hexapod.HexapodPlant) in (ROOT / "models/hexapod/README.md").read_text()
 

@@ -13,9 +13,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-import models
-from sims import runner, scenarios
-from sims.params import ParamError
+from planbench import models
+from planbench import runner, scenarios
+from planbench.params import ParamError
 
 PINNED = {
     'antenna-paper-motion': {'qpos': 252.34256240492317, 'qvel': 128.28624452325786, 'actuator_force': 20713686.967366107, 'ctrl': 127.9771675287166},

@@ -1,4 +1,4 @@
-"""The loader's drive trains as built (sims.loader.physics.as_built): each axis's motor,
+"""The loader's drive trains as built (planbench.loader.physics.as_built): each axis's motor,
 reducer, friction and encoder against their definitions, the start's static equilibrium
 through the reducers, and the plant's errors of the new elements."""
 
@@ -10,14 +10,14 @@ import mujoco
 import numpy as np
 import pytest
 
-import models
-from planners.errors import LimitError
-from sims import runner, scenarios
-from sims.drives import MOTOR_SUFFIX, TRANSMISSION_SUFFIX
-from sims.loader import physics as loader_physics
-from sims.loader.params import LoaderPlant
-from sims.loader.physics import TRANSMISSIONS, LoaderPhysics
-from sims.params import ParamError
+from planbench import models
+from planbench.planners.errors import LimitError
+from planbench import runner, scenarios
+from planbench.drives import MOTOR_SUFFIX, TRANSMISSION_SUFFIX
+from planbench.loader import physics as loader_physics
+from planbench.loader.params import LoaderPlant
+from planbench.loader.physics import TRANSMISSIONS, LoaderPhysics
+from planbench.params import ParamError
 
 NAMES = models.loader_spec().names
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-import models
-from planners.loader import forward_kinematics
+from planbench import models
+from planbench.planners.loader import forward_kinematics
 
 SPEC = models.loader_spec()
 

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from planners.loader import direct_plan, supply_plan
-from sims import runner, scenarios
-from sims.loader.collision import clearance
-from sims.loader import LoaderPhysics
-from sims.controllers import ServoFeedforwardController
+from planbench.planners.loader import direct_plan, supply_plan
+from planbench import runner, scenarios
+from planbench.loader.collision import clearance
+from planbench.loader import LoaderPhysics
+from planbench.controllers import ServoFeedforwardController
 
 
 def run(name, **options):
@@ -131,7 +131,7 @@ def test_steps_per_tick_rejects_non_multiples():
 
 
 def test_dm_control_environment_steps():
-    from sims.envs import loader_environment
+    from planbench.envs import loader_environment
 
     env = loader_environment()
     ts = env.reset()
@@ -149,7 +149,7 @@ def test_dm_control_environment_steps():
 
 
 def test_benchmark_reports_ratios_against_bare_stepping():
-    from sims import bench
+    from planbench import bench
 
     row = bench.bench_scenario("loader-supply")
     assert row["physics_steps"] == 6000 and row["passed"]
@@ -160,7 +160,7 @@ def test_benchmark_reports_ratios_against_bare_stepping():
 
 def test_shell_tip_sensor_matches_planner_kinematics(supply):
     """The sensor lags the logged qpos by one physics step; at rest at the end they agree."""
-    from planners.loader import forward_kinematics
+    from planbench.planners.loader import forward_kinematics
 
     result, setup = supply
     tip = setup.physics.shell_tip_log(result.log.sensordata)
@@ -177,7 +177,7 @@ def test_shell_tip_sensor_matches_planner_kinematics(supply):
 def test_a_shell_lighter_than_a_milligram_is_none(mass):
     """MuJoCo cannot diagonalize the inertia of geoms that light (found by hypothesis at
     1e-12 kg): the model then carries no shell, as at 0 kg, and still builds and runs."""
-    from sims.loader.physics import LoaderPhysics
+    from planbench.loader.physics import LoaderPhysics
 
     physics = LoaderPhysics.load(mass)
     model = physics.model.ptr

@@ -1,4 +1,4 @@
-"""Planner-only checks of loader runs (sims.loader.plan_checks): against a run's reference,
+"""Planner-only checks of loader runs (planbench.loader.plan_checks): against a run's reference,
 against sampling every tick, bad plans, batches against single runs, random key points."""
 
 from __future__ import annotations
@@ -8,15 +8,15 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-import models
-from planners.errors import PlanningError
-from planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, si_to_table1
-from planners.loader.bspline import CubicBSplineTrajectory
-from planners.trajectory import TrajectorySample
-from sims import api, scenarios
-from sims.loader import LoaderParams, problem
-from sims.loader.collision import clearance
-from sims.loader.plan_checks import _collision, judge_plans, judge_trajectory, random_key_points
+from planbench import models
+from planbench.planners.errors import PlanningError
+from planbench.planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, si_to_table1
+from planbench.planners.loader.bspline import CubicBSplineTrajectory
+from planbench.planners.trajectory import TrajectorySample
+from planbench import api, scenarios
+from planbench.loader import LoaderParams, problem
+from planbench.loader.collision import clearance
+from planbench.loader.plan_checks import _collision, judge_plans, judge_trajectory, random_key_points
 
 SPEC = models.loader_spec()
 LOW, HIGH = si_to_table1(SPEC.lower), si_to_table1(SPEC.upper)

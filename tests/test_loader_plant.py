@@ -1,4 +1,4 @@
-"""Plant uncertainty of the loader (sims.loader.LoaderPlant): each field edits exactly its part of
+"""Plant uncertainty of the loader (planbench.loader.LoaderPlant): each field edits exactly its part of
 the compiled model, the controller keeps the nominal model, the nominal plant runs as before,
 short runs show each perturbation acting as computed by hand, and bad values are refused."""
 
@@ -12,12 +12,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import models
+from planbench import models
 from model_diff import changed_fields
 from plant_model import assert_edits_only
-from planners.loader import forward_kinematics, table1_to_si
-from sims import api, loader, runner, scenarios
-from sims.params import ParamError
+from planbench.planners.loader import forward_kinematics, table1_to_si
+from planbench import api, loader, runner, scenarios
+from planbench.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("loader-supply")
@@ -52,7 +52,7 @@ def test_every_loader_scenario_declares_the_nominal_loader_plant():
 
 
 def test_the_readme_documents_every_plant_field():
-    from sims.params import markdown_table
+    from planbench.params import markdown_table
 
     assert markdown_table(loader.LoaderPlant) in (ROOT / "models/loader/README.md").read_text()
 

@@ -1,4 +1,4 @@
-"""A run's log streams to disk in chunks (sims.logfile): every row arrives, at every chunk
+"""A run's log streams to disk in chunks (planbench.logfile): every row arrives, at every chunk
 boundary; a log cut short by SIGKILL reads back as its whole chunks, marked incomplete; the
 streamed log holds exactly the state MuJoCo had at each tick; two runs write the same bytes;
 a log that would not fit on the disk is refused before any work."""
@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from sims import api, logfile, outputs, pipeline, run_limits, runner, scenarios
-from sims.cli import main
-from sims.logfile import ChunkWriter, read_log
+from planbench import api, logfile, outputs, pipeline, run_limits, runner, scenarios
+from planbench.cli import main
+from planbench.logfile import ChunkWriter, read_log
 
 ROOT = Path(__file__).resolve().parents[1]
 SHAPES = {"qpos": (3,), "act": (0,), "mocap_pos": (2, 3)}
@@ -243,7 +243,7 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
     to the first rows of the same run completed."""
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    proc = subprocess.Popen([sys.executable, "-m", "sims.cli", "run", "loader-supply", "--duration", "200",
+    proc = subprocess.Popen([sys.executable, "-m", "planbench.cli", "run", "loader-supply", "--duration", "200",
                              "--out", str(out), "--quiet"], env=env, cwd=tmp_path,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -283,7 +283,7 @@ def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path)
     readable, incomplete, equal to the first rows of the same run completed."""
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    proc = subprocess.run([sys.executable, "-m", "sims.cli", "run", "loader-supply", "--duration", "300",
+    proc = subprocess.run([sys.executable, "-m", "planbench.cli", "run", "loader-supply", "--duration", "300",
                            "--timeout", "5", "--out", str(out), "--quiet"], env=env, cwd=tmp_path,
                           capture_output=True, text=True, timeout=180)
     assert proc.returncode == 1, proc.stderr

@@ -4,8 +4,8 @@ import mujoco
 import numpy as np
 import pytest
 
-import models
-from sims.runner import warning_counts
+from planbench import models
+from planbench.runner import warning_counts
 
 
 @pytest.fixture(scope="module", params=models.MECHANISMS)

@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sims import outputs
-from sims.cli import main
-from sims.outputs import MANIFEST, OutputDir, OutputError, VideoFile
+from planbench import outputs
+from planbench.cli import main
+from planbench.outputs import MANIFEST, OutputDir, OutputError, VideoFile
 
-PLANBENCH = [sys.executable, "-m", "sims.cli"]
+PLANBENCH = [sys.executable, "-m", "planbench.cli"]
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -128,8 +128,8 @@ def test_video_outside_replaces_only_planbench_videos(tmp_path):
 def test_every_accepted_video_suffix_is_written_and_tagged(suffix, tmp_path):
     import mujoco
 
-    from sims.render import render_video
-    from sims.runner import RunLog
+    from planbench.render import render_video
+    from planbench.runner import RunLog
 
     model = mujoco.MjModel.from_xml_string(
         '<mujoco><visual><global offwidth="64" offheight="48"/></visual><worldbody>'

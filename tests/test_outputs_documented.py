@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sims import api, scenarios
-from sims.plans import write_plan
+from planbench import api, scenarios
+from planbench.plans import write_plan
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 RUNS = {  # short runs (s): every array and metric is written whatever the duration

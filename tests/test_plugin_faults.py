@@ -36,8 +36,8 @@ PLUGIN = textwrap.dedent('''
     if WHERE == "import":
         act()
 
-    from planners.loader import CubicBSplinePlanner
-    from sims.loader import reference_controller
+    from planbench.planners.loader import CubicBSplinePlanner
+    from planbench.loader import reference_controller
 
     class Controller:
         def reset(self, context):
@@ -97,7 +97,7 @@ def expected_exit(where: str, mode: str) -> int:
 
 
 def planbench(*args, env=None, cwd=None, timeout=120):
-    return subprocess.run([sys.executable, "-m", "sims.cli", *map(str, args)], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "planbench.cli", *map(str, args)], capture_output=True, text=True,
                           env={**os.environ, **(env or {})}, cwd=cwd, timeout=timeout)
 
 

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sims import api
-from sims.cli import main
-from sims.task import PluginError
+from planbench import api
+from planbench.cli import main
+from planbench.task import PluginError
 
 PLUGINS = textwrap.dedent('''
     import numpy as np
@@ -142,7 +142,7 @@ def test_a_plugin_that_raises_during_the_run_fails_a_check_and_writes_outputs(pl
     assert not error["passed"] and "KeyError: 'setpoint'" in error["note"] and "t = 0.0250 s" in error["note"]
     assert summary["plugins"] == {"controller": spec}
     assert summary["components"]["controller"].endswith(".RaisesLater")
-    assert summary["components"]["planner"] == "planners.loader.CubicBSplinePlanner"
+    assert summary["components"]["planner"] == "planbench.planners.loader.CubicBSplinePlanner"
 
 
 def test_a_module_plugin_and_the_python_api_run_the_same(plugin_file, monkeypatch):

@@ -14,8 +14,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from planners.errors import LimitError, PlanningError
-from planners.profiles import (
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.profiles import (
     Profile,
     concatenate,
     cruise,
@@ -24,7 +24,7 @@ from planners.profiles import (
     move_min_time,
     velocity_change,
 )
-from planners.trajectory import Trajectory, TrajectorySample
+from planbench.planners.trajectory import Trajectory, TrajectorySample
 
 A_MAX, A_T_MAX, A_S_MAX = 10e-3, 15e-3, 25e-3  # m/s^2, Table 1
 V_S_MAX = 400e-3  # m/s, Table 1

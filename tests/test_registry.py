@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-import models
-from sims import scenarios
+from planbench import models
+from planbench import scenarios
 
 
 def test_the_mechanisms_are_the_model_folders():
@@ -30,7 +30,7 @@ def test_a_model_folder_without_its_simulation_package_is_named(monkeypatch):
 
 
 def test_a_scenario_found_by_its_mechanism_imports_that_mechanism_alone():
-    # A campaign's worker (sims.campaign.worker) looks its scenario up with get_of: the same
+    # A campaign's worker (planbench.campaign.worker) looks its scenario up with get_of: the same
     # scenario as the registry's, without importing the other mechanisms' packages.
     import subprocess
     import sys
@@ -38,7 +38,7 @@ def test_a_scenario_found_by_its_mechanism_imports_that_mechanism_alone():
     code = ("import sys; from sims import scenarios\n"
             "by_mechanism = {m: scenarios.get_of(m, n) for m, n in [('hexapod', 'hexapod-sync-move'), "
             "('loader', 'loader-supply')]}\n"
-            "print(sorted(m for m in ('sims.fast', 'sims.antenna') if m in sys.modules))\n"
+            "print(sorted(m for m in ('planbench.fast', 'planbench.antenna') if m in sys.modules))\n"
             "print(all(s is scenarios.get(s.name) for s in by_mechanism.values()))\n"
             "print(scenarios.get_of('hexapod', 'fast-tracking').name)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout

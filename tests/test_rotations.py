@@ -1,4 +1,4 @@
-"""planners.rotations: the shared rotation helpers against numpy, scipy and MuJoCo."""
+"""planbench.planners.rotations: the shared rotation helpers against numpy, scipy and MuJoCo."""
 
 import mujoco
 import numpy as np
@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy.spatial.transform import Rotation
 
-from planners.rotations import rot_x, rot_y, rot_z, skew, vee, wxyz
+from planbench.planners.rotations import rot_x, rot_y, rot_z, skew, vee, wxyz
 
 vectors = arrays(float, 3, elements=st.floats(-10, 10))
 

@@ -1,8 +1,8 @@
 """Run options that are valid numbers but not a run.
 
 Refused up front, before anything is built or written: a duration under one control tick or
-whose log would not fit in the free disk space (sims.run_limits), sea states outside the range of the
-spectrum and the RAOs (sims.antenna.ship_motion.check_sea_state), angles beyond one turn, winds
+whose log would not fit in the free disk space (planbench.run_limits), sea states outside the range of the
+spectrum and the RAOs (planbench.antenna.ship_motion.check_sea_state), angles beyond one turn, winds
 beyond IEC 61400-1's classes, IMU rates and latencies the controller does not model, cable
 segments beyond the timestep's limit. The CLI says so in one line (exit 2); the Python API
 raises a ValueError subclass with the same words. A check that cannot be evaluated fails
@@ -15,12 +15,12 @@ import re
 import numpy as np
 import pytest
 
-from sims import antenna, fast, hexapod, loader, run_limits, runner, scenarios, wind
-from sims.antenna import ship_motion
-from sims.checks import NOT_EVALUATED, Check
-from sims.cli import BadInput, _resolve_source, format_checks, main
-from sims.fast.loads import CableLoads
-from sims.fast.physics import max_cable_segments
+from planbench import antenna, fast, hexapod, loader, run_limits, runner, scenarios, wind
+from planbench.antenna import ship_motion
+from planbench.checks import NOT_EVALUATED, Check
+from planbench.cli import BadInput, _resolve_source, format_checks, main
+from planbench.fast.loads import CableLoads
+from planbench.fast.physics import max_cable_segments
 
 
 def _read(args):
@@ -257,7 +257,7 @@ def test_build_checks_before_any_work(monkeypatch, name):
     """The refusal comes before any model file is opened (every mechanism's physics loads its
     scene through ``models.scene_path``), and so before the work proportional to the duration
     that follows it (the antenna's ideal path)."""
-    import models
+    from planbench import models
 
     def must_not_run(*args, **kwargs):
         raise AssertionError(f"{name}: a model was loaded before the duration was checked")

@@ -1,6 +1,6 @@
 """Scenarios as data: typed parameters declared once, scenario files, reruns.
 
-Every scenario's parameters are one sims.params class; these tests hold the declarations to
+Every scenario's parameters are one planbench.params class; these tests hold the declarations to
 what they promise: valid values build and plan, a value outside its range is refused with its
 key, the CLI's help and the README's tables come from them, a scenario file and a run's
 summary.json run (the rerun bit for bit), and user parameters reach the physics (a list of
@@ -21,11 +21,11 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from planners.fast import sky
-from sims import antenna, fast, hexapod, loader, params, runner, scenarios
-from sims.antenna.ship_motion import GRAVITY, steepness_limit
-from sims.cli import main
-from sims.params import ParamError
+from planbench.planners.fast import sky
+from planbench import antenna, fast, hexapod, loader, params, runner, scenarios
+from planbench.antenna.ship_motion import GRAVITY, steepness_limit
+from planbench.cli import main
+from planbench.params import ParamError
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Scenario files (campaign specs, *_campaign.toml, are tests/test_campaign.py's).
@@ -125,8 +125,8 @@ def test_any_valid_loader_parameters_build_and_plan(p):
     setup = scenario.build(p)
     np.testing.assert_allclose(setup.physics.joint_positions(), setup.task.problem.key_points[0], atol=1e-12)
     model = setup.physics.model.ptr
-    # A shell under a milligram is none (sims.loader.physics.MIN_PAYLOAD_KG).
-    from sims.loader.physics import MIN_PAYLOAD_KG
+    # A shell under a milligram is none (planbench.loader.physics.MIN_PAYLOAD_KG).
+    from planbench.loader.physics import MIN_PAYLOAD_KG
 
     carried = p.payload_mass if p.payload_mass >= MIN_PAYLOAD_KG else 0.0
     assert model.body_mass[model.body("shell").id] == pytest.approx(carried, abs=1e-9)
@@ -273,9 +273,9 @@ def test_the_readme_tables_are_the_declarations():
     readme = (ROOT / "README.md").read_text()
     for cls in _classes():
         assert params.markdown_table(cls) in readme, f"README's table of {cls.__name__} differs: regenerate it " \
-                                                     "with sims.params.markdown_table"
+                                                     "with planbench.params.markdown_table"
     # and the nested tables (a scenario's ``sensors``, list items): the whole generated section
-    assert params.readme_tables().rstrip("\n") in readme, "README's parameter tables differ: python -m sims.params"
+    assert params.readme_tables().rstrip("\n") in readme, "README's parameter tables differ: python -m planbench.params"
 
 
 # ------------------------------------------------------------------ scenario files
@@ -433,7 +433,7 @@ def test_plan_takes_the_same_files_and_overrides(tmp_path, capsys):
 
 
 def test_measured_wind_is_validated_and_resampled(tmp_path):
-    from sims.wind import MeasuredWind, WindFileError
+    from planbench.wind import MeasuredWind, WindFileError
 
     good = tmp_path / "w.csv"
     good.write_text("t,speed,direction\n0,4,0\n10,6,90\n")
@@ -452,7 +452,7 @@ def test_measured_wind_is_validated_and_resampled(tmp_path):
 
 
 def test_a_file_called_like_a_scenario_does_not_shadow_it(tmp_path, monkeypatch):
-    from sims.cli import _resolve_source
+    from planbench.cli import _resolve_source
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "loader-supply").write_text("not a scenario file")

@@ -25,7 +25,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from sims import runner, scenarios
+from planbench import runner, scenarios
 
 RUNS = {  # the shortest runs that see several readings of the slowest sensor (s)
     "loader-supply": 0.5, "loader-direct": 0.5, "hexapod-sync-move": 0.5, "hexapod-async-move": 0.5,
@@ -99,7 +99,7 @@ def test_readings_are_no_newer_than_their_latency(name):
             steps = np.diff(np.unique(stamp[seen]))
             if steps.size:
                 # A stamp is when MuJoCo's sensors saw the state: the t = 0 sample at t = 0, the
-                # later ones at the start of their tick's last physics step (sims.antenna.AntennaImu),
+                # later ones at the start of their tick's last physics step (planbench.antenna.AntennaImu),
                 # so the first interval may be one physics step short, and no other.
                 first = steps[0] if stamp[seen][0] == 0.0 else period
                 assert period - physics_dt - 1e-9 <= first <= period + 1e-9, (name, sensor.name, first)

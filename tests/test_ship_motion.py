@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 from scipy import integrate
 from scipy.spatial.transform import Rotation
 
-from planners.errors import PlanningError
-from sims.antenna.ship_motion import (
+from planbench.planners.errors import PlanningError
+from planbench.antenna.ship_motion import (
     AXES,
     HEADING,
     HEAVE,

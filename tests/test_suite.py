@@ -1,5 +1,5 @@
 """Suite-wide tests over every registered scenario (in the spirit of dm_control's
-``suite_test.py``): a scenario added to ``sims.scenarios.SCENARIOS`` gets them with no new
+``suite_test.py``): a scenario added to ``planbench.scenarios.SCENARIOS`` gets them with no new
 test code. Each runs a short stretch (SHORT_S) of the scenario, twice with one seed and once
 with another.
 """
@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from sims import outputs, pipeline, runner, scenarios
-from sims.checks import NOT_EVALUATED
-from sims.task import PluginError
+from planbench import outputs, pipeline, runner, scenarios
+from planbench.checks import NOT_EVALUATED
+from planbench.task import PluginError
 
 SHORT_S = 0.25  # s: 25-50 control ticks, enough for every disturbance and sensor to act
 LOGGED = ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata", "mocap_pos", "mocap_quat")
@@ -164,7 +164,7 @@ class HoldStill:
 def test_a_hold_still_plugin_controller_runs_and_is_judged(name, tmp_path):
     """Every scenario runs a user's controller that only holds, through the CLI's plug-in
     path: every check is evaluated or says why not, and summary.json names the plug-in."""
-    from sims import api
+    from planbench import api
 
     result = api.run(name, controller=HoldStill(), params=dict(duration=SHORT_S, seed=1), out=tmp_path / "out")
     checks = {c.name: c for c in result.checks}
@@ -180,7 +180,7 @@ def test_a_hold_still_plugin_controller_runs_and_is_judged(name, tmp_path):
 def test_the_nominal_plant_runs_bit_for_bit_as_without_one(name):
     # A scenario's nominal plant, given explicitly, is the machine built without one (issue
     # 15: plant uncertainty perturbs only when it is set).
-    from sims import api
+    from planbench import api
 
     scenario = scenarios.get(name)
     assert scenario.plant is not None and scenario.plant.is_nominal

@@ -12,7 +12,7 @@ ship's motion; the reference controller predicts the attitude from the gyro inst
 
 from __future__ import annotations
 
-from planners.antenna import JOINT_LABELS
+from planbench.planners.antenna import JOINT_LABELS
 
 
 class SampleAndHold:

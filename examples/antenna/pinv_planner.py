@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners import antenna as ant
+from planbench.planners import antenna as ant
 
 
 class PinvIntegration:

@@ -4,7 +4,7 @@ Run it:  planbench run fast-source-switch --planner examples/fast/straight_switc
 
 The paper switches sources along a line to the focal sphere and then an arc on it (section
 3.2, eq. 10). Here the feed takes the chord: one straight line from where the switch starts to
-where it ends, in the same time, with the paper's speed profile (planners.profiles) along it.
+where it ends, in the same time, with the paper's speed profile (planbench.planners.profiles) along it.
 Everything else (start, observations, termination) is the paper's plan of the session
 (``problem.goal``), so the observing windows are kept.
 """
@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners import fast
-from planners.fast import plan as fp
-from planners import profiles
+from planbench.planners import fast
+from planbench.planners.fast import plan as fp
+from planbench.planners import profiles
 
 
 class StraightSwitch:

@@ -5,7 +5,7 @@ Run it:  planbench run hexapod-sync-move --controller examples/hexapod/pd_contro
 
 The drives' set-point follows the planned strut positions. The 3 t camera's weight is then
 held by the position error alone, kp (s - q) = F: each strut sags by F / kp below its plan.
-The reference controller (sims.hexapod.HexapodController) adds the static drive forces and an
+The reference controller (planbench.hexapod.HexapodController) adds the static drive forces and an
 integral action.
 """
 

@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
-from planners.hexapod import STRUT_LABELS, strut_positions
-from planners.trajectory import TrajectorySample
+from planbench.planners.hexapod import STRUT_LABELS, strut_positions
+from planbench.planners.trajectory import TrajectorySample
 
 
 class QuinticTrajectory:

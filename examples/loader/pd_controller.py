@@ -32,7 +32,7 @@ def make() -> PlainPD:
 
 
 if __name__ == "__main__":  # the same from Python
-    from sims import api
+    from planbench import api
 
     result = api.run("loader-supply", controller=make())
     print("passed" if result.passed else "failed", {c.name: round(float(c.value), 4) for c in result.checks})

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
-from planners.trajectory import TrajectorySample
+from planbench.planners.trajectory import TrajectorySample
 
 
 class SplineTrajectory:

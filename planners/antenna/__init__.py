@@ -46,9 +46,9 @@ from typing import Sequence
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from planners.errors import LimitError, PlanningError
-from planners.rotations import rot_x, rot_y, rot_z, vee
-from planners.trajectory import TrajectorySample, sample_times
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.rotations import rot_x, rot_y, rot_z, vee
+from planbench.planners.trajectory import TrajectorySample, sample_times
 
 JOINT_LABELS = ("azimuth", "elevation", "cross_elevation", "polarization")
 #: The paper's weights, eq. (7): motion of axis 1 costs most, axis 4 least.

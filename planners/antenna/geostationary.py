@@ -11,7 +11,7 @@ Polarization. The satellite transmits linearly polarized waves whose E-field is 
 parallel to the Earth's axis ("vertical") or to the equatorial plane ("horizontal"). The
 antenna's polarization angle sigma is the paper's sigma_e of eq. (1): the angle about the
 boresight from the Y_s axis at sigma = 0 (the local horizontal in the aperture plane, see
-``planners.antenna.satellite_attitude``) to the received E-field. For horizontal polarization
+``planbench.planners.antenna.satellite_attitude``) to the received E-field. For horizontal polarization
 it is minus the polarization skew of Maral & Bousquet (Satellite Communications Systems,
 5th ed., sec. 8.3.3), tan(psi) = sin(dLambda) / tan(lat) with dLambda = satellite minus ship
 longitude, for a spherical Earth (their psi is counted the other way round the boresight);
@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.antenna import satellite_attitude
-from planners.errors import LimitError, PlanningError
+from planbench.planners.antenna import satellite_attitude
+from planbench.planners.errors import LimitError, PlanningError
 
 GEO_RADIUS = 42_164_172.0  # m: (mu / Omega^2)^(1/3) with mu = 3.986004418e14, sidereal day
 POLARIZATIONS = ("horizontal", "vertical")

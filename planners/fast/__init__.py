@@ -31,7 +31,7 @@ cabin (theta_C, 0-14 deg) and the A-B rotator (theta_AB = ZA - theta_C, at most 
 the same vertical plane (azimuth phi of s): R_C R_AB z = s.
 
 Statics: six cables, six degrees of freedom, so the structure matrix is square and the wrench
-balance A t + W = 0 gives the tensions directly (planners.legs). Cable weight: half of each
+balance A t + W = 0 gives the tensions directly (planbench.planners.legs). Cable weight: half of each
 cable's weight is lumped at its cabin anchor as a vertical load (REFERENCE.md's common
 approximation); the sag's change of the cable direction at the anchor is left out. The A-B
 rotator's tilt moves the cabin's centre of mass (``cabin_com_at``): the tilted part (B frame,
@@ -45,9 +45,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planners.errors import LimitError, PlanningError
-from planners.legs import leg_forces, leg_lengths, structure_matrix
-from planners.rotations import rot_x, rot_y, rot_z
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.legs import leg_forces, leg_lengths, structure_matrix
+from planbench.planners.rotations import rot_x, rot_y, rot_z
 
 GRAVITY = 9.81
 
@@ -167,7 +167,7 @@ def stewart_leg_lengths(offset=None, rotation=None, geometry: FastGeometry = FAS
                         stewart: StewartGeometry = STEWART) -> np.ndarray:
     """(..., 6) Stewart leg lengths, m, for a platform displaced by ``offset`` (..., 3) in the
     AB frame and turned by ``rotation`` (..., 3, 3) from its nominal pose at r_AB-s (the same
-    leg formula as the cables and the hexapod, planners.legs)."""
+    leg formula as the cables and the hexapod, planbench.planners.legs)."""
     position = geometry.r_ab_s if offset is None else geometry.r_ab_s + np.asarray(offset, dtype=float)
     if rotation is None:
         rotation = np.broadcast_to(np.eye(3), np.shape(position)[:-1] + (3, 3))

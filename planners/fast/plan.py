@@ -4,10 +4,10 @@ Paper: Yao et al. 2020 (REFERENCE.md "Papers"). A plan is a
 sequence of feed segments (Figure 5): source switching P0 -> Ph (a straight line to the closest
 focal-surface point) -> P1 (along the focal surface), start planning P1 -> Ps, the observation
 Ps -> Pt (tracking, or a motion scan with transition segments), termination planning Pt -> P2.
-Every segment's speed along its path is a profile of ``planners.profiles`` (first-degree
+Every segment's speed along its path is a profile of ``planbench.planners.profiles`` (first-degree
 acceleration, Figure 6) except the observation, which follows the sky.
 
-From the feed position the rest follows (planners.fast): the feed axis points along the
+From the feed position the rest follows (planbench.planners.fast): the feed axis points along the
 focal-sphere radius (P_feed = -r s), the tilt is split between the cabin and the A-B rotator
 by the smooth tilt law (``fast.tilt_law``: the max-min-tension split tabulated over the sky),
 eq. (3)-(9) give the cabin pose and the A-B angles, the cable lengths and
@@ -23,10 +23,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
-from planners import fast
-from planners import profiles as prof
-from planners.errors import LimitError, PlanningError
-from planners.trajectory import TrajectorySample, check_values, sample_times
+from planbench.planners import fast
+from planbench.planners import profiles as prof
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.trajectory import TrajectorySample, check_values, sample_times
 
 R_FOCAL = fast.FOCAL_SURFACE_RADIUS
 MIN_LENGTH = 1e-6  # m: shorter lines and arcs are left out of a switch
@@ -451,7 +451,7 @@ def feed_state(t, feed, feed_velocity, feed_acceleration, multifeed, segment=Non
                ) -> FastPlanSample:
     """Everything the mechanism must do to put the feed at ``feed`` (n, 3) m: the focal axis,
     the tilt law, the cabin pose, the A-B angles, the cable lengths and the static tensions
-    (planners.fast), at the times ``t`` (n,) s. ``segment``: (n,) segment indices, or None
+    (planbench.planners.fast), at the times ``t`` (n,) s. ``segment``: (n,) segment indices, or None
     (-1: a trajectory without segments, e.g. a user's)."""
     axis = -feed / np.linalg.norm(feed, axis=1, keepdims=True)
     tilt = fast.tilt_law(geometry, limits)(axis)
@@ -621,13 +621,13 @@ class FastPlan:
 def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX, dut1: float = 0.0):
     """Observation legs and transitions of a motion scan (section 3.3).
 
-    ``scan``: a planners.fast.sky.MotionScan; ``start``: its start UTC. Each leg follows the
+    ``scan``: a planbench.planners.fast.sky.MotionScan; ``start``: its start UTC. Each leg follows the
     sky (``observation_segment``); between legs a transition of the scan's t2 joins the end
     state of one leg to the start state of the next (``transition_segment``). Raises
     LimitError when a transition would need more than ``a_limit`` (A_t-max). ``dut1``: UT1 -
     UTC, s.
     """
-    from planners.fast.sky import parallactic_angle
+    from planbench.planners.fast.sky import parallactic_angle
 
     path = scan.path(start, step=step, dut1=dut1)
     directions = path.directions()
@@ -734,7 +734,7 @@ class FastProblem:
         is the goal, the sources' focal points (observations, scan legs) and the scans'
         transitions; a planner may reuse its segments.
       info: the session in words and numbers (sources, UTC, scan parameters).
-      geometry, limits: the mechanism (planners.fast).
+      geometry, limits: the mechanism (planbench.planners.fast).
     A planner returns a Trajectory with the channels PLAN_LABELS; the task judges its feed
     against ``goal`` during the windows, and its cable tensions everywhere.
     """

@@ -86,7 +86,7 @@ declination ``dec_i`` run ``leg_length / cos(dec_i)`` in RA at ``speed / cos(dec
 every leg is ``leg_length`` long on the sky and lasts ``leg_length / speed``.
 
 Zenith-angle limit: every path is checked against the 40 deg of Table 1
-(``planners.fast.MAX_ZENITH_ANGLE``); a ``LimitError`` names the first sample beyond it (UTC,
+(``planbench.planners.fast.MAX_ZENITH_ANGLE``); a ``LimitError`` names the first sample beyond it (UTC,
 seconds after the start, zenith angle).
 
 Horizon rates: ``horizon_rates`` differentiates a path numerically (azimuth and elevation rates,
@@ -108,8 +108,8 @@ from typing import NamedTuple
 import erfa
 import numpy as np
 
-from planners.errors import PlanningError
-from planners.fast import FOCAL_SURFACE_RADIUS, MAX_ZENITH_ANGLE, ZenithLimitError, source_direction
+from planbench.planners.errors import PlanningError
+from planbench.planners.fast import FOCAL_SURFACE_RADIUS, MAX_ZENITH_ANGLE, ZenithLimitError, source_direction
 
 #: 1 deg/h in rad/s: the paper's scan speeds (V_dec, deg/h) at the edges.
 DEG_PER_HOUR = math.radians(1.0) / 3600.0
@@ -441,7 +441,7 @@ class SkyPath:
         return float(self.t[-1])
 
     def directions(self) -> np.ndarray:
-        """(n, 3) unit vectors to the sky in East-North-Up (planners.fast's frame)."""
+        """(n, 3) unit vectors to the sky in East-North-Up (planbench.planners.fast's frame)."""
         return source_direction(self.az, self.el)
 
     def rates(self) -> HorizonRates:

@@ -45,9 +45,9 @@ from typing import Sequence
 
 import numpy as np
 
-from planners.errors import LimitError, PlanningError
-from planners.legs import component_norm, leg_forces, leg_lengths, leg_vector_components, structure_matrix
-from planners.trajectory import TrajectorySample, check_positive, check_values, sample_times
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.legs import component_norm, leg_forces, leg_lengths, leg_vector_components, structure_matrix
+from planbench.planners.trajectory import TrajectorySample, check_positive, check_values, sample_times
 
 POSE_LABELS = ("x", "y", "z", "rx", "ry", "rz")
 STRUT_LABELS = tuple(f"strut{i}" for i in range(1, 7))
@@ -208,7 +208,7 @@ def _pose_unit(axis: int) -> str:
 
 def _as_poses(pose, what: str = "pose") -> np.ndarray:
     """Poses (..., 6) as floats; PlanningError naming the row, axis and value of a NaN, inf or
-    |value| > MAX_MAGNITUDE entry (``planners.trajectory.check_values``)."""
+    |value| > MAX_MAGNITUDE entry (``planbench.planners.trajectory.check_values``)."""
     try:
         pose = np.asarray(pose, dtype=float)
     except (TypeError, ValueError):
@@ -279,7 +279,7 @@ def jacobian(pose, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
     """(..., 6, 6) dL/d(pose): row i is strut i, columns x, y, z, rx, ry, rz.
 
     dL_i = u_i . (dp + omega x R b_i) = u_i . dp + (R b_i x u_i) . E d(angles).
-    Computed on components (``planners.legs.leg_vector_components``); E's first column is
+    Computed on components (``planbench.planners.legs.leg_vector_components``); E's first column is
     e_x and its (1, 0), (2, 0), (0, 1) entries are zeros, whose products the sum drops.
     """
     pose = _as_poses(pose)
@@ -412,7 +412,7 @@ def static_strut_forces(pose, wrench, geometry: HexapodGeometry = RUBIN_CAMERA) 
         current position (the moving frame's origin), in the hexapod frame.
 
     Virtual work: J^T f = (F, E^T M) in pose coordinates (J = dL/dpose); written with the structure matrix of
-    ``planners.legs`` (the same code FAST's cables use).
+    ``planbench.planners.legs`` (the same code FAST's cables use).
     """
     position, rotation = platform_frame(pose, geometry)
     structure = structure_matrix(geometry.base_pivots, geometry.platform_local, position, rotation)
@@ -676,7 +676,7 @@ class StrutMove:
 
     def sample(self, t) -> TrajectorySample:
         """Strut positions, velocities, accelerations at the times t (a number or a 1-D
-        array of finite times, ``planners.trajectory.sample_times``)."""
+        array of finite times, ``planbench.planners.trajectory.sample_times``)."""
         t = sample_times(t)
         tau = np.maximum(t, 0.0)[:, None]  # at rest on the start before t = 0
         a = self.accel

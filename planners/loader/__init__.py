@@ -14,10 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from models import SerialChainSpec, loader_spec
-from planners.loader.bspline import CubicBSplineTrajectory
-from planners.errors import PlanningError
-from planners.trajectory import check_values
+from planbench.models import SerialChainSpec, loader_spec
+from planbench.planners.loader.bspline import CubicBSplineTrajectory
+from planbench.planners.errors import PlanningError
+from planbench.planners.trajectory import check_values
 
 #: Table 1 as printed: rows P2, M1, M2, M3, M4, P3; columns theta1 (mm), theta2..theta6 (deg).
 TABLE1 = np.array(
@@ -34,7 +34,7 @@ TABLE1_TIMES = np.arange(6) * 0.5  # s
 
 #: How far a joint may be beyond its range and still count as within it, m for the slide and
 #: rad for the hinges: 1 nm and 1 nrad, the same for the planner's refusal and for the
-#: ``joint_range`` check (``sims.loader.plan_checks``). The loader's encoders are modelled
+#: ``joint_range`` check (``planbench.loader.plan_checks``). The loader's encoders are modelled
 #: exact (no figures are published, models/loader/README.md); the finest absolute encoders
 #: resolve ~7.5e-7 rad (23 bits a turn) and linear scales ~1e-8 m, so a value this close to a
 #: limit is the limit for any machine that measures it. It is also far above the spline's
@@ -79,7 +79,7 @@ class LoaderProblem:
 
 class CubicBSplinePlanner:
     """The paper's planner: the cubic B-spline through the problem's key points (section 3,
-    ``planners.loader.bspline``), checked against the joint ranges: it refuses (a LimitError)
+    ``planbench.planners.loader.bspline``), checked against the joint ranges: it refuses (a LimitError)
     key points, or a spline between them, beyond a limit by more than
     ``JOINT_LIMIT_TOLERANCE`` (between key points plus the spline's round-off,
     ``limit_tolerance``)."""

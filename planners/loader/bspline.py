@@ -51,12 +51,12 @@ stays within the limits up to the same tolerance (both tested in
 A planner for a machine may also allow an absolute ``margin`` per joint (default 0): key
 points may then lie up to ``margin`` beyond a limit, and the spline between them up to
 ``margin`` plus its round-off (``limit_tolerance``). The loader's planner allows its encoders'
-``planners.loader.JOINT_LIMIT_TOLERANCE``, so that what it refuses is a departure from the
+``planbench.planners.loader.JOINT_LIMIT_TOLERANCE``, so that what it refuses is a departure from the
 range the machine could measure, not one of 1e-92 m (round-off of values near 1e-88 is
 1e-104, which no limit check at the range's scale can see).
 
 Inputs are checked before anything is solved: key times, key points and limits must be finite
-and within +/-``planners.trajectory.MAX_MAGNITUDE``, the limits ordered, and the key step long
+and within +/-``planbench.planners.trajectory.MAX_MAGNITUDE``, the limits ordered, and the key step long
 enough that the spline's accelerations stay within that magnitude too (a step of 1e-200 s
 would give infinite accelerations).
 """
@@ -68,8 +68,8 @@ from typing import Sequence
 import numpy as np
 from scipy import linalg
 
-from planners.errors import LimitError, PlanningError
-from planners.trajectory import (MAX_MAGNITUDE, TrajectorySample, check_values, fmt_number,
+from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.trajectory import (MAX_MAGNITUDE, TrajectorySample, check_values, fmt_number,
                                  sample_times)
 
 # Eq. (10): power-basis coefficients of the uniform cubic B-spline, rows for u^3, u^2, u, 1.
@@ -271,7 +271,7 @@ class CubicBSplineTrajectory:
     def sample(self, t: np.ndarray | float) -> TrajectorySample:
         """Positions, velocities and accelerations at times ``t`` (s), vectorized (eq. 10).
 
-        ``t``: a number or a 1-D array of finite times (``planners.trajectory.sample_times``;
+        ``t``: a number or a 1-D array of finite times (``planbench.planners.trajectory.sample_times``;
         a PlanningError names a NaN or infinite time).
         """
         t = sample_times(t)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sims.bench import best_time
+from planbench.bench import best_time
 
 def antenna_update_rate(duration: float = 60.0) -> list[dict]:
     """Joint-position updates per second of the antenna planner over the paper's conditions.
@@ -15,8 +15,8 @@ def antenna_update_rate(duration: float = 60.0) -> list[dict]:
     both CRR rows again by the online planner's one-pose path in plain floats
     (``crr_step_scalar``). Best of REPEATS. The paper's IMU delivers 20-50 attitudes per second.
     """
-    from planners import antenna
-    from sims.antenna.ship_motion import PaperShipMotion
+    from planbench.planners import antenna
+    from planbench.antenna.ship_motion import PaperShipMotion
 
     t = np.arange(int(round(duration / antenna.PAPER_DT)) + 1) * antenna.PAPER_DT
     ship = PaperShipMotion().sample(t)

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners import antenna as ant
-from sims.antenna.params import JOINTS, _exp_so3
+from planbench.planners import antenna as ant
+from planbench.antenna.params import JOINTS, _exp_so3
 
 
 class AntennaController:

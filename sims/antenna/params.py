@@ -14,15 +14,15 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-import models
-from planners import antenna as ant
-from planners.errors import PlanningError
-from planners.antenna.geostationary import look_angles
-from sims import run_limits
-from sims.drives import DRIVES, torque_constant_error
-from sims.antenna.ship_motion import SEA_HS_MAX_M, SEA_TP_RANGE_S, check_sea_state
-from sims.params import ParamError, Params, PlantParams, ScenarioParams, override, param
-from sims.plant import set_inertial
+from planbench import models
+from planbench.planners import antenna as ant
+from planbench.planners.errors import PlanningError
+from planbench.planners.antenna.geostationary import look_angles
+from planbench import run_limits
+from planbench.drives import DRIVES, torque_constant_error
+from planbench.antenna.ship_motion import SEA_HS_MAX_M, SEA_TP_RANGE_S, check_sea_state
+from planbench.params import ParamError, Params, PlantParams, ScenarioParams, override, param
+from planbench.plant import set_inertial
 
 
 CONTROL_DT = 0.005  # s: the runner's tick; the IMU rate is a whole number of ticks
@@ -65,7 +65,7 @@ REFERENCE_DT = 0.05
 @dataclass(frozen=True)
 class ImuModel(Params):
     """The pedestal IMU's datasheet, as the controller sees it: the scenarios' ``imu`` table
-    (typed and ranged as every parameter, sims.params), declared here once.
+    (typed and ranged as every parameter, planbench.params), declared here once.
 
     The attitude error is first-order Gauss-Markov, e_k+1 = e_k exp(-h / T) +
     sigma sqrt(1 - exp(-2 h / T)) n_k (T = attitude_noise_time_s; 0 for white noise).
@@ -156,12 +156,12 @@ MAST_JOINTS = ("mast_x", "mast_y")
 
 def axis_drive(nominal: mujoco.MjModel, name: str, friction: float = AXIS_FRICTION,
                plant: "AntennaPlant | None" = None):
-    """The drive train of the antenna axis ``name`` as built (``sims.drives.DriveTrain``): its
+    """The drive train of the antenna axis ``name`` as built (``planbench.drives.DriveTrain``): its
     motor's rotor is the model's armature (J N^2), its loop gains and torque limit the model's
     drive's; azimuth through a belt, the others through gears with backlash. ``plant`` (None:
     nominal): its errors of the transmissions' stiffness, the gears' backlash and the motors'
     torque constant (which scales every force the drive makes, its loops' too)."""
-    from sims.drives import DriveTrain
+    from planbench.drives import DriveTrain
 
     joint, actuator = nominal.joint(name), nominal.actuator(name)
     belt = name == "azimuth"
@@ -186,7 +186,7 @@ def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, friction: float = AXI
     (two hinges, ``MAST_JOINTS``, whose stiffness puts the mode at MAST_MODE_HZ against the
     antenna's inertia about them) and each axis's drive train (``axis_drive``); the home
     keyframe rebuilt for the joints added (the motors with their axes, the mast straight)."""
-    from sims.drives import add_drive_train, keyframe_with_motors
+    from planbench.drives import add_drive_train, keyframe_with_motors
 
     pedestal = spec.body("pedestal")
     for name, axis in zip(MAST_JOINTS, ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])):
@@ -258,7 +258,7 @@ class AntennaParams(ScenarioParams):
     ship_lon: float = param(SHIP_LON_DEG, "the ship's longitude (east positive)", "deg", low=-180.0, high=180.0,
                             reason="a longitude")
     ship_heading: float = param(0.0, "the ship's mean course, clockwise from north (compass)", **_ANGLE)
-    imu: ImuModel = param(ImuModel(), "the pedestal IMU (sims.antenna.ImuModel: rate_hz, latency_s, "
+    imu: ImuModel = param(ImuModel(), "the pedestal IMU (planbench.antenna.ImuModel: rate_hz, latency_s, "
                           "attitude_noise_deg, attitude_noise_time_s, gyro_noise_deg_s)")
     prediction: bool = param(True, "the controller predicts the IMU's latency away with its gyro")
     drives: str = param("as-built", "the pedestal's drives: as-built (motors, an azimuth belt, geared axes with backlash, "

@@ -11,12 +11,12 @@ import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
-import models
-from planners import antenna as ant
-from planners.rotations import rot_x, rot_y
-from sims.antenna.params import DECK_JOINTS, JOINTS, MAST_JOINTS, AntennaPlant, _model
-from sims.drives import drive_coordinates
-from sims.antenna.ship_motion import world_from_ship
+from planbench import models
+from planbench.planners import antenna as ant
+from planbench.planners.rotations import rot_x, rot_y
+from planbench.antenna.params import DECK_JOINTS, JOINTS, MAST_JOINTS, AntennaPlant, _model
+from planbench.drives import drive_coordinates
+from planbench.antenna.ship_motion import world_from_ship
 
 
 class AntennaPhysics(dm_mujoco.Physics):

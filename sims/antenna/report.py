@@ -1,10 +1,10 @@
-"""report.png of an antenna run, and methods.png (the paper's Figures 2-8) (matplotlib, Agg: sims.report)."""
+"""report.png of an antenna run, and methods.png (the paper's Figures 2-8) (matplotlib, Agg: planbench.report)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from sims.report import finish, plt
+from planbench.report import finish, plt
 
 
 def antenna_report(ts: dict, t: np.ndarray, checks, path, pointing_limit_deg: float) -> None:

@@ -11,9 +11,9 @@ from collections import deque
 import mujoco
 import numpy as np
 
-from sims.task import JointEncoders, Sensors, SensorSpec
-from sims.antenna.params import AXIS_ENCODER, AntennaPlant, ImuModel, _exp_so3
-from sims.antenna.physics import AntennaPhysics
+from planbench.task import JointEncoders, Sensors, SensorSpec
+from planbench.antenna.params import AXIS_ENCODER, AntennaPlant, ImuModel, _exp_so3
+from planbench.antenna.physics import AntennaPhysics
 
 
 class AntennaImu(Sensors):

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate
 
-from planners.errors import PlanningError
+from planbench.planners.errors import PlanningError
 
 GRAVITY = 9.81  # m/s^2
 

@@ -1,6 +1,6 @@
 """The ship antenna's task: the sea (``ShipMotionDrive``, the disturbance that moves the deck),
 the evaluation (``AntennaEvaluation``: checks, metrics, timeseries), the ideal joint path and
-the start angles, ``build`` (a ``Setup`` of sims.runner around a ``Task`` of sims.task),
+the start angles, ``build`` (a ``Setup`` of planbench.runner around a ``Task`` of planbench.task),
 ``plan``, the paper's comparison of methods, the scenarios and the environment reward.
 """
 
@@ -13,22 +13,22 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from planners import antenna as ant
-from planners.trajectory import TrajectorySample
-from sims import run_limits
-from sims.checks import Check
-from sims.controllers import ServoFeedforwardController, demanded_force
-from sims.runner import RunLog, Setup
-from sims.scenarios import BENCHMARK, DEMO, Scenario
-from sims.task import (Components, ControlContext, JointEncoders, Output, Provenance, RecordingPlanner, Task,
+from planbench.planners import antenna as ant
+from planbench.planners.trajectory import TrajectorySample
+from planbench import run_limits
+from planbench.checks import Check
+from planbench.controllers import ServoFeedforwardController, demanded_force
+from planbench.runner import RunLog, Setup
+from planbench.scenarios import BENCHMARK, DEMO, Scenario
+from planbench.task import (Components, ControlContext, JointEncoders, Output, Provenance, RecordingPlanner, Task,
                        check_planner, nominal_copy)
-from sims.antenna.ship_motion import PaperShipMotion, SeaStateMotion
-from sims.antenna.params import (CONTROL_DT, DECK_JOINTS, JOINTS, PAPER_DURATION_S, REFERENCE_DT, AntennaPaperParams,
+from planbench.antenna.ship_motion import PaperShipMotion, SeaStateMotion
+from planbench.antenna.params import (CONTROL_DT, DECK_JOINTS, JOINTS, PAPER_DURATION_S, REFERENCE_DT, AntennaPaperParams,
                                  AntennaParams, AntennaPlant, AntennaSeaParams, ImuModel, _exp_so3, log_bytes_per_tick,
                                  satellite_of)
-from sims.antenna.physics import AntennaPhysics
-from sims.antenna.sensors import AntennaImu
-from sims.antenna.controller import AntennaController
+from planbench.antenna.physics import AntennaPhysics
+from planbench.antenna.sensors import AntennaImu
+from planbench.antenna.controller import AntennaController
 
 
 #: Check limits (REFERENCE.md, "Ship antenna"; FCC ESV: transmit off within 100 ms above
@@ -44,7 +44,7 @@ ATTITUDE_FRO_LIMIT = 1e-6
 
 
 class ShipMotionTrajectory:
-    """A ship motion (sims.antenna.ship_motion) as a Trajectory of the deck joints."""
+    """A ship motion (planbench.antenna.ship_motion) as a Trajectory of the deck joints."""
 
     labels = DECK_JOINTS
 
@@ -68,7 +68,7 @@ class ShipMotionDrive:
     the prescribed motion to a few thousandths of a degree whatever the antenna does.
 
     Args:
-      motion: the ship motion the task was built with (``sims.antenna.ship_motion``).
+      motion: the ship motion the task was built with (``planbench.antenna.ship_motion``).
       seed: the seed ``motion`` was drawn from.
       sea_start: for a random sea, draws another sea and its start for another episode seed
         (``draw_start``); None: every episode has ``motion``.
@@ -84,7 +84,7 @@ class ShipMotionDrive:
 
     def draw_start(self, physics, seed: int) -> None:
         """A random sea (``sea_start``) is drawn afresh for each seed but the one it was built
-        with; the physics is put at that sea's start (``sims.task.Disturbance``)."""
+        with; the physics is put at that sea's start (``planbench.task.Disturbance``)."""
         if self.sea_start is None or seed == self.seed:
             self.motion = self.built_motion
         else:
@@ -257,7 +257,7 @@ class AntennaEvaluation:
         }
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.antenna.report import antenna_report
+        from planbench.antenna.report import antenna_report
 
         antenna_report(self.timeseries(log), log.t, checks, path, self.pointing_max_deg)
 
@@ -277,7 +277,7 @@ def ideal_path(motion, satellite: np.ndarray, duration: float, theta0) -> ant.Jo
 def start_angles(motion, satellite: np.ndarray, azimuth: float, elevation: float,
                  polarization: float) -> np.ndarray:
     """Joint angles for the attitude at t = 0: from the level-ship solution (eq. 15),
-    corrected to the ship's attitude at 0 by weighted Newton steps (planners.antenna)."""
+    corrected to the ship's attitude at 0 by weighted Newton steps (planbench.planners.antenna)."""
     theta = ant.joint_angles_at_rest(azimuth, elevation, polarization)
     ship = motion.sample(0.0)
     target = ant.ship_attitude(ship.heading[0], ship.pitch[0], ship.roll[0]) @ satellite
@@ -306,7 +306,7 @@ def _slerp(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
     relative = b @ a.T
     if (np.trace(relative) - 1.0) / 2.0 < math.cos(math.pi - 1e-6):
         # A half turn (ship heading 180 deg with no motion, found by hypothesis): the matrix
-        # log of planners.antenna refuses it; scipy's Slerp picks one of its two axes.
+        # log of planbench.planners.antenna refuses it; scipy's Slerp picks one of its two axes.
         return Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([a, b])))(np.linspace(0.0, 1.0, n + 1)).as_matrix()
     rotvec = ant.rotation_log(relative)
     s = np.linspace(0.0, 1.0, n + 1)
@@ -489,7 +489,7 @@ def compare_methods(duration: float = PAPER_DURATION_S) -> dict:
 def write_method_comparison(plan, out_dir) -> None:
     """methods.npz and methods.png: the paper's Figures 2-8 for the three methods (the
     scenario's own plan is not needed: the comparison runs the paper's conditions)."""
-    from sims.antenna.report import antenna_methods_plot
+    from planbench.antenna.report import antenna_methods_plot
 
     paths = compare_methods()
     arrays = {"t": paths["pinv"].t}

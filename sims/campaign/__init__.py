@@ -1,15 +1,15 @@
 """Campaigns: many runs of a typed scenario, locally or on Ray (README, "Campaigns").
 
 ``planbench sweep SPEC.toml --out DIR`` = ``sweep(...)``:
-  1. read and check the spec (sims.campaign.spec): every axis, value and distribution, and,
+  1. read and check the spec (planbench.campaign.spec): every axis, value and distribution, and,
      unless ``invalid = "skip"``, every run's parameters, before any run starts;
-  2. open DIR (sims.campaign.store): new, or the same spec resumed (finished runs skipped);
-  3. send chunks of runs to the engine (sims.campaign.engines: a spawned process pool, started
+  2. open DIR (planbench.campaign.store): new, or the same spec resumed (finished runs skipped);
+  3. send chunks of runs to the engine (planbench.campaign.engines: a spawned process pool, started
      once the spec and the options hold, or Ray), and write each finished chunk's rows (one part file of
      the results table) and its runs' summaries as they come, under a tqdm bar of runs done,
      failures and time left; a planner-only campaign whose scenario judges columns sends its
      chunks as arrays (``worker.ColumnTask``) and gets Arrow tables back;
-  4. write results.parquet and the report (sims.campaign.report), print its table;
+  4. write results.parquet and the report (planbench.campaign.report), print its table;
   5. ``--rerun-worst K``: simulate the K worst runs again, with video, into DIR/worst/.
 """
 
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from tqdm import tqdm
 
-from sims.campaign import engines, report, spec as spec_module, store as store_module, worker
+from planbench.campaign import engines, report, spec as spec_module, store as store_module, worker
 
 #: Runs per task of a planner-only campaign (one vectorized judge_plans call each).
 PLAN_CHUNK = 5_000
@@ -42,7 +42,7 @@ class Outcome:
 
 
 def context_of(spec) -> worker.Context:
-    from sims import scenarios
+    from planbench import scenarios
 
     try:
         mechanism = scenarios.mechanism_of(spec.scenario.name).name
@@ -59,8 +59,8 @@ def check_plugins(spec) -> None:
     run: a PluginError (one line, exit 2) when one is missing, broken, exits or hangs."""
     if not spec.plugins:
         return
-    from sims import plugins, supervise
-    from sims.task import PluginError
+    from planbench import plugins, supervise
+    from planbench.task import PluginError
 
     online = spec.scenario.online_planner
 
@@ -132,7 +132,7 @@ def check_columns(spec, quiet: bool) -> None:
     naming the run, is the one ``spec.resolve`` gives)."""
     import numpy as np
 
-    from sims.campaign.spec import Run, parse_path
+    from planbench.campaign.spec import Run, parse_path
 
     paths = [parse_path(a.column) for a in spec.axes]
     bar = tqdm(total=spec.size, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False)
@@ -155,7 +155,7 @@ def sweep(spec_path, out, engine="local", workers: int | None = None, address: s
     """Run (or resume) the campaign of ``spec_path`` into ``out``; see the module's steps.
     ``engine``: "local", "ray", or an engine the caller holds (``engines.LocalEngine`` in a
     ``with`` block: its workers serve this campaign and the next)."""
-    from sims.params import ParamError
+    from planbench.params import ParamError
 
     start = time.perf_counter()
     spec = spec_module.load(spec_path)
@@ -230,7 +230,7 @@ def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
     the rerun's check values must equal the table's (the same parameters and seed)."""
     import numpy as np
 
-    from sims import outputs, pipeline
+    from planbench import outputs, pipeline
 
     picked = report.worst_runs(table, k, target.checks())
     rows = {r["run"]: r for r in table.to_pylist() if r["run"] in set(picked)}

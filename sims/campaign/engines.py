@@ -1,6 +1,6 @@
 """Where a campaign's chunks run: a local process pool, or Ray (README, "Campaigns").
 
-Both take the same ``Context`` and chunks of ``RunTask``s (plain data, sims.campaign.worker)
+Both take the same ``Context`` and chunks of ``RunTask``s (plain data, planbench.campaign.worker)
 and yield each chunk's result as it finishes, in any order; the campaign writes the rows.
 
 ``LocalEngine`` is a ``concurrent.futures.ProcessPoolExecutor`` whose workers are *spawned*
@@ -18,8 +18,8 @@ import itertools
 import multiprocessing
 import os
 
-from sims import outputs
-from sims.campaign import worker
+from planbench import outputs
+from planbench.campaign import worker
 
 ENGINES = ("local", "ray")
 
@@ -42,8 +42,8 @@ def _init_worker(parent: int | None = None, context: worker.Context | None = Non
     # base parameters (``worker.prepare``). What fails here fails again in the first chunk,
     # which reports it in its rows (an initializer's error would break the pool instead).
     try:
-        import sims.pipeline  # noqa: F401
-        import sims.scenarios  # noqa: F401
+        import planbench.pipeline  # noqa: F401
+        import planbench.scenarios  # noqa: F401
 
         if context is not None:
             worker.prepare(context)
@@ -66,7 +66,7 @@ def contain_worker(parent: int | None) -> None:
     Ctrl-C at a terminal signals the whole process group: the driver alone answers it (it
     ends its workers and prints one line), so a worker ignores SIGINT and SIGHUP, and SIGTERM
     (the driver's way to end it) ends it silently. The driver spawns its workers with those
-    signals blocked (``sims.outputs.signals_deferred``), so none arrives before this. And a
+    signals blocked (``planbench.outputs.signals_deferred``), so none arrives before this. And a
     worker ends with its driver, even one killed by SIGKILL: the kernel sends it SIGKILL when
     the driver dies (Linux PR_SET_PDEATHSIG), elsewhere a thread that looks every
     PARENT_POLL_S whether the parent's pid changed. Without that, orphaned workers (and the
@@ -75,7 +75,7 @@ def contain_worker(parent: int | None) -> None:
     import signal
     import threading
 
-    from sims.outputs import INTERRUPT_SIGNALS
+    from planbench.outputs import INTERRUPT_SIGNALS
 
     if parent == os.getpid():  # an in-process stand-in for a pool (tests): this is the driver
         return
@@ -336,7 +336,7 @@ def _check_reachable(address: str, timeout: float | None = None) -> None:
     addresses are left to Ray."""
     import socket
 
-    from sims.params import ParamError
+    from planbench.params import ParamError
 
     timeout = RAY_CONNECT_TIMEOUT_S if timeout is None else timeout
     if address in ("auto", "local") or "://" in address:
@@ -362,7 +362,7 @@ def _ray_connect(ray, address: str, options: dict) -> None:
     by itself (about 20 s with Ray 2.x when a port answers that is not a Ray head)."""
     import tempfile
 
-    from sims.params import ParamError
+    from planbench.params import ParamError
 
     saved = os.dup(2)
     try:
@@ -388,7 +388,7 @@ def ray_available() -> bool:
 def make(engine, workers: int | None, address: str | None):
     """The engine called ``engine`` ("local", "ray") with ``workers`` and ``address``, or
     ``engine`` itself when it is one (a pool or Ray engine the caller holds)."""
-    from sims.params import ParamError
+    from planbench.params import ParamError
 
     if isinstance(engine, (LocalEngine, RayEngine)):
         if workers is not None or address is not None:

@@ -345,7 +345,7 @@ def write(store, spec, table: pa.Table) -> dict:
     import tempfile
     from pathlib import Path
 
-    from sims.campaign.store import write_atomic
+    from planbench.campaign.store import write_atomic
 
     summary = summarize(spec, table, store.checks())
     write_atomic(store.path / "campaign.json", (json.dumps(summary, indent=1) + "\n").encode())

@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from sims.params import ParamError, Params, _bound, field_types
+from planbench.params import ParamError, Params, _bound, field_types
 
 SPEC_KEYS = ("scenario", "planner", "controller", "mode", "seed", "seeds", "samples", "invalid", "save",
              "timeout", "parameters", "plant", "grid", "random")
@@ -240,7 +240,7 @@ class Axis:
 
     @property
     def unit(self) -> str:
-        from sims.params import unit_of
+        from planbench.params import unit_of
 
         return unit_of(self.leaf.declared, self.leaf.column) if self.leaf.kind in ("float", "int") else ""
 
@@ -277,7 +277,7 @@ class CampaignSpec:
     random: list[Axis]
     fingerprint: str
     data: dict = field(repr=False, default_factory=dict)
-    timeout: float | None = None  # each run's wall-time limit, s (None: sims.supervise's default)
+    timeout: float | None = None  # each run's wall-time limit, s (None: planbench.supervise's default)
 
     @property
     def axes(self) -> list[Axis]:
@@ -411,7 +411,7 @@ def _int(data: dict, key: str, default: int, low: int, high: int) -> int:
 def load(path, get_scenario=None, known_names=None) -> CampaignSpec:
     """Read and validate the campaign spec at ``path``: every key, axis, value and
     distribution is checked here, before any run (a ParamError naming the file and the key)."""
-    from sims import scenario_files, scenarios
+    from planbench import scenario_files, scenarios
 
     path = Path(path)
     get_scenario = scenarios.get if get_scenario is None else get_scenario
@@ -454,7 +454,7 @@ def _parse(path: Path, data: dict, get_scenario, known_names, scenario_files) ->
         if role in data:
             if not isinstance(data[role], str):
                 raise ParamError(f"key {role!r} must be MODULE:FACTORY, got {data[role]!r}")
-            from sims.plugins import is_file, split_spec
+            from planbench.plugins import is_file, split_spec
 
             module_name, factory = split_spec(data[role], role)
             if is_file(module_name) and not Path(module_name).is_absolute():
@@ -583,7 +583,7 @@ def _axis(section: str, key: str, value, plant: bool, cls) -> Axis:
     outside = (low is not None and (s_low < low or (declared.low_open and s_low <= low))) or \
               (high is not None and (s_high > high or (declared.high_open and s_high >= high)))
     if outside:
-        from sims.params import range_text
+        from planbench.params import range_text
 
         hint = " (truncate it with low and high)" if distribution.name == "normal" else ""
         raise ParamError(f"random.{shown} = {distribution.text()} reaches [{s_low:g}, {s_high:g}], outside "
@@ -627,7 +627,7 @@ def _try(spec: CampaignSpec, axis: Axis, value, whole: bool) -> None:
         if whole:
             type(base).from_mapping(data, base=base, prefix="plant." if axis.plant else "")
         else:
-            from sims.params import _convert
+            from planbench.params import _convert
 
             name = axis.path[0]
             declared = type(base).__dataclass_fields__[name].metadata["declared"]

@@ -9,10 +9,10 @@
     DIR/checks.json               each check's unit and comparison
     DIR/runs/NNNNNN/              a simulated run's summary.json (timeseries and video when asked)
     DIR/results.parquet           the whole table, sorted by run, rewritten at the end
-    DIR/campaign.json, campaign.png, plots/, worst/   the report (sims.campaign.report)
+    DIR/campaign.json, campaign.png, plots/, worst/   the report (planbench.campaign.report)
 
 planbench never writes into a directory it did not create as a campaign (or an empty one),
-and one campaign at a time holds a directory (a lock file beside it, as sims.outputs).
+and one campaign at a time holds a directory (a lock file beside it, as planbench.outputs).
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sims import outputs
-from sims.outputs import OutputError
+from planbench import outputs
+from planbench.outputs import OutputError
 
 STATE = outputs.CAMPAIGN_STATE  # "planbench-campaign.json"
 TABLE = "table"
@@ -155,7 +155,7 @@ class CampaignDir(outputs._Target):
             table = rows
             first, last = table.column("run")[0].as_py(), table.column("run")[-1].as_py()
         else:
-            from sims.campaign.worker import rows_table
+            from planbench.campaign.worker import rows_table
 
             first, last = rows[0]["run"], rows[-1]["run"]
             table = rows_table(rows)
@@ -189,7 +189,7 @@ class CampaignDir(outputs._Target):
         return self.path / RUNS / f"{index:06d}"
 
     def write_run_files(self, index: int, files: dict, scenario: str) -> None:
-        """A run's files into DIR/runs/NNNNNN, staged and swapped in whole (sims.outputs)."""
+        """A run's files into DIR/runs/NNNNNN, staged and swapped in whole (planbench.outputs)."""
         if not files:
             return
         target = outputs.OutputDir(self.run_dir(index), kind="campaign run")

@@ -72,7 +72,7 @@ def _base(context: Context):
     key = json.dumps([context.scenario, context.base_params, context.base_plant, context.plugins], sort_keys=True,
                      default=str)
     if key not in _cache:
-        from sims import plugins, scenarios
+        from planbench import plugins, scenarios
 
         scenario = (scenarios.get(context.scenario) if context.mechanism is None
                     else scenarios.get_of(context.mechanism, context.scenario))
@@ -187,9 +187,9 @@ def _watchdog(limit_s: float):
 
 
 def _simulate(scenario, context, params, plant, plugin_specs, row, meta) -> dict:
-    """One run in MuJoCo (``sims.pipeline.execute``); its row filled in, its files returned."""
-    from sims import outputs, pipeline, supervise
-    from sims.logfile import LOG_FILE
+    """One run in MuJoCo (``planbench.pipeline.execute``); its row filled in, its files returned."""
+    from planbench import outputs, pipeline, supervise
+    from planbench.logfile import LOG_FILE
 
     start = time.perf_counter()
     board = supervise.in_worker()
@@ -298,7 +298,7 @@ def lost_columns(context: Context, task: ColumnTask, why: str) -> dict:
 def columns_supported(scenario, base_params, context_axes, plugins: dict, mode: str) -> bool:
     """Whether a campaign's chunks can be columns: planner-only, the scenario's own planner
     (no plug-in), a scenario with a columnar judge (``plan_columns``) that takes every axis."""
-    from sims.campaign.spec import parse_path
+    from planbench.campaign.spec import parse_path
 
     columnar = getattr(scenario, "plan_columns", None)
     if mode != "plan" or columnar is None or plugins.get("planner"):
@@ -312,7 +312,7 @@ def _overrides(base: dict, paths, values, seed: int) -> dict:
     """A run's parameter overrides (``CampaignSpec.overrides``) from its axis values."""
     import copy
 
-    from sims.campaign.spec import set_path
+    from planbench.campaign.spec import set_path
 
     out = {"seed": seed}
     for path, value in zip(paths, values):
@@ -337,7 +337,7 @@ def run_columns(context: Context, task: ColumnTask) -> dict:
     import numpy as np
     import pyarrow as pa
 
-    from sims.campaign.spec import parse_path
+    from planbench.campaign.spec import parse_path
 
     scenario, base_params, _, _, _ = _base(context)
     columnar = scenario.plan_columns

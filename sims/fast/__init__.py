@@ -11,7 +11,7 @@ feed_error_rms (<= 10 mm, REFERENCE.md), feed_error_max, cabin_error_rms; over t
 cable_tension_min (>= T_min, a slack cable fails), cable_tension_max (<= T_max),
 stewart_stroke, stewart_force.
 
-Plans (planners.fast_plan), all at the FAST site with pyerfa (planners.fast_sky):
+Plans (planbench.planners.fast_plan), all at the FAST site with pyerfa (planbench.planners.fast_sky):
   fast-tracking       park -> 3C 286 (source switch: line + focal arc), start, 20 min of
                       tracking centred on its transit, termination
   fast-source-switch  park -> 3C 286, 5 min of tracking, termination, switch (focal arc) to
@@ -26,20 +26,20 @@ speeds, s for the times, deg/h for V_dec and V_asc (eq. 15-16 print "h/s" for V_
 slope 0.751 mm/s per unit is r x 1 deg/h = 0.786 mm/s times cos 17 deg, so deg/h is meant).
 """
 
-from sims.fast.controller import ControllerOptions, FastController, ab_gravity_torque, parked_command, winch_feedforward
-from sims.fast.loads import CableLoads, ChainCableLoads
-from sims.fast.measurement import FusedSensors, IdealSensors, SensorOptions, make_sensors
-from sims.fast.params import (DEC_SCAN, DEFAULT_CABLE_SEGMENTS, DEFAULT_WIND_M_S, OBSERVING_NIGHT, PER_TICK_FLOATS,
+from planbench.fast.controller import ControllerOptions, FastController, ab_gravity_torque, parked_command, winch_feedforward
+from planbench.fast.loads import CableLoads, ChainCableLoads
+from planbench.fast.measurement import FusedSensors, IdealSensors, SensorOptions, make_sensors
+from planbench.fast.params import (DEC_SCAN, DEFAULT_CABLE_SEGMENTS, DEFAULT_WIND_M_S, OBSERVING_NIGHT, PER_TICK_FLOATS,
                               RA_SCAN, SOURCES, WIND_AZIMUTH_DEG, FastParams, FastPlant, FastScanParams,
                               FastSourceParams, FastSwitchParams, FastTrackingParams, _radec, _start, _transit,
                               log_bytes_per_tick)
-from sims.fast.physics import CONTROL_DT, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, FastPhysics, max_cable_segments
-from sims.fast.task import (CABIN_RMS_LIMIT_MM, FEED_MAX_LIMIT_MM, FEED_RMS_LIMIT_MM, LONG_RUN_S, OBSERVING_PREFIXES,
+from planbench.fast.physics import CONTROL_DT, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, FastPhysics, max_cable_segments
+from planbench.fast.task import (CABIN_RMS_LIMIT_MM, FEED_MAX_LIMIT_MM, FEED_RMS_LIMIT_MM, LONG_RUN_S, OBSERVING_PREFIXES,
                             OUTPUT_RATE_HZ, PARK, PLANS, SCENARIOS, TRACK_STEP_S, FastEvaluation, _scan_factory,
                             build, build_scenario, dec_scan_plan, environment_reward, goal_plan, observation_plan,
                             observing_mask, output_stride, perturbed_start, plan_kinds, problem, ra_scan_plan,
                             scan_plan, source_name, source_switch_plan, static_equilibrium, tracking_plan,
                             write_figures)
-from sims.scenarios import Mechanism
+from planbench.scenarios import Mechanism
 
 MECHANISM = Mechanism("fast", SCENARIOS, environment_reward, plans=PLANS, benchmark_runs=2)

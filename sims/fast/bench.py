@@ -6,12 +6,12 @@ import time
 
 import numpy as np
 
-from sims.bench import REPEATS
+from planbench.bench import REPEATS
 
 def fast_plan_rate(hours: float = 4.0, rate_hz: float = 10.0) -> dict:
     """Time to plan a FAST tracking observation of ``hours`` (switch, start, tracking,
     termination) and to sample every channel of it at ``rate_hz`` (best of REPEATS)."""
-    from sims import fast
+    from planbench import fast
 
     best_plan, best_sample = float("inf"), float("inf")
     for _ in range(REPEATS):

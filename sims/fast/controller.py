@@ -4,7 +4,7 @@
   sag under the planned tensions, plus feedback on the cabin pose: integral only by
   default), the A-B rotator servo (gravity feed-forward and integral action), the multi-beam
   rotation, and the Stewart stabilizer. With FAST's fused measurement system
-  (sims.fast.measurement, the default) the cable loop reads the cabin's fused estimate at
+  (planbench.fast.measurement, the default) the cable loop reads the cabin's fused estimate at
   each GPS/RTK fix, and the stabilizer is an integral loop every tick on the platform's fused
   estimate (its planned pose less the estimate, through the legs' Jacobian, added to the
   legs' planned lengths). With the idealized sensors (``system = "ideal"``) it reads the
@@ -20,17 +20,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners import fast
-from planners.fast import plan as fast_plan
-from planners.legs import leg_lengths, structure_matrix
-from planners.rotations import rot_y, rot_z, skew, vee
-from sims.fast.physics import PHYSICS_DT, FastPhysics, index_view, unstretched_length
-from sims.params import ParamError, Params, param
+from planbench.planners import fast
+from planbench.planners.fast import plan as fast_plan
+from planbench.planners.legs import leg_lengths, structure_matrix
+from planbench.planners.rotations import rot_y, rot_z, skew, vee
+from planbench.fast.physics import PHYSICS_DT, FastPhysics, index_view, unstretched_length
+from planbench.params import ParamError, Params, param
 
 
 @dataclass(frozen=True)
 class ControllerOptions(Params):
-    """The FAST controller's settings (typed and ranged as sims.params declares).
+    """The FAST controller's settings (typed and ranged as planbench.params declares).
 
     Why the defaults: the stabilizer's estimator is an alpha-beta tracker (critically damped)
     of the 100 Hz cabin pose measurement's deviation from the planned pose and of its rate;
@@ -125,7 +125,7 @@ class PlanRows:
     """The controller's plan at the ticks ``start`` on (``FastController._plan_rows``)."""
 
     start: int
-    state: object  # planners.fast.plan.FastPlanSample
+    state: object  # planbench.planners.fast.plan.FastPlanSample
     l0_ff: np.ndarray
     r_platform: np.ndarray
     p_platform: np.ndarray
@@ -137,11 +137,11 @@ class PlanRows:
 class FastController:
     """Winches, A-B rotator, multi-beam rotation and Stewart stabilizer (see the module doc).
 
-    It follows the reference's feed and multi-beam channels (planners.fast.plan.PLAN_LABELS);
+    It follows the reference's feed and multi-beam channels (planbench.planners.fast.plan.PLAN_LABELS);
     the cabin pose, the A-B angles, the cable lengths and the tensions that go with them come
-    from the planners' kinematics and statics (``planners.fast.plan.reference_state``), so
+    from the planners' kinematics and statics (``planbench.planners.fast.plan.reference_state``), so
     any FAST trajectory can be followed. It reads the task's observation: with the fused
-    measurement system (``sims.fast.measurement.FusedSensors``) the cabin's estimate for the
+    measurement system (``planbench.fast.measurement.FusedSensors``) the cabin's estimate for the
     cable loop and the platform's for the stabilizer; with the idealized one
     (``IdealSensors``) the total stations' fix and the 100 Hz pose; the encoders; rates and
     latencies from the sensors' specs.
@@ -194,7 +194,7 @@ class FastController:
         self._leg_target = np.zeros(6)
         self.dt = control_dt
         self._kp_ab, _ = nominal.drive_gains(self.ab_ids)
-        # The fused measurement system (sims.fast.measurement.FusedSensors): the cable loop on
+        # The fused measurement system (planbench.fast.measurement.FusedSensors): the cable loop on
         # the cabin's fused estimate at its fixes' rate, the stabilizer closed on the
         # platform's; otherwise the idealized pair of cabin-pose measurements.
         self.fused = fused
@@ -276,7 +276,7 @@ class FastController:
     def _setup_fused(self, specs, control_dt: float) -> None:
         """The fused path's gains (its plan, the legs' planned lengths: ``_plan_rows``): the
         legs' Jacobian at the nominal pose, dl = J dx for a platform motion dx = (dp, dtheta) in the base frame (J = -A^T,
-        A the structure matrix, planners.legs), and the integral gain 2 pi f dt."""
+        A the structure matrix, planbench.planners.legs), and the integral gain 2 pi f dt."""
         g = fast.FAST
         self.platform_jacobian = -structure_matrix(fast.STEWART.base_anchors, fast.STEWART.platform_anchors,
                                                    g.r_ab_s, np.eye(3)).T
@@ -331,7 +331,7 @@ class FastController:
                 self._fused_cable_feedback(obs, tick)
             else:
                 self._cable_feedback(obs)
-            # Cable lengths for the pose correction dx: dL = -A^T dx (planners.legs), at the
+            # Cable lengths for the pose correction dx: dL = -A^T dx (planbench.planners.legs), at the
             # planned pose (it moves by millimetres between two updates).
             a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[row],
                                  s.cabin_rotation[row])

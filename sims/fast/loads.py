@@ -16,15 +16,15 @@ import math
 import mujoco
 import numpy as np
 
-from planners import fast
-from planners.errors import LimitError
-from sims.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICIENT, CABIN_HEIGHT, CABLE_DAMPING_S,
+from planbench.planners import fast
+from planbench.planners.errors import LimitError
+from planbench.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICIENT, CABIN_HEIGHT, CABLE_DAMPING_S,
                                CABLE_EA, CONTROL_DT, NODE_DAMPING_RATIO, SEGMENT_OMEGA_DT_LIMIT, STRING_MODE_HZ, FastPhysics,
                                cable_drag_force, catenary_tension, chord_factor, end_fraction, index_view,
                                max_cable_segments,
                                moment_sum, node_mass_factor, tangent_stiffness)
-from sims.logfile import temporary_writer
-from sims.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
+from planbench.logfile import temporary_writer
+from planbench.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
 
 
 #: The winches' rope speed and acceleration limits, m/s and m/s^2 (models/fast/README.md "Winches
@@ -149,9 +149,9 @@ class CableLoads:
     Args:
       wind_speed: mean wind, m/s (0: none).
       wind_azimuth_deg: the direction the wind blows toward, deg from +x (east) toward +y.
-      spectrum: "kaimal" or "davenport" (sims.wind).
-      turbulence_intensity: sigma_u / U; None: the spectrum's own (sims.wind.wind_speed_series).
-      measured: a sims.wind.MeasuredWind record instead of the model (its speed, and its
+      spectrum: "kaimal" or "davenport" (planbench.wind).
+      turbulence_intensity: sigma_u / U; None: the spectrum's own (planbench.wind.wind_speed_series).
+      measured: a planbench.wind.MeasuredWind record instead of the model (its speed, and its
         direction where it has one), resampled to the ticks.
       ea, mass_per_length: the true cables' EA (N) and mass per length (kg/m) for the plant's
         law and loads; default the nominal ones (a perturbed plant's: ``FastPlant``). The
@@ -208,7 +208,7 @@ class CableLoads:
         self.apply(physics)
 
     def log(self, rows: int):
-        """The per-tick records of the run's first ``rows`` ticks (a ``sims.logfile.LogFile``:
+        """The per-tick records of the run's first ``rows`` ticks (a ``planbench.logfile.LogFile``:
         "tension" (rows, 6) N, "force" (rows, 3) N; a tick with no wind has zero force), their
         file closed the first time."""
         return self.records.read_back(rows)

@@ -40,16 +40,16 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from planners.rotations import skew, vee
-from sims.fast.physics import CONTROL_DT, PHYSICS_DT, index_view, moment_sum
-from sims.logfile import temporary_writer
-from sims.params import ParamError, Params, param
-from sims.task import Sensors, SensorSpec
+from planbench.planners.rotations import skew, vee
+from planbench.fast.physics import CONTROL_DT, PHYSICS_DT, index_view, moment_sum
+from planbench.logfile import temporary_writer
+from planbench.params import ParamError, Params, param
+from planbench.task import Sensors, SensorSpec
 
 @dataclass(frozen=True)
 class SensorOptions(Params):
     """FAST's measurement system (the task's, not the controller's: a user's controller gets
-    the same readings). Typed and ranged as the scenarios' parameters (sims.params).
+    the same readings). Typed and ranged as the scenarios' parameters (planbench.params).
 
     ``system = "fused"`` (default): the measurement system of the module doc, whose defaults
     give the published fused errors (positions and attitudes). ``system = "ideal"``: the earlier, idealized pair of
@@ -147,7 +147,7 @@ class Encoders:
     """The encoders' readings (``encoder_specs``) in an observation every tick: the A-B angles
     and the B frame's rotation in the cabin frame that they give, the legs' lengths and
     set-points. Exact readings whose indices step evenly (``index_view``) are read-only views
-    of the live buffers, put in ``obs`` (no cost per tick, as ``sims.task.JointEncoders``');
+    of the live buffers, put in ``obs`` (no cost per tick, as ``planbench.task.JointEncoders``');
     the others are copied every tick."""
 
     def __init__(self, physics, obs: dict):
@@ -768,7 +768,7 @@ class FusedSensors(Sensors):
         return obs
 
     def estimate_log(self, rows: int):
-        """The estimates of the run's first ``rows`` ticks (a ``sims.logfile.LogFile`` whose
+        """The estimates of the run's first ``rows`` ticks (a ``planbench.logfile.LogFile`` whose
         array ``estimate`` is (rows, 2, 12): per tick the position (3) and rotation (9) of each
         body), their file closed the first time."""
         return self.estimates.read_back(rows)
@@ -854,7 +854,7 @@ def floats_per_tick(options: SensorOptions, control_dt: float = CONTROL_DT) -> f
 
 def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
     """The fused estimates' RMS errors against the true bodies over a run's log (a
-    ``sims.runner.RunLog``; all rows but the last, where no sensor read), read a chunk at a
+    ``planbench.runner.RunLog``; all rows but the last, where no sensor read), read a chunk at a
     time: {"cabin_mm", "cabin_deg", "platform_mm", "platform_deg"}; position of the body
     frame's origin, attitude the angle of the estimated rotation times the true one's
     inverse."""

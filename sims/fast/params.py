@@ -9,19 +9,19 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-import models
-from planners import fast
-from planners.fast import plan as fp
-from planners.fast import sky as sky
-from sims import run_limits
-from sims.fast.loads import CableLoads, ChainCableLoads
-from sims.drives import DRIVES
-from sims.fast.measurement import SensorOptions, floats_per_tick
-from sims.fast.physics import (CABLE_EA, CONTROL_DT, LEG_ACTUATORS, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, _compiled,
+from planbench import models
+from planbench.planners import fast
+from planbench.planners.fast import plan as fp
+from planbench.planners.fast import sky as sky
+from planbench import run_limits
+from planbench.fast.loads import CableLoads, ChainCableLoads
+from planbench.drives import DRIVES
+from planbench.fast.measurement import SensorOptions, floats_per_tick
+from planbench.fast.physics import (CABLE_EA, CONTROL_DT, LEG_ACTUATORS, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, _compiled,
                                discretized_spec, max_cable_segments)
-from sims.params import ParamError, PlantParams, ScenarioParams, param
-from sims.plant import set_inertial
-from sims.wind import MEAN_SPEED, SPECTRA, MeasuredWind, WindFileError
+from planbench.params import ParamError, PlantParams, ScenarioParams, param
+from planbench.plant import set_inertial
+from planbench.wind import MEAN_SPEED, SPECTRA, MeasuredWind, WindFileError
 
 
 # ----------------------------------------------------------------------------- plant uncertainty
@@ -51,7 +51,7 @@ class FastPlant(PlantParams):
     plant's Python-side cable physics (``CableLoads``, ``ChainCableLoads``: the catenary law,
     the applied half cable weights, the chain's springs and node masses). The controller's
     winch feed-forward keeps the nominal EA and weight (``winch_feedforward``), its statics the
-    nominal masses (planners.fast.FAST). A perturbed plant starts where its own static
+    nominal masses (planbench.planners.fast.FAST). A perturbed plant starts where its own static
     equilibrium lies under the nominal parked commands (``perturbed_start``).
     """
 
@@ -76,7 +76,7 @@ class FastPlant(PlantParams):
     cabin_com_offset: tuple[float, ...] = param(
         (0.0, 0.0, 0.0), "shift of the whole cabin's centre of mass (the shell's moves by the cabin's mass over the "
         "shell's, 1.295 times this), cabin frame (x, y, z)", "m", low=-0.5, high=0.5, length=3,
-        reason="its place 1 m below the anchor plane is an assumption (planners.fast); 0.5 m, under a tenth of the "
+        reason="its place 1 m below the anchor plane is an assumption (planbench.planners.fast); 0.5 m, under a tenth of the "
         "cabin's 7.6 m height and 13 m diameter (assumed)")
     stewart_force_scale: float = param(
         1.0, "the Stewart legs' force limits as a fraction of their +/-30 kN rating", "fraction", low=0.5, high=1.0,
@@ -214,8 +214,8 @@ DEFAULT_CABLE_SEGMENTS = 2
 
 #: Doubles per tick that a FAST run keeps besides the runner's log and its sensors' records: the
 #: plant's wind speed (1, in memory), wind force and catenary tensions (3 + 6, streamed to a
-#: file of their own: sims.fast.loads.CableLoads.log). (The controller holds its plan's per-tick
-#: arrays a block of ticks at a time: sims.fast.controller.PLAN_BLOCK_TICKS.)
+#: file of their own: planbench.fast.loads.CableLoads.log). (The controller holds its plan's per-tick
+#: arrays a block of ticks at a time: planbench.fast.controller.PLAN_BLOCK_TICKS.)
 PER_TICK_FLOATS = 10
 
 
@@ -223,7 +223,7 @@ def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: Se
                        control_dt: float = CONTROL_DT) -> float:
     """Bytes a FAST run keeps per control tick, in memory or on disk: the runner's log of the compiled model
     (13 planned channels; the discretized cables add their nodes' joints), PER_TICK_FLOATS and
-    the sensors' (``sims.fast.measurement.floats_per_tick``)."""
+    the sensors' (``planbench.fast.measurement.floats_per_tick``)."""
     return run_limits.floats(run_limits.runlog_floats_per_tick(_compiled(cable_segments), len(fp.PLAN_LABELS))
                              + PER_TICK_FLOATS + floats_per_tick(sensors, control_dt))
 
@@ -251,7 +251,7 @@ class FastParams(ScenarioParams):
     drives: str = param("as-built", "the winches: as-built (each rope within its drive's speed and acceleration, "
                         "0.5 m/s and 0.05 m/s^2; models/fast/README.md) or ideal (each rope at its command every "
                         "tick)", choices=DRIVES)
-    sensors: SensorOptions = param(SensorOptions(), "the measurement system (sims.fast.measurement.SensorOptions: "
+    sensors: SensorOptions = param(SensorOptions(), "the measurement system (planbench.fast.measurement.SensorOptions: "
                                    "fused, FAST's, or ideal; its rates, latencies, noises and biases)")
     cable_segments: int = param(DEFAULT_CABLE_SEGMENTS, "each cable as a chain of this many elastic segments (2: "
                                 "the measured 0.19 Hz cabin-cable mode, models/fast/README.md); 0: straight cables "
@@ -317,7 +317,7 @@ class FastParams(ScenarioParams):
 class FastSourceParams(FastParams):
     """A session on one source: by catalogue name or by RA/Dec, from a start time."""
 
-    source: str | None = param("3C 286", "the source, from the built-in catalogue (sims.fast.SOURCES); for "
+    source: str | None = param("3C 286", "the source, from the built-in catalogue (planbench.fast.SOURCES); for "
                                "source_radec instead leave it out (a scenario file: giving source_radec clears "
                                "it) or --set source=none", choices=tuple(SOURCES), excludes=("source_radec",))
     source_radec: tuple[float, ...] | None = param(

@@ -26,13 +26,13 @@ import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
-import models
-from planners import fast
-from planners.rotations import wxyz
-from sims.wind import AIR_DENSITY
+from planbench import models
+from planbench.planners import fast
+from planbench.planners.rotations import wxyz
+from planbench.wind import AIR_DENSITY
 
 if TYPE_CHECKING:  # annotations only: sims/fast/params.py imports this module
-    from sims.fast.params import FastPlant
+    from planbench.fast.params import FastPlant
 
 #: s: the default control period (50 Hz; FastParams.control_rate_hz). FAST's own rates are not
 #: public; 50 Hz samples the 0.17-0.6 Hz cabin modes and the stabilizer's 2 Hz loop 25-80

@@ -1,10 +1,10 @@
-"""report.png of a FAST run, and figures.png (the paper's Figures 16 and 17) (matplotlib, Agg: sims.report)."""
+"""report.png of a FAST run, and figures.png (the paper's Figures 16 and 17) (matplotlib, Agg: planbench.report)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from sims.report import finish, plt
+from planbench.report import finish, plt
 
 
 def fast_plan_figure(plan, t: np.ndarray, path) -> None:

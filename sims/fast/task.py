@@ -12,24 +12,24 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from planners import fast
-from planners.fast import plan as fp
-from planners.fast import sky as sky
-from planners.errors import LimitError
-from sims import run_limits
-from sims.checks import Check
-from sims.controllers import demanded_force
-from sims.fast.controller import ControllerOptions, FastController, parked_command, winch_feedforward
-from sims.fast.loads import CableLoads, ChainCableLoads, Winches
-from sims.fast.measurement import FusedSensors, SensorOptions, estimate_errors, make_sensors
-from sims.fast.params import (DEC_SCAN, RA_SCAN, FastParams, FastPlant, FastScanParams, FastSwitchParams,
+from planbench.planners import fast
+from planbench.planners.fast import plan as fp
+from planbench.planners.fast import sky as sky
+from planbench.planners.errors import LimitError
+from planbench import run_limits
+from planbench.checks import Check
+from planbench.controllers import demanded_force
+from planbench.fast.controller import ControllerOptions, FastController, parked_command, winch_feedforward
+from planbench.fast.loads import CableLoads, ChainCableLoads, Winches
+from planbench.fast.measurement import FusedSensors, SensorOptions, estimate_errors, make_sensors
+from planbench.fast.params import (DEC_SCAN, RA_SCAN, FastParams, FastPlant, FastScanParams, FastSwitchParams,
                               FastTrackingParams, _radec, _start, _transit)
-from sims.fast.physics import CONTROL_DT, STRING_MODE_HZ, FastPhysics
-from sims.params import ParamError
-from sims.runner import RunLog, Setup
-from sims.scenarios import BENCHMARK, DEMO, Scenario
-from sims.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
-from sims.wind import MeasuredWind, WindFileError
+from planbench.fast.physics import CONTROL_DT, STRING_MODE_HZ, FastPhysics
+from planbench.params import ParamError
+from planbench.runner import RunLog, Setup
+from planbench.scenarios import BENCHMARK, DEMO, Scenario
+from planbench.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
+from planbench.wind import MeasuredWind, WindFileError
 
 #: Where the feed waits between observations: 10 m above the focal point of the zenith
 #: (inside the focal sphere), so a switch starts with the paper's straight line to P_h.
@@ -114,7 +114,7 @@ def plan_kinds() -> list[str]:
 def write_figures(plan: fp.FastPlan, out_dir) -> None:
     """figures.png (the paper's Figures 16 and 17: the feed's and one cable's velocity and
     acceleration) and segments.json."""
-    from sims.fast.report import fast_plan_figure  # matplotlib: only when figures are written
+    from planbench.fast.report import fast_plan_figure  # matplotlib: only when figures are written
 
     t = np.arange(0.0, plan.duration, 0.1)
     fast_plan_figure(plan, t, Path(out_dir) / "figures.png")
@@ -215,7 +215,7 @@ OUTPUT_RATE_HZ = 10.0
 def output_stride(control_dt: float) -> int:
     """Ticks between two rows of a long run's timeseries.npz (OUTPUT_RATE_HZ)."""
     return max(1, int(round(1.0 / (OUTPUT_RATE_HZ * control_dt))))
-#: Segments during which the feed must hold its accuracy (names of planners.fast_plan).
+#: Segments during which the feed must hold its accuracy (names of planbench.planners.fast_plan).
 OBSERVING_PREFIXES = ("observation", "leg", "transition")
 
 
@@ -227,7 +227,7 @@ def observing_mask(plan: fp.FastPlan, segment_index: np.ndarray) -> np.ndarray:
 
 def _hold_last_every(log, name: str, n: int, stride: int) -> np.ndarray:
     """Rows 0, stride, 2 stride, ... of the first n rows of a per-tick log of the plant's loads
-    (a ``sims.logfile.LogFile`` of n rows), the last one held: the runner applies no loads
+    (a ``planbench.logfile.LogFile`` of n rows), the last one held: the runner applies no loads
     after its last tick."""
     out = log.every(name, stride)
     if (n - 1) % stride == 0:
@@ -449,7 +449,7 @@ class FastEvaluation:
         return out
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.fast.report import fast_report
+        from planbench.fast.report import fast_report
 
         fast_report(self.timeseries(log), self.summary(log)["t_every"], checks, path,
                     fast.FAST_LIMITS.tension_min)
@@ -468,7 +468,7 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     paper's, whose plan is the goal) plans it, ``controller`` (default ``FastController`` with
     ``controller_options``, else the stabilizer as ``params.stewart`` says) follows it, with
     the physics at the trajectory's first pose (at rest, in equilibrium), the cables
-    (``params.cable_segments`` >= 2: discretized, sims.fast.physics.discretized_spec), the wind
+    (``params.cable_segments`` >= 2: discretized, planbench.fast.physics.discretized_spec), the wind
     of ``params`` and the sensors (``sensor_options``, default ``params.sensors``).
 
     ``plant`` (None or nominal: the model as it is) perturbs the simulated machine only

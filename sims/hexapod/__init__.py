@@ -23,25 +23,25 @@ and declares the mechanism's record.
 
 from __future__ import annotations
 
-from planners.hexapod import STRUT_LABELS
-from sims.hexapod.controller import INTEGRAL_TIME_S, HexapodController
-from sims.hexapod.params import (ASYNC_TARGET_MM_DEG, CONTROL_DT, DEFAULT_WIND_M_S, SETTLE_S, SYNC_TARGET_MM_DEG,
+from planbench.planners.hexapod import STRUT_LABELS
+from planbench.hexapod.controller import INTEGRAL_TIME_S, HexapodController
+from planbench.hexapod.params import (ASYNC_TARGET_MM_DEG, CONTROL_DT, DEFAULT_WIND_M_S, SETTLE_S, SYNC_TARGET_MM_DEG,
                                  _POSE_HIGH, _POSE_LOW, _POSE_REASON, _POSE_UNITS, HexapodMove, HexapodParams,
                                  HexapodPlant, _check_pose, pose_mm_deg, pose_si)
-from sims.hexapod.physics import (DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, PLATFORM_KEY_QPOS, HexapodPhysics,
+from planbench.hexapod.physics import (DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, PLATFORM_KEY_QPOS, HexapodPhysics,
                                   _compiled, _compiled_plant, _radial, _spec, apply_plant, check_elevation,
                                   log_bytes_per_tick, magnified_qpos, top_end_rotation)
-from sims.hexapod import plan_columns
-from sims.hexapod.plan_checks import judge_plans
-from sims.hexapod.sensors import sensors
-from sims.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, ARRIVAL_TOLERANCE, ARRIVAL_ULPS, CAMERA_DRAG_COEFFICIENT,
+from planbench.hexapod import plan_columns
+from planbench.hexapod.plan_checks import judge_plans
+from planbench.hexapod.sensors import sensors
+from planbench.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, ARRIVAL_TOLERANCE, ARRIVAL_ULPS, CAMERA_DRAG_COEFFICIENT,
                                ENCODER_COUNT_M, ENCODER_SETTLE_M, FOLLOWING_LIMIT_UM, OWN_TIME_LIMIT_S,
                                POSE_FINAL_LIMIT_UM, SETTLE_WINDOW_S, STRUT_MOVE_THRESHOLD_M, VIDEO_MAGNIFICATION,
                                WIND_AZIMUTH_DEG, HexapodEvaluation, arrival_times, build, camera_area,
                                default_duration, end_tick, environment_reward, hexapod_speed_check, plan,
                                plan_moves, problems, strut_kinds, strut_tolerances)
-from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
-from sims.wind import horizontal_direction
+from planbench.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
+from planbench.wind import horizontal_direction
 
 _RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT, plant=HexapodPlant(), judge_plans=judge_plans,
             plan_columns=plan_columns)

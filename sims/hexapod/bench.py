@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sims.bench import best_time
+from planbench.bench import best_time
 
 PLANNING_MOVES = 10_000
 
@@ -16,7 +16,7 @@ def planning_throughput(n_moves: int = PLANNING_MOVES, seed: int = 0) -> list[di
     includes the inverse kinematics, the limit checks and the tick realization (best of
     REPEATS), for both modes and both long-move solvers (closed form, the paper's iteration).
     """
-    from planners import hexapod
+    from planbench.planners import hexapod
 
     rng = np.random.default_rng(seed)
     start, target = hexapod.random_poses(n_moves, rng), hexapod.random_poses(n_moves, rng)

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from sims.controllers import ServoFeedforwardController
-from sims.hexapod.physics import static_drive_forces
+from planbench.controllers import ServoFeedforwardController
+from planbench.hexapod.physics import static_drive_forces
 
 INTEGRAL_TIME_S = 0.1  # integral action's time constant; the lowest mode is ~12 Hz
 
@@ -14,11 +14,11 @@ INTEGRAL_TIME_S = 0.1  # integral action's time constant; the lowest mode is ~12
 class HexapodController(ServoFeedforwardController):
     """Strut servo: reference tracking with static-load feed-forward and integral action.
 
-    ``sims.controllers.ServoFeedforwardController`` (set-point interpolation, feed-forward in
+    ``planbench.controllers.ServoFeedforwardController`` (set-point interpolation, feed-forward in
     the set-point, integral action on the encoder error) with its feed-forward replaced:
     inverse dynamics does not apply to the closed loops, so f_ff is the set of drive forces
     that hold the payload in static equilibrium at the reference pose, what a real hexapod's
-    gravity table supplies (``sims.hexapod.physics.static_drive_forces``). The integral action takes what the
+    gravity table supplies (``planbench.hexapod.physics.static_drive_forces``). The integral action takes what the
     model leaves out (wind, the constraint compliance, the payload's tiny inertial forces).
     Gains and force limits are read from the nominal model in ``reset``; the statics use the
     nominal model at the start pose (``ControlContext.nominal_physics``).

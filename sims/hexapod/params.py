@@ -10,14 +10,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners import hexapod as hexapod_planner
-from planners.errors import LimitError
-from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS
-from sims import run_limits
-from sims.drives import DRIVES, torque_constant_error
-from sims.hexapod.physics import DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
-from sims.params import Params, ParamError, PlantParams, ScenarioParams, param
-from sims.wind import MEAN_SPEED
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.errors import LimitError
+from planbench.planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS
+from planbench import run_limits
+from planbench.drives import DRIVES, torque_constant_error
+from planbench.hexapod.physics import DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
+from planbench.params import Params, ParamError, PlantParams, ScenarioParams, param
+from planbench.wind import MEAN_SPEED
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
 SETTLE_S = 1.0  # s simulated after the move: the integral action settles in ~0.5 s

@@ -19,19 +19,19 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 from scipy.spatial.transform import Rotation
 
-import models
-from planners import hexapod as hexapod_planner
-from planners.errors import LimitError
-from planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
-from planners.rotations import wxyz
-from sims import run_limits
-from sims.drives import (DRIVES, DriveTrain, add_drive_train, check_option, drive_coordinates, servo_gains,
+from planbench import models
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.errors import LimitError
+from planbench.planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
+from planbench.planners.rotations import wxyz
+from planbench import run_limits
+from planbench.drives import (DRIVES, DriveTrain, add_drive_train, check_option, drive_coordinates, servo_gains,
                          transmission_deflection)
-from sims.plant import set_inertial
-from sims.runner import RunLog
+from planbench.plant import set_inertial
+from planbench.runner import RunLog
 
 if TYPE_CHECKING:  # annotations only: sims/hexapod/params.py imports this module
-    from sims.hexapod.params import HexapodPlant
+    from planbench.hexapod.params import HexapodPlant
 
 ELEVATION_RANGE_DEG = (15.0, 90.0)
 DEFAULT_ELEVATION_DEG = 45.0
@@ -162,7 +162,7 @@ def apply_plant(spec: mujoco.MjSpec, plant: "HexapodPlant", nominal: mujoco.MjMo
 
     * camera_mass_error, camera_com_offset: the camera body's mass and central inertia times
       (1 + error), its centre of mass moved by the offset (m, hexapod frame = the camera body's
-      frame), its principal axes kept (``sims.plant.set_inertial``; the geoms stay);
+      frame), its principal axes kept (``planbench.plant.set_inertial``; the geoms stay);
     * base_pivot_radius_error, platform_pivot_radius_error: the six base pivot sites and the
       strut housings on them, or the six mirror-side pivot sites, moved radially (m). The
       struts keep their built lengths (the rods' zero), so the loops close elsewhere;
@@ -398,7 +398,7 @@ def static_drive_forces(physics: HexapodPhysics, strut_positions: np.ndarray) ->
     housing and rod hang on its base universal joint; the moment of their weights about it,
     M = sum_k r_k x m_k g (r_k along the strut), is held by a transverse force at the top pivot,
     F_t = (l x M) / |l|^2, whose reaction loads the platform. The rod's weight along the strut
-    is the drive's own. Tensions from ``planners.hexapod.static_strut_forces`` of the total
+    is the drive's own. Tensions from ``planbench.planners.hexapod.static_strut_forces`` of the total
     wrench on the platform.
     """
     model = physics.model.ptr

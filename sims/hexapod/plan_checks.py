@@ -1,7 +1,7 @@
 """Planner-only checks of hexapod runs: the planned moves judged without physics.
 
 ``judge_plans(params_list)`` plans every move of every run as a run does
-(``sims.hexapod.problems``: each move from the pose the one before reached, the paper's
+(``planbench.hexapod.problems``: each move from the pose the one before reached, the paper's
 generator) and returns, per run, the checks that judge the trajectory the planner returned.
 Where the run has a check of the same quantity it has the run's name, limit and unit; where
 the run's check of that name measures the machine (the encoders, the platform's pose), the
@@ -34,7 +34,7 @@ plan_pose_error_final  um     <= POSE_FINAL_LIMIT_UM (1)   largest mirror-side p
                                                            ``pose_error_final`` is the platform's)
 =====================  =====  ===========================  =========================================
 
-Limits are the run's constants (``sims.hexapod``) and Rubin's (``planners.hexapod.RUBIN_LIMITS``,
+Limits are the run's constants (``planbench.hexapod``) and Rubin's (``planbench.planners.hexapod.RUBIN_LIMITS``,
 REFERENCE.md "Rubin hexapod"), never loosened. ``pose_limits`` has no counterpart in a run:
 the generator plans in strut space and checks the pose limits at the start and the target
 only, so a path between two poses inside the limits can leave them (the struts' profiles
@@ -42,7 +42,7 @@ differ in shape, and asynchronous struts arrive one after another).
 
 How the paper's plans are judged fast (``judge_plans`` without a planner)
 ------------------------------------------------------------------------
-The moves of all runs are planned together, grouped by mode, by ``planners.hexapod.plan_moves``
+The moves of all runs are planned together, grouped by mode, by ``planbench.planners.hexapod.plan_moves``
 (the closed-form long-move acceleration; the tick realization, the motion itself, depends only
 on the distances and the half times, so it equals ``PaperMovePlanner``'s, which uses the
 iteration). On the tick grid a strut accelerates for ``n_accel`` ticks, cruises and brakes; its
@@ -54,7 +54,7 @@ position is one quadratic in t, so
   switching ticks; a strut's position is monotone, its peak magnitude at its start or end;
 * the arrivals are the ticks n_i (the planned motion rests exactly on the target after them,
   and one tick earlier a moving strut is at least D_i / (2 n_a (n - n_a)) > 1e-8 D_i from it,
-  beyond the arrival tolerance of ``sims.hexapod.strut_tolerances``);
+  beyond the arrival tolerance of ``planbench.hexapod.strut_tolerances``);
 * the hexapod-space speeds (``hexapod_speed_ratios``: norms of the pose rate J^-1 qdot) peak at
   switching ticks too, the Jacobian being constant to ~1e-6 over a move of millimetres;
 * the pose, the forward kinematics of six quadratics, is smooth inside a piece: its largest
@@ -83,13 +83,13 @@ Throughput (one core of the 2-core development machine, with other jobs on it; t
 examples/hexapod/random_moves_campaign.toml measures it end to end): 10^5 single-move runs, start and target uniform in
 the limits, judged in 26 s of CPU (3800-4300 runs/s: 10^6 in about 4 min); building their
 ``HexapodParams`` took 40 s (10^6: about 7 min), longer than judging them. A campaign's
-columnar path (``sims.hexapod.plan_columns``) builds none: it validates the runs' poses as
+columnar path (``planbench.hexapod.plan_columns``) builds none: it validates the runs' poses as
 arrays and judges them through ``judge_moves``, the same per-move quantities.
 
 Example::
 
-    >>> from sims.hexapod import HexapodMove, HexapodParams
-    >>> from sims.hexapod.plan_checks import judge_plans
+    >>> from planbench.hexapod import HexapodMove, HexapodParams
+    >>> from planbench.hexapod.plan_checks import judge_plans
     >>> params = HexapodParams(moves=(HexapodMove((1.5, -1.0, 0.8, 0.1, -0.05, 0.03)),))
     >>> [checks] = judge_plans([params])
     >>> [(c.name, c.passed) for c in checks][:3]
@@ -102,14 +102,14 @@ from typing import Sequence
 
 import numpy as np
 
-from planners import hexapod as hexapod_planner
-from planners.errors import PlanningError
-from planners.hexapod import POSE_LABELS, RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS, StrutMove
-from planners.legs import component_norm, leg_vector_components
-from planners.trajectory import PiecewiseTrajectory, control_ticks
-from sims.checks import Check
-from sims.hexapod.params import HexapodParams
-from sims.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM, arrival_times,
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.errors import PlanningError
+from planbench.planners.hexapod import POSE_LABELS, RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS, StrutMove
+from planbench.planners.legs import component_norm, leg_vector_components
+from planbench.planners.trajectory import PiecewiseTrajectory, control_ticks
+from planbench.checks import Check
+from planbench.hexapod.params import HexapodParams
+from planbench.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM, arrival_times,
                                hexapod_speed_check, plan_moves, problems, strut_tolerances)
 #: Forward kinematics stops for a pose once its largest strut-length residual is below this,
 #: m (0.1 nm: 1e-8 of the smallest pose limit, 1e-4 of the 1 um end-pose limit).
@@ -142,7 +142,7 @@ def _max_last(values: np.ndarray) -> np.ndarray:
 
 
 def _strut_lengths(pose: np.ndarray) -> np.ndarray:
-    """``planners.hexapod.strut_lengths`` without its input check (the poses here are the
+    """``planbench.planners.hexapod.strut_lengths`` without its input check (the poses here are the
     kinematics' own iterates, finite by construction), on components (the same numbers),
     (M, 6) -> (M, 6) m."""
     vectors, _ = leg_vector_components(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local,
@@ -156,7 +156,7 @@ def poses_of_lengths(lengths: np.ndarray, guess: np.ndarray, inverse_jacobian: n
     """Forward kinematics of many strut-length sets, each on its own.
 
     The chord method: pose <- pose - J0^-1 (L(pose) - lengths) with a fixed J0 per row near
-    the solution (``planners.hexapod.forward_kinematics`` is Newton's method, but it stops when
+    the solution (``planbench.planners.hexapod.forward_kinematics`` is Newton's method, but it stops when
     the worst row of its batch has converged, so a row's result would depend on the batch).
     Each row stops when its own residual is below FK_TOLERANCE_M.
 
@@ -188,7 +188,7 @@ def poses_of_lengths(lengths: np.ndarray, guess: np.ndarray, inverse_jacobian: n
 
 
 def _inverse_jacobians(poses: np.ndarray) -> np.ndarray:
-    """(M, 6, 6) inverses of dL/dpose at the poses (``planners.hexapod.jacobian``)."""
+    """(M, 6, 6) inverses of dL/dpose at the poses (``planbench.planners.hexapod.jacobian``)."""
     return np.linalg.inv(hexapod_planner.jacobian(poses))
 
 
@@ -493,7 +493,7 @@ def judge_plans(params_list: Sequence[HexapodParams], planner=None) -> list[list
         matter: elevation, wind, dwell and duration act on the machine, not on the plan.
       planner: None for the paper's generator (the moves of all runs judged together, fast),
         or a planner of your own with ``plan(MoveProblem) -> Trajectory``: each run planned
-        by ``sims.hexapod.plan_moves`` and judged at its control ticks
+        by ``planbench.hexapod.plan_moves`` and judged at its control ticks
         (``judge_trajectories``); a ``PlanningError`` it raises propagates, as in a run.
 
     Returns:
@@ -555,14 +555,14 @@ def judge_trajectories(moves: Sequence[hexapod_planner.MoveProblem], trajectorie
     """The planner checks of one run from the trajectory planned for each of its moves.
 
     Each trajectory (channels STRUT_LABELS, strut length changes in m, from t = 0) is sampled
-    at its control ticks 0, dt, ... up to its duration (``planners.trajectory.control_ticks``,
-    as a run samples it); its arrivals are ``sims.hexapod.arrival_times`` of that sample, its
+    at its control ticks 0, dt, ... up to its duration (``planbench.planners.trajectory.control_ticks``,
+    as a run samples it); its arrivals are ``planbench.hexapod.arrival_times`` of that sample, its
     peaks those of the samples, its pose the forward kinematics of every tick. This is what
     ``judge_plans`` computes for the paper's generator, without its shortcuts, for any
     planner's trajectories (and a hand-made bad one).
 
     Args:
-      moves: the run's ``MoveProblem``s (``sims.hexapod.problems``).
+      moves: the run's ``MoveProblem``s (``planbench.hexapod.problems``).
       trajectories: what the planner returned for each.
     """
     if len(moves) != len(trajectories) or not moves:

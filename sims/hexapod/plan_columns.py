@@ -1,5 +1,5 @@
 """Planner-only campaigns of the hexapod as columns: a chunk of runs validated and judged on
-arrays (sims.campaign's columnar path, README "Campaigns").
+arrays (planbench.campaign's columnar path, README "Campaigns").
 
 A campaign's runs differ in their axes only. Where every axis is a component of the start
 pose or of a move's target, or a move's ``synchronous`` (``supports``), the runs of a chunk
@@ -8,7 +8,7 @@ order ``HexapodParams.from_mapping`` applies them, and gives the same message fo
 common failure (a strut beyond its stroke at a move's target or at the start pose); a run
 with any rarer finding (a value outside its declared range or the pose limits, a move of
 zero length) is marked ``unsure`` and validated by ``from_mapping`` itself (the campaign's
-worker does that). ``judge`` gives the checks of ``sims.hexapod.plan_checks.judge_plans`` as
+worker does that). ``judge`` gives the checks of ``planbench.hexapod.plan_checks.judge_plans`` as
 columns: the same per-move quantities (``judge_moves``) and, for runs of one move, the
 same values, limits and verdicts computed on arrays; runs of several moves go through
 ``checks_of_runs``.
@@ -18,17 +18,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners import hexapod as hexapod_planner
-from planners.hexapod import RUBIN_LIMITS
-from sims.hexapod import plan_checks
-from sims.hexapod.params import HexapodMove, HexapodParams, pose_si
-from sims.hexapod.task import ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM
-from sims.params import _bound
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.hexapod import RUBIN_LIMITS
+from planbench.hexapod import plan_checks
+from planbench.hexapod.params import HexapodMove, HexapodParams, pose_si
+from planbench.hexapod.task import ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM
+from planbench.params import _bound
 
 
 def supports(base: HexapodParams, paths) -> bool:
     """Whether runs that differ from ``base`` in the axes ``paths`` (parsed keys, as
-    ``sims.campaign.spec.parse_path`` gives) can be validated and judged as columns."""
+    ``planbench.campaign.spec.parse_path`` gives) can be validated and judged as columns."""
     moves = len(base.moves)
     for path in paths:
         if len(path) == 2 and path[0] == "start_pose" and isinstance(path[1], int) and path[1] < 6:

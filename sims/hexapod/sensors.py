@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import dataclasses
 
-from sims.hexapod.params import CONTROL_DT
-from sims.hexapod.physics import STRUT_DRIVE, HexapodPhysics
-from sims.task import JointEncoders
+from planbench.hexapod.params import CONTROL_DT
+from planbench.hexapod.physics import STRUT_DRIVE, HexapodPhysics
+from planbench.task import JointEncoders
 
 
 def sensors(physics: HexapodPhysics) -> JointEncoders:

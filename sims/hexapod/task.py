@@ -1,6 +1,6 @@
 """The hexapod's task: the moves (``problems``, ``plan_moves``), the wind on the camera, the
 evaluation (``HexapodEvaluation``: checks, metrics, timeseries), ``build`` (a run's
-``sims.runner.Setup``) and the dm_control reward.
+``planbench.runner.Setup``) and the dm_control reward.
 """
 
 from __future__ import annotations
@@ -9,21 +9,21 @@ import math
 
 import numpy as np
 
-from planners import hexapod as hexapod_planner
-from planners.errors import PlanningError
-from planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
-from planners.trajectory import PiecewiseTrajectory, TrajectorySample
-from sims import run_limits
-from sims.checks import Check
-from sims.controllers import demanded_force
-from sims.envs import joint_tracking_reward
-from sims.hexapod.controller import HexapodController
-from sims.hexapod.params import CONTROL_DT, SETTLE_S, HexapodParams, HexapodPlant, pose_si
-from sims.hexapod.physics import HexapodPhysics, magnified_qpos
-from sims.hexapod.sensors import sensors
-from sims.runner import RunLog, Setup
-from sims.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
-from sims.wind import BodyWindDrag, horizontal_direction
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.errors import PlanningError
+from planbench.planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
+from planbench.planners.trajectory import PiecewiseTrajectory, TrajectorySample
+from planbench import run_limits
+from planbench.checks import Check
+from planbench.controllers import demanded_force
+from planbench.envs import joint_tracking_reward
+from planbench.hexapod.controller import HexapodController
+from planbench.hexapod.params import CONTROL_DT, SETTLE_S, HexapodParams, HexapodPlant, pose_si
+from planbench.hexapod.physics import HexapodPhysics, magnified_qpos
+from planbench.hexapod.sensors import sensors
+from planbench.runner import RunLog, Setup
+from planbench.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
+from planbench.wind import BodyWindDrag, horizontal_direction
 
 SETTLE_WINDOW_S = 0.25  # s: pose_error_final is the worst over the run's last 0.25 s
 
@@ -376,7 +376,7 @@ class HexapodEvaluation:
         return 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(poses) - wanted, axis=-1).max(axis=-1)
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.hexapod.report import hexapod_report
+        from planbench.hexapod.report import hexapod_report
 
         hexapod_report(self.timeseries(log), log.t, checks, path)
 

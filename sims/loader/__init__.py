@@ -18,16 +18,16 @@ sims/loader/plan_checks.py (planner-only checks), sims/loader/report.py (report.
 
 from __future__ import annotations
 
-from planners import loader as loader_planner
-from sims.loader.controller import reference_controller
-from sims.loader.params import (_BIAS_LIMIT, _BIAS_UNITS, _KEY_HIGH, _KEY_LOW, CONTROL_DT, SETTLE_S, LoaderParams,
+from planbench.planners import loader as loader_planner
+from planbench.loader.controller import reference_controller
+from planbench.loader.params import (_BIAS_LIMIT, _BIAS_UNITS, _KEY_HIGH, _KEY_LOW, CONTROL_DT, SETTLE_S, LoaderParams,
                                 LoaderPlant, log_bytes_per_tick)
-from sims.loader.physics import (ARM_BODIES, OBSTACLE_CONTYPE, ROBOT_CONTYPE, LoaderPhysics, apply_plant,
+from planbench.loader.physics import (ARM_BODIES, OBSTACLE_CONTYPE, ROBOT_CONTYPE, LoaderPhysics, apply_plant,
                                  joint_kinds, plant_chain, shell_mass)
-from sims.loader.plan_checks import judge_plans
-from sims.loader.task import (KEYPOINT_LIMIT_DEG, TRACKING_LIMIT_DEG, LoaderEvaluation, build, environment_reward,
+from planbench.loader.plan_checks import judge_plans
+from planbench.loader.task import (KEYPOINT_LIMIT_DEG, TRACKING_LIMIT_DEG, LoaderEvaluation, build, environment_reward,
                               plan, problem)
-from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
+from planbench.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
 
 _RUN = dict(build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT, plant=LoaderPlant(), judge_plans=judge_plans)
 

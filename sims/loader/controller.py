@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import models
-from sims.controllers import ServoFeedforwardController
+from planbench import models
+from planbench.controllers import ServoFeedforwardController
 
 
 def reference_controller() -> ServoFeedforwardController:

@@ -8,11 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import models
-from planners import loader as loader_planner
-from sims import run_limits
-from sims.drives import DRIVES, torque_constant_error
-from sims.params import PlantParams, ScenarioParams, param
+from planbench import models
+from planbench.planners import loader as loader_planner
+from planbench import run_limits
+from planbench.drives import DRIVES, torque_constant_error
+from planbench.params import PlantParams, ScenarioParams, param
 
 CONTROL_DT = 0.005  # s: 200 Hz motion controller; the drives run at the 0.5 ms physics step
 SETTLE_S = 0.5  # s simulated after the plan ends, so the arrival is seen at rest
@@ -24,7 +24,7 @@ def log_bytes_per_tick(drives: str = "ideal") -> float:
     model with ``drives`` (6 planned joints) and the servo controller's set-points and
     feed-forward torques (6 + 6 doubles). The contact list of loader-direct (a few hundred
     ticks) is left out."""
-    from sims.loader.physics import LoaderPhysics  # the physics module imports this one
+    from planbench.loader.physics import LoaderPhysics  # the physics module imports this one
 
     model = LoaderPhysics.load(drives=drives).model.ptr
     return run_limits.floats(run_limits.runlog_floats_per_tick(model, 6) + 2 * 6)

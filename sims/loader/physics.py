@@ -13,12 +13,12 @@ import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
-import models
-from sims.drives import (DriveTrain, add_drive_train, check_option, drive_coordinates, keyframe_with_motors,
+from planbench import models
+from planbench.drives import (DriveTrain, add_drive_train, check_option, drive_coordinates, keyframe_with_motors,
                          transmission_deflection)
-from sims.loader.collision import geoms_by_contype
-from sims.loader.params import LoaderPlant
-from sims.plant import set_inertial
+from planbench.loader.collision import geoms_by_contype
+from planbench.loader.params import LoaderPlant
+from planbench.plant import set_inertial
 
 #: Robot collision geoms have contype 1, obstacles (breechblock, seat ring, floor) contype 2.
 ROBOT_CONTYPE = 1
@@ -117,7 +117,7 @@ class LoaderPhysics(dm_mujoco.Physics):
         distribution), edited with MjSpec before compiling. ``plant`` (None: the nominal
         plant): the true machine, perturbed as ``LoaderPlant`` says (``apply_plant``); its
         ``payload_mass_error`` makes the shell's true mass payload_mass (1 + error).
-        ``drives`` (``sims.drives.DRIVES``): the arm's drive trains as built (``as_built``) or the MJCF's
+        ``drives`` (``planbench.drives.DRIVES``): the arm's drive trains as built (``as_built``) or the MJCF's
         ideal servos."""
         check_option(drives)
         nominal = plant is None or plant.is_nominal
@@ -259,7 +259,7 @@ def apply_plant(spec: mujoco.MjSpec, plant: "LoaderPlant") -> None:
     ``LoaderPhysics.load`` scales). Each edit touches only its own elements:
 
     * arm_mass_error: the mass and inertia of every body of ``ARM_BODIES`` times (1 + error),
-      its centre of mass and principal axes kept (``sims.plant.set_inertial``);
+      its centre of mass and principal axes kept (``planbench.plant.set_inertial``);
     * upper_arm_length_error: the elbow axis (body ``forearm``) moved along the upper arm, m
       (the beam's geom and mass are left: a bore position error, not another beam);
     * joint_viscous_friction: each joint's damping (N s/m, N m s/rad) = fraction x its drive's

@@ -1,9 +1,9 @@
 """Planner-only checks of loader runs: the planned joint trajectory judged without physics.
 
 ``judge_plans(params_list)`` builds each run's planning problem as a run does
-(``sims.loader.task.problem``: the key points at uniform times, the model's joint limits) and
+(``planbench.loader.task.problem``: the key points at uniform times, the model's joint limits) and
 returns, per run, the checks that judge the trajectory the paper's planner (the cubic
-B-spline, ``planners.loader.CubicBSplinePlanner``) returns for it. Where a run's check of the
+B-spline, ``planbench.planners.loader.CubicBSplinePlanner``) returns for it. Where a run's check of the
 same name measures the machine (the encoders, the logged poses), the planned quantity's name
 begins with ``plan_``.
 
@@ -32,9 +32,9 @@ plan_min_clearance   m      > 0                   smallest signed distance betwe
                                                   of the logged poses)
 ===================  =====  ====================  ================================================
 
-Limits are the run's (``sims.loader.task``) and the model's (``models.loader_spec``), never
+Limits are the run's (``planbench.loader.task``) and the model's (``models.loader_spec``), never
 loosened. ``joint_range`` judges as the planner does, with its numbers and its one tolerance,
-``planners.loader.JOINT_LIMIT_TOLERANCE`` (1e-9 m on the slide, 1e-9 rad on the hinges):
+``planbench.planners.loader.JOINT_LIMIT_TOLERANCE`` (1e-9 m on the slide, 1e-9 rad on the hinges):
 a key point beyond a limit by no more than it, or the spline between key points (at the
 planner's own ``CubicBSplineTrajectory.extrema``) by no more than it plus the spline's
 round-off (``limit_tolerance``), counts as on the limit (ratio at most 1); anything beyond is
@@ -55,7 +55,7 @@ How it is fast
 * The extrema. Per segment a joint is a cubic in t (``segment_polynomials``): its range is
   checked at the roots of its derivative (as the planner's own overshoot check), its rate at
   the root of the second derivative, both exactly.
-* The clearance. The run's measure, ``sims.loader.collision.clearance`` (MuJoCo's
+* The clearance. The run's measure, ``planbench.loader.collision.clearance`` (MuJoCo's
   ``mj_geomDistance`` over every robot-obstacle pair after ``mj_kinematics``, capped at
   0.5 m), at the control ticks, as a run samples the plan for its controller (the shell moves
   up to ~1 cm between two ticks at the supply stage's speeds, so this is the ticks' minimum,
@@ -94,8 +94,8 @@ centimetres: 150 runs/s, 10^5 in about 11 min. The clearance is nine tenths of i
 
 Example::
 
-    >>> from sims.loader import LoaderParams
-    >>> from sims.loader.plan_checks import judge_plans
+    >>> from planbench.loader import LoaderParams
+    >>> from planbench.loader.plan_checks import judge_plans
     >>> [checks] = judge_plans([LoaderParams()])    # Table 1's key points
     >>> [(c.name, c.passed) for c in checks]
     [('plan_keypoint_error', True), ('joint_range', True), ('joint_rate', True), ('plan_min_clearance', True)]
@@ -109,19 +109,19 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-import models
-from planners.errors import PlanningError
-from planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, LoaderProblem, si_to_table1
-from planners.loader.bspline import CubicBSplineTrajectory
-from planners.trajectory import control_ticks
-from sims.checks import Check
-from sims.loader.collision import clearance, geoms_by_contype
-from sims.loader.params import CONTROL_DT, LoaderParams
-from sims.loader.physics import OBSTACLE_CONTYPE, ROBOT_CONTYPE
-from sims.loader.task import KEYPOINT_LIMIT_DEG, problem
-from sims.task import plan_checked
+from planbench import models
+from planbench.planners.errors import PlanningError
+from planbench.planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, LoaderProblem, si_to_table1
+from planbench.planners.loader.bspline import CubicBSplineTrajectory
+from planbench.planners.trajectory import control_ticks
+from planbench.checks import Check
+from planbench.loader.collision import clearance, geoms_by_contype
+from planbench.loader.params import CONTROL_DT, LoaderParams
+from planbench.loader.physics import OBSTACLE_CONTYPE, ROBOT_CONTYPE
+from planbench.loader.task import KEYPOINT_LIMIT_DEG, problem
+from planbench.task import plan_checked
 
-#: ``sims.loader.collision.clearance``'s cap: distances beyond it are reported as it, m.
+#: ``planbench.loader.collision.clearance``'s cap: distances beyond it are reported as it, m.
 DISTMAX_M = 0.5
 #: Slack on the branch and bound's lower bounds, m: an interval is skipped only when its bound
 #: exceeds the smallest clearance found by this much, so MuJoCo's distance approximations
@@ -187,7 +187,7 @@ def _segment_distance(p1, d1, p2, d2, e) -> np.ndarray:
 
 
 class _Collision:
-    """The loader scene's robot and obstacle collision geoms (``sims.loader.physics``'s contypes), and
+    """The loader scene's robot and obstacle collision geoms (``planbench.loader.physics``'s contypes), and
     ``clearance`` at many poses with what makes it cheap (module docstring)."""
 
     def __init__(self):

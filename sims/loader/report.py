@@ -1,10 +1,10 @@
-"""report.png of a loader run (matplotlib, Agg: sims.report)."""
+"""report.png of a loader run (matplotlib, Agg: planbench.report)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from sims.report import finish, plt
+from planbench.report import finish, plt
 
 
 def loader_report(ts: dict, t: np.ndarray, checks, path) -> None:

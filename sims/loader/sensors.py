@@ -6,17 +6,17 @@ import dataclasses
 
 import numpy as np
 
-from sims.loader.params import CONTROL_DT
-import models
-from sims.loader.physics import LoaderPhysics, joint_drive
-from sims.task import JointEncoders
+from planbench.loader.params import CONTROL_DT
+from planbench import models
+from planbench.loader.physics import LoaderPhysics, joint_drive
+from planbench.task import JointEncoders
 
 
 def sensors(physics: LoaderPhysics, bias=None) -> JointEncoders:
     """The loader's sensors: the drives' encoders on theta1 ... theta6, every tick. With the
     drives as built they are the motors' encoders (the arm has no joint-side ones, as an
     industrial arm's): each reads its motor's angle over the transmission ratio, in counts of
-    2 pi / (2^20 N) (``sims.loader.physics.MOTOR_ENCODER_COUNTS``), so it does not see the
+    2 pi / (2^20 N) (``planbench.loader.physics.MOTOR_ENCODER_COUNTS``), so it does not see the
     reducer's deflection or backlash; with the ideal drives they read the joints exactly.
     ``bias`` (6,) m and rad: the plant's encoder zero offsets (``LoaderPlant.encoder_bias``),
     added to every reading; None or zeros: none."""

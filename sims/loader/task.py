@@ -5,19 +5,19 @@ from __future__ import annotations
 
 import numpy as np
 
-import models
-from planners import loader as loader_planner
-from planners.loader import forward_kinematics
-from sims import run_limits
-from sims.checks import Check
-from sims.controllers import demanded_force
-from sims.loader.collision import clearance, obstacle_contact_pairs
-from sims.loader.controller import reference_controller
-from sims.loader.params import CONTROL_DT, LoaderParams, LoaderPlant
-from sims.loader.physics import LoaderPhysics, _joint_dofs, plant_chain
-from sims.loader.sensors import sensors
-from sims.runner import RunLog, Setup
-from sims.task import Components, Provenance, Task, nominal_copy, plan_checked
+from planbench import models
+from planbench.planners import loader as loader_planner
+from planbench.planners.loader import forward_kinematics
+from planbench import run_limits
+from planbench.checks import Check
+from planbench.controllers import demanded_force
+from planbench.loader.collision import clearance, obstacle_contact_pairs
+from planbench.loader.controller import reference_controller
+from planbench.loader.params import CONTROL_DT, LoaderParams, LoaderPlant
+from planbench.loader.physics import LoaderPhysics, _joint_dofs, plant_chain
+from planbench.loader.sensors import sensors
+from planbench.runner import RunLog, Setup
+from planbench.task import Components, Provenance, Task, nominal_copy, plan_checked
 
 #: Check limits. 0.1 deg at the key points is 3.8 mm at the 2.2 m reach of the shell tip, a
 #: small fraction of the 6 cm by which the planned path clears the obstacles; the run-wide
@@ -141,7 +141,7 @@ class LoaderEvaluation:
         }
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.loader.report import loader_report  # lazy: matplotlib, only when a report is drawn
+        from planbench.loader.report import loader_report  # lazy: matplotlib, only when a report is drawn
 
         loader_report(self.timeseries(log), log.t, checks, path)
 
@@ -198,8 +198,8 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
 
 def environment_reward(setup: Setup):
     """The dm_control reward: exp(-max joint tracking error / 0.1 deg)."""
-    # Lazy: sims.envs loads dm_control.suite (about a second), needed only by the environments.
-    from sims.envs import joint_tracking_reward
+    # Lazy: planbench.envs loads dm_control.suite (about a second), needed only by the environments.
+    from planbench.envs import joint_tracking_reward
 
     physics = setup.physics
     return joint_tracking_reward(physics.model.ptr.jnt_qposadr[[physics.model.ptr.joint(n).id

@@ -1,7 +1,7 @@
 """Rest-to-rest swing of a one-joint pendulum: the quintic blend s(tau) = 10 tau^3 - 15 tau^4
 + 6 tau^5 (tau = t / T), which starts and ends with zero velocity and acceleration.
 
-Pure numpy; ``QuinticPlanner().plan(problem)`` returns a ``planners.trajectory.Trajectory``.
+Pure numpy; ``QuinticPlanner().plan(problem)`` returns a ``planbench.planners.trajectory.Trajectory``.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.trajectory import TrajectorySample, sample_times
+from planbench.planners.trajectory import TrajectorySample, sample_times
 
 
 @dataclass(frozen=True)

@@ -16,16 +16,16 @@ from dataclasses import dataclass
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
-import models
-from planners import pendulum as pendulum_planner
-from sims import run_limits
-from sims.checks import Check
-from sims.controllers import ServoFeedforwardController, demanded_force
-from sims.envs import joint_tracking_reward
-from sims.params import ScenarioParams, param
-from sims.runner import RunLog, Setup
-from sims.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
-from sims.task import Components, JointEncoders, Provenance, Task, plan_checked
+from planbench import models
+from planbench.planners import pendulum as pendulum_planner
+from planbench import run_limits
+from planbench.checks import Check
+from planbench.controllers import ServoFeedforwardController, demanded_force
+from planbench.envs import joint_tracking_reward
+from planbench.params import ScenarioParams, param
+from planbench.runner import RunLog, Setup
+from planbench.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
+from planbench.task import Components, JointEncoders, Provenance, Task, plan_checked
 
 CONTROL_DT = 0.005  # s: 200 Hz; five 1 ms physics steps a tick
 #: Arrival: within this of the goal (rad) and this slow (rad/s) over the last ARRIVAL_S.
@@ -117,7 +117,7 @@ class PendulumEvaluation:
                 "drive_torque": log.actuator_force[:, 0]}
 
     def report(self, log: RunLog, checks, path) -> None:
-        from sims.report import finish, plt
+        from planbench.report import finish, plt
 
         ts = self.timeseries(log)
         fig, axes = plt.subplots(1, 2, figsize=(10, 4))
