@@ -1,4 +1,23 @@
-"""planbench's simulation layer: runner, controllers, disturbances, checks, rendering, CLI.
+"""planbench: a MuJoCo testbed for the motion planners of FAST, a Rubin-style hexapod, a ship
+antenna and a PRR-3R loader.
+
+The public API is what ``__all__`` names (README, "Python API"); a plug-in needs nothing else:
+
+    import planbench
+
+    result = planbench.run("loader-supply", controller=MyController(), params={"seed": 1})
+    print(result.passed, [(c.name, c.value, c.limit) for c in result.checks])
+
+Entry points: ``run`` (one run, as ``planbench run``), ``plan`` (the planned motion alone, as
+``planbench plan``), ``sweep`` (a campaign, as ``planbench sweep``), ``environment`` (a
+dm_control Environment of a scenario), ``scenario_names``. A plug-in implements ``Controller``
+(given a ``ControlContext``), ``Planner`` or ``OnlinePlanner``, returns a ``Trajectory`` (or a
+``PiecewiseTrajectory``) sampled as ``TrajectorySample``, for the problems ``LoaderProblem``,
+``MoveProblem``, ``FastProblem`` and ``AntennaProblem``, and raises ``PlanningError`` (or
+``LimitError``) for a problem it cannot solve. planbench raises ``PluginError`` for a plug-in
+that breaks the contract and ``ParamError`` for bad parameters. Everything else, the
+subpackages included (``planbench.planners``, ``planbench.models``, the mechanisms' packages),
+is internal: it may change between releases.
 
 MuJoCo picks its OpenGL back end when it is first imported, so the choice is made here,
 before anything imports mujoco: EGL (headless GPU or Mesa) when libEGL is present, else
@@ -25,3 +44,50 @@ def _default_gl() -> str:
 os.environ.setdefault("MUJOCO_GL", _default_gl())
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
+
+
+__version__ = "0.2.0"
+
+# name -> module that defines it; imported on first use (PEP 562), so that importing
+# planbench.planners (pure numpy) does not import MuJoCo.
+_PUBLIC = {
+    "run": "planbench.api",
+    "plan": "planbench.api",
+    "sweep": "planbench.api",
+    "environment": "planbench.api",
+    "scenario_names": "planbench.api",
+    "RunResult": "planbench.runner",
+    "Check": "planbench.checks",
+    "Controller": "planbench.task",
+    "Planner": "planbench.task",
+    "OnlinePlanner": "planbench.task",
+    "ControlContext": "planbench.task",
+    "PluginError": "planbench.task",
+    "ParamError": "planbench.params",
+    "Trajectory": "planbench.planners.trajectory",
+    "TrajectorySample": "planbench.planners.trajectory",
+    "PiecewiseTrajectory": "planbench.planners.trajectory",
+    "PlanningError": "planbench.planners.errors",
+    "LimitError": "planbench.planners.errors",
+    "LoaderProblem": "planbench.planners.loader",
+    "MoveProblem": "planbench.planners.hexapod",
+    "FastProblem": "planbench.planners.fast.plan",
+    "AntennaProblem": "planbench.planners.antenna",
+}
+
+__all__ = ["__version__", *_PUBLIC]
+
+
+def __getattr__(name: str):
+    module = _PUBLIC.get(name)
+    if module is None:
+        raise AttributeError(f"module 'planbench' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_PUBLIC))

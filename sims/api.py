@@ -1,8 +1,9 @@
-"""planbench from Python: run a scenario with your own planner or controller objects.
+"""planbench from Python: the entry points that ``planbench`` re-exports (``run``, ``plan``,
+``sweep``, ``environment``, ``scenario_names``).
 
-    from planbench import api
+    import planbench
 
-    result = api.run("loader-supply", controller=MyController(), params={"seed": 1, "payload_mass": 50.0})
+    result = planbench.run("loader-supply", controller=MyController(), params={"seed": 1, "payload_mass": 50.0})
     print(result.passed, [(c.name, c.value, c.limit) for c in result.checks])
 
 What the objects must provide is the Task contract (``planbench.task``): a controller has
@@ -15,7 +16,7 @@ the command line (``planbench.plugins``).
 from __future__ import annotations
 
 from planbench import outputs, pipeline, runner, scenarios
-from planbench.task import check_controller, check_planner
+from planbench.task import PluginError, check_controller, check_planner
 
 
 def run(scenario: str, *, planner=None, controller=None, params=None, plant=None,
@@ -69,3 +70,63 @@ def run(scenario: str, *, planner=None, controller=None, params=None, plant=None
             return execute()
         with video_file.reserved():
             return execute()
+
+
+def plan(scenario: str, *, planner=None, params=None):
+    """The planned motion of the scenario ``scenario`` (``planbench plan``, no physics): the
+    ``Trajectory`` its planner returns for its problem.
+
+    Args:
+      scenario: a name of ``planbench list`` (or a plan-only entry of ``planbench plan``).
+      planner: your planner (``plan(problem)``), None for the paper's. Your planner gets the
+        problem the scenario's run would give it (the model is compiled for that, not
+        stepped).
+      params: overrides of the scenario's parameters (a mapping), or its Params object.
+
+    Raises:
+      planbench.PluginError: a planner that breaks the contract, or an online planner (the
+        antenna's plans one attitude at a time, during a run: use ``run``).
+      planbench.PlanningError: a problem the planner cannot solve.
+    """
+    spec = scenarios.get_plan(scenario) if planner is None else scenarios.get(scenario)
+    params = spec.resolve(params) if params is None or isinstance(params, dict) else params
+    if planner is None:
+        return spec.plan(params)
+    if spec.online_planner:
+        raise PluginError(f"{spec.name}'s planner is online (reset and step during the run): "
+                          "planbench.run judges it, plan has no trajectory to give")
+    check_planner(planner, online=False)
+    return spec.build(params, planner=planner).components.trajectory
+
+
+def sweep(spec, out, *, engine: str = "local", workers: int | None = None, address: str | None = None,
+          quiet: bool = True):
+    """Run (or resume) the campaign of the TOML file ``spec`` into the directory ``out``, as
+    ``planbench sweep`` does (README, "Campaigns"); returns its ``Outcome`` (summary, the
+    runs run now, the results table, the worst runs).
+
+    Raises:
+      planbench.ParamError: a bad spec or option, before any run starts.
+    """
+    from planbench import campaign
+
+    return campaign.sweep(spec, out, engine=engine, workers=workers, address=address, quiet=quiet,
+                          echo=(lambda *args, **kwargs: None) if quiet else print)
+
+
+def environment(scenario: str, random=None, **params):
+    """The dm_control ``Environment`` of the scenario ``scenario``: its task built with
+    ``params`` (keys of ``planbench run NAME --help``), the action the commands of the
+    actuators a controller drives, the observation the sensors' readings and the reference.
+    ``random``: the episodes' random state (None: from the ``seed`` parameter)."""
+    from planbench import envs
+
+    return envs.make(scenario, random=random, **params)
+
+
+def scenario_names(tag: str | None = None) -> tuple[str, ...]:
+    """The runnable scenarios' names (``planbench list``), in registry order; ``tag``: only
+    those tagged "demo" or "benchmark"."""
+    if tag is None:
+        return tuple(scenarios.SCENARIOS)
+    return tuple(s.name for s in scenarios.tagged(tag))

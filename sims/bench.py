@@ -382,7 +382,7 @@ def planner_benchmarks() -> list[str]:
 
     texts = []
     for record in scenarios.mechanisms():
-        name = f"sims.{record.name}.bench"
+        name = f"planbench.{record.name}.bench"
         if importlib.util.find_spec(name) is not None:
             texts.append(importlib.import_module(name).planner_benchmark())
     return texts

@@ -25,7 +25,7 @@ import sys
 import threading
 from pathlib import Path
 
-import planbench  # noqa: F401  (chooses the OpenGL back end before mujoco is imported)
+import planbench  # first: it chooses the OpenGL back end before mujoco is imported
 
 EXIT_OK, EXIT_CHECK_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -48,6 +48,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="planbench", description="MuJoCo testbed for motion planners.")
+    parser.add_argument("--version", action="version", version=f"planbench {planbench.__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sub.add_parser("list", help="list the scenarios")
     sub.add_parser("run", help="simulate a scenario and check it (planbench run NAME --help: its parameters)",

@@ -20,6 +20,22 @@ from planbench import supervise
 from planbench.task import PluginError, _callable_with, check_controller, check_planner, fault_text
 
 
+#: The top-level names planbench's modules had before they moved under ``planbench`` (0.2.0),
+#: with their names now: a plug-in that imports an old name is told the new one in one line.
+#: To be dropped in the release after 0.2.0.
+OLD_NAMES = {"sims": "planbench", "planners": "planbench.planners", "models": "planbench.models"}
+
+
+def _old_name_text(error: ModuleNotFoundError) -> str | None:
+    """What to write instead, if ``error`` is a missing old top-level name of planbench's."""
+    top = (error.name or "").partition(".")[0]
+    if top not in OLD_NAMES:
+        return None
+    new = OLD_NAMES[top]
+    return (f"it imports {error.name!r}, a name of planbench's modules before 0.2.0: import "
+            f"{new!r} instead ({top}.X is {new}.X)")
+
+
 def is_file(module_name: str) -> bool:
     """``MODULE`` of a spec names a .py file (else an importable module)."""
     return module_name.endswith(".py") or "/" in module_name or "\\" in module_name
@@ -55,12 +71,16 @@ def _module(name: str, role: str):
             spec.loader.exec_module(module)
         except (Exception, SystemExit) as e:
             del sys.modules[key]
-            raise PluginError(f"--{role} {name}: importing it raised {fault_text(e)}") from None
+            old = _old_name_text(e) if isinstance(e, ModuleNotFoundError) else None
+            raise PluginError(f"--{role} {name}: {old or 'importing it raised ' + fault_text(e)}") from None
         return module
     supervise.phase(f"importing --{role} {name}")
     try:
         return importlib.import_module(name)
     except ModuleNotFoundError as e:
+        old = _old_name_text(e)
+        if old:
+            raise PluginError(f"--{role} {name}: {old}") from None
         raise PluginError(f"--{role} {name}: no module named {e.name!r} (give an importable module or a "
                           "path to a .py file)") from None
     except (Exception, SystemExit) as e:

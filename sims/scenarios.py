@@ -141,19 +141,20 @@ class Mechanism:
 
 
 def _import_mechanism(name: str):
-    from planbench import planners
     import planbench
+    from planbench import planners
 
     # A mechanism of a root PLANBENCH_MECHANISMS names: its sims/ and planners/ folders
-    # are searched after the project's own (as a namespace package's portions).
+    # are searched after the project's own (as a namespace package's portions), as
+    # planbench.<name> and planbench.planners.<name>.
     for root in models.extra_roots():
-        for package, folder in ((sims, root / "sims"), (planners, root / "planners")):
+        for package, folder in ((planbench, root / "sims"), (planners, root / "planners")):
             if folder.is_dir() and str(folder) not in package.__path__:
                 package.__path__.append(str(folder))
     try:
-        return importlib.import_module(f"sims.{name}")
+        return importlib.import_module(f"planbench.{name}")
     except ModuleNotFoundError as e:
-        if e.name != f"sims.{name}":
+        if e.name != f"planbench.{name}":
             raise
         raise ImportError(f"models/{name}/scene.xml has no simulation package sims/{name}/") from None
 

@@ -89,8 +89,8 @@ def test_the_summary_is_strict_json_and_names_what_ran(name, tmp_path):
     assert summary["scenario"] == name and summary["seed"] == 1
     components = summary["components"]
     assert set(components) == {"planner", "trajectory", "controller", "sensors", "disturbance"}
-    assert components["planner"].startswith("planners.") and components["trajectory"].startswith("planners.")
-    assert components["controller"].startswith("sims.") and components["sensors"].startswith("sims.")
+    assert components["planner"].startswith("planbench.planners.") and components["trajectory"].startswith("planbench.planners.")
+    assert components["controller"].startswith("planbench.") and components["sensors"].startswith("planbench.")
     assert summary["plugins"] == {}
     assert summary["sensors"] and all(s["rate_hz"] > 0 and s["name"] for s in summary["sensors"])
     assert [c["name"] for c in summary["checks"]] == [c.name for c in result.checks]
