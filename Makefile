@@ -36,7 +36,7 @@ lint: $(STAMP)
 typecheck: $(STAMP)
 	@rm -rf $(TYPED) && mkdir -p $(TYPED)/planbench
 	@ln -s $(CURDIR)/sims/* $(TYPED)/planbench/ && ln -s $(CURDIR)/planners $(CURDIR)/models $(TYPED)/planbench/
-	cd $(TYPED) && $(CURDIR)/$(BIN)/mypy --config-file $(CURDIR)/pyproject.toml $(addprefix planbench/,$(PUBLIC_API))
+	cd $(TYPED) && $(CURDIR)/$(BIN)/mypy --config-file $(CURDIR)/pyproject.toml --cache-dir $(CURDIR)/.mypy_cache $(addprefix planbench/,$(PUBLIC_API))
 
 bench: $(STAMP)
 	$(BIN)/planbench bench
