@@ -65,7 +65,7 @@ def test_without_prediction_the_pointing_error_is_measurably_worse(paper_run):
 
 def test_a_twice_faster_ship_breaks_the_rate_and_torque_checks():
     """The checks can fail: the paper's motion at twice its speed (periods 4 s and 5 s)."""
-    setup = antenna._setup(PaperShipMotion(sample_time=0.005), *np.radians(ant.PAPER_SATELLITE_DEG),
+    setup = antenna.task._setup(PaperShipMotion(sample_time=0.005), *np.radians(ant.PAPER_SATELLITE_DEG),
                            6.0, 0, antenna.POINTING_MAX_PAPER_DEG, None, {},
                            antenna.AntennaOptions())
     checks = _checks(runner.run("fast ship", setup))

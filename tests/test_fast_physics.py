@@ -419,7 +419,10 @@ def cabin_modes(setup):
     mujoco.mjd_transitionFD(model, data, 1e-6, True, a, None, None, None)
     eig, vec = np.linalg.eig(a)
     s = np.log(eig.astype(complex)) / model.opt.timestep
-    freq, zeta = s.imag / (2 * np.pi), -s.real / np.abs(s)
+    # Eigenvalues of exactly 1 (s = 0: the states the step leaves unchanged) have no damping
+    # ratio; they are not modes below 1 Hz and are dropped below.
+    freq = s.imag / (2 * np.pi)
+    zeta = np.divide(-s.real, np.abs(s), out=np.full(s.shape, np.nan), where=np.abs(s) > 0)
     mass = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, mass)
     velocity = vec[model.nv:2 * model.nv]

@@ -159,8 +159,8 @@ def test_motion_scans_with_transitions(build):
 
 
 def test_shorter_t2_breaks_a_t_max():
-    make = fast_sims._scan_factory(fast_sims.DEC_SCAN)
-    jd1, jd2 = fast_sims._transit("3C 286")
+    make = fast_sims.task._scan_factory(fast_sims.DEC_SCAN)
+    jd1, jd2 = fast_sims.params._transit("3C 286")
     start = (jd1, jd2)
     t2 = fp.minimum_t2(make, start)
     with pytest.raises(LimitError, match="A_t-max 15.0 mm/s"):

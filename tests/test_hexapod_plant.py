@@ -119,7 +119,7 @@ def _bias(nominal, plant):
 ], ids=["camera_mass_error", "camera_com_offset", "base_pivot_radius_error", "platform_pivot_radius_error",
         "drive_stiffness_error", "drive_force_scale", "encoder_bias_um"])
 def test_a_field_changes_its_part_of_the_model_and_nothing_else(fields, edits):
-    nominal = hexapod._compiled(ELEVATION)
+    nominal = hexapod.physics._compiled(ELEVATION)
     plant = plant_model(**fields)
     assert changed_fields(nominal, plant), "the perturbation changed nothing"
     assert_edits_only(nominal, plant, edits(nominal, plant), rtol=1e-12)
@@ -141,14 +141,14 @@ def test_the_plant_geometry_is_the_model_s():
 
 
 def test_the_nominal_compile_stays_cached():
-    hexapod._compiled(ELEVATION)
+    hexapod.physics._compiled(ELEVATION)
     plant_model(camera_mass_error=0.02)  # a plant compiles its own model, not a nominal one
-    before = hexapod._compiled.cache_info()
+    before = hexapod.physics._compiled.cache_info()
     models = [hexapod.HexapodPhysics.load(ELEVATION).model.ptr,
               hexapod.HexapodPhysics.load(ELEVATION, hexapod.HexapodPlant()).model.ptr]
-    after = hexapod._compiled.cache_info()
+    after = hexapod.physics._compiled.cache_info()
     assert after.misses == before.misses and after.hits == before.hits + 2
-    assert all(changed_fields(hexapod._compiled(ELEVATION), m) == {} for m in models)
+    assert all(changed_fields(hexapod.physics._compiled(ELEVATION), m) == {} for m in models)
 
 
 # ------------------------------------------------------------------ the controller keeps the nominal model
@@ -158,7 +158,7 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start():
     params = SPEC.resolve(duration=0.1)
     setup = SPEC.build(params, plant=hexapod.HexapodPlant(**EVERYTHING))
     reference = SPEC.build(params)
-    nominal = hexapod._compiled(ELEVATION, params.drives)
+    nominal = hexapod.physics._compiled(ELEVATION, params.drives)
     assert changed_fields(nominal, setup.physics.model.ptr)  # the plant is perturbed
     given_model = setup.task.nominal_physics()
     assert changed_fields(nominal, given_model.model.ptr) == {}

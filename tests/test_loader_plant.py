@@ -254,8 +254,8 @@ def test_a_longer_upper_arm_moves_the_shell_tip_the_evaluation_reports():
 @settings(max_examples=30, deadline=None)
 def test_an_encoder_bias_out_of_its_range_names_the_joint(column, excess):
     bias = [0.0] * 6
-    bias[column] = loader._BIAS_LIMIT[column] + excess
-    unit = loader._BIAS_UNITS[column]
+    bias[column] = loader.params._BIAS_LIMIT[column] + excess
+    unit = loader.params._BIAS_UNITS[column]
     with pytest.raises(ParamError, match=rf"^plant\.encoder_bias\[{column}\] = .* {unit} is outside"):
         SPEC.resolve_plant({"encoder_bias": bias})
 

@@ -61,7 +61,7 @@ def _fraction(draw, low, high, inner=1.0):
 @st.composite
 def loader_params(draw):
     k = draw(st.integers(2, 5))
-    rows = [tuple(_fraction(draw, lo, hi, 0.4) for lo, hi in zip(loader._KEY_LOW, loader._KEY_HIGH))
+    rows = [tuple(_fraction(draw, lo, hi, 0.4) for lo, hi in zip(loader.params._KEY_LOW, loader.params._KEY_HIGH))
             for _ in range(k)]
     return loader.LoaderParams(key_points=tuple(rows), key_interval=draw(st.floats(0.4, 2.0)),
                                settle=draw(st.floats(0.0, 1.0)), payload_mass=draw(st.floats(0.0, 90.0)),
@@ -71,7 +71,7 @@ def loader_params(draw):
 @st.composite
 def hexapod_params(draw):
     def pose():
-        return tuple(_fraction(draw, lo, hi, 0.25) for lo, hi in zip(hexapod._POSE_LOW, hexapod._POSE_HIGH))
+        return tuple(_fraction(draw, lo, hi, 0.25) for lo, hi in zip(hexapod.params._POSE_LOW, hexapod.params._POSE_HIGH))
     start = pose()
     moves = tuple(hexapod.HexapodMove(pose(), draw(st.booleans())) for _ in range(draw(st.integers(1, 3))))
     try:  # a move of zero length (no strut length changes) is refused; the rest must build

@@ -26,10 +26,10 @@ from __future__ import annotations
 from planbench.planners.hexapod import STRUT_LABELS
 from planbench.hexapod.controller import INTEGRAL_TIME_S, HexapodController
 from planbench.hexapod.params import (ASYNC_TARGET_MM_DEG, CONTROL_DT, DEFAULT_WIND_M_S, SETTLE_S, SYNC_TARGET_MM_DEG,
-                                 _POSE_HIGH, _POSE_LOW, _POSE_REASON, _POSE_UNITS, HexapodMove, HexapodParams,
-                                 HexapodPlant, _check_pose, pose_mm_deg, pose_si)
+                                 HexapodMove, HexapodParams,
+                                 HexapodPlant, pose_mm_deg, pose_si)
 from planbench.hexapod.physics import (DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, PLATFORM_KEY_QPOS, HexapodPhysics,
-                                  _compiled, _compiled_plant, _radial, _spec, apply_plant, check_elevation,
+                                  apply_plant, check_elevation,
                                   log_bytes_per_tick, magnified_qpos, top_end_rotation)
 from planbench.hexapod import plan_columns
 from planbench.hexapod.plan_checks import judge_plans
@@ -64,3 +64,60 @@ SCENARIOS = (
 
 
 MECHANISM = Mechanism("hexapod", SCENARIOS, environment_reward, benchmark_runs=5)
+
+__all__ = [
+    "ARRIVAL_SPREAD_LIMIT_S",
+    "ARRIVAL_TOLERANCE",
+    "ARRIVAL_ULPS",
+    "ASYNC_TARGET_MM_DEG",
+    "CAMERA_DRAG_COEFFICIENT",
+    "CONTROL_DT",
+    "DEFAULT_ELEVATION_DEG",
+    "DEFAULT_WIND_M_S",
+    "ELEVATION_RANGE_DEG",
+    "ENCODER_COUNT_M",
+    "ENCODER_SETTLE_M",
+    "FOLLOWING_LIMIT_UM",
+    "HexapodController",
+    "HexapodEvaluation",
+    "HexapodMove",
+    "HexapodParams",
+    "HexapodPhysics",
+    "HexapodPlant",
+    "INTEGRAL_TIME_S",
+    "MECHANISM",
+    "OWN_TIME_LIMIT_S",
+    "PLATFORM_KEY_QPOS",
+    "POSE_FINAL_LIMIT_UM",
+    "SCENARIOS",
+    "SETTLE_S",
+    "SETTLE_WINDOW_S",
+    "STRUT_LABELS",
+    "STRUT_MOVE_THRESHOLD_M",
+    "SYNC_TARGET_MM_DEG",
+    "VIDEO_MAGNIFICATION",
+    "WIND_AZIMUTH_DEG",
+    "apply_plant",
+    "arrival_times",
+    "build",
+    "camera_area",
+    "check_elevation",
+    "default_duration",
+    "end_tick",
+    "environment_reward",
+    "hexapod_speed_check",
+    "horizontal_direction",
+    "judge_plans",
+    "log_bytes_per_tick",
+    "magnified_qpos",
+    "plan",
+    "plan_columns",
+    "plan_moves",
+    "pose_mm_deg",
+    "pose_si",
+    "problems",
+    "sensors",
+    "strut_kinds",
+    "strut_tolerances",
+    "top_end_rotation",
+]

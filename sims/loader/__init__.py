@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from planbench.planners import loader as loader_planner
 from planbench.loader.controller import reference_controller
-from planbench.loader.params import (_BIAS_LIMIT, _BIAS_UNITS, _KEY_HIGH, _KEY_LOW, CONTROL_DT, SETTLE_S, LoaderParams,
+from planbench.loader.params import (CONTROL_DT, SETTLE_S, LoaderParams,
                                 LoaderPlant, log_bytes_per_tick)
 from planbench.loader.physics import (ARM_BODIES, OBSTACLE_CONTYPE, ROBOT_CONTYPE, LoaderPhysics, apply_plant,
                                  joint_kinds, plant_chain, shell_mass)
@@ -51,3 +51,31 @@ SCENARIOS = (
 
 
 MECHANISM = Mechanism("loader", SCENARIOS, environment_reward, benchmark_runs=5)
+
+__all__ = [
+    "ARM_BODIES",
+    "CONTROL_DT",
+    "KEYPOINT_LIMIT_DEG",
+    "LoaderEvaluation",
+    "LoaderParams",
+    "LoaderPhysics",
+    "LoaderPlant",
+    "MECHANISM",
+    "OBSTACLE_CONTYPE",
+    "ROBOT_CONTYPE",
+    "SCENARIOS",
+    "SETTLE_S",
+    "TRACKING_LIMIT_DEG",
+    "apply_plant",
+    "build",
+    "environment_reward",
+    "joint_kinds",
+    "judge_plans",
+    "loader_planner",
+    "log_bytes_per_tick",
+    "plan",
+    "plant_chain",
+    "problem",
+    "reference_controller",
+    "shell_mass",
+]
