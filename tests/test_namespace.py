@@ -10,6 +10,7 @@ line; the public API is what ``planbench.__all__`` names.
 from __future__ import annotations
 
 import importlib.metadata
+import json
 import os
 import shutil
 import subprocess
@@ -94,7 +95,8 @@ def test_users_packages_called_models_sims_and_planners_do_not_disturb_a_run(tmp
     proc = _planbench("run", "loader-supply", "--controller", "mine.py:make", "--out", tmp_path / "out",
                       "--quiet", cwd=tmp_path, path=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    assert "passed" in proc.stdout
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["passed"] and summary["plugins"] == {"controller": "mine.py:make"}
 
 
 def test_planbench_imports_no_old_top_level_name(tmp_path):
