@@ -165,8 +165,8 @@ class JointEncoders(Sensors):
         self._all_counted = bool(self._counted.all())
         self._counts_per_unit = np.divide(1.0, self.resolution, out=np.zeros_like(self.resolution),
                                           where=self._counted)
-        self._copies = []  # (live buffer, index, out) read by __call__ every tick
-        self._counted_run = None  # (live view, out): counted positions read in one pass
+        self._copies: list[tuple] = []  # (live buffer, index, out) read by __call__ every tick
+        self._counted_run: tuple | None = None  # (live view, out): counted positions read in one pass
 
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
         data = physics.data.ptr

@@ -519,3 +519,25 @@ def test_scalar_joint_rates_at_the_exact_singularity():
     np.testing.assert_allclose(rates, expected[0], rtol=0, atol=1e-12)
     with pytest.raises(ant.SingularityError):
         ant.joint_rates_scalar(theta, omega)
+
+
+def test_the_exact_singularity_with_no_damping_allowed_is_a_singularity_error(monkeypatch):
+    """Limits whose max_damping is 0 give the solve nothing to damp with where J W^-1 J^T is
+    exactly singular (the undamped solve raising LinAlgError, as it does at rank 2 in exact
+    arithmetic): both paths raise SingularityError, not a TypeError from the missing solution."""
+    theta = np.array([0.3, 0.0, np.pi / 2, 0.2])
+    omega = np.array([0.05, -0.2, 0.1])
+    limits = ant.AntennaLimits(rate=np.full(4, np.radians(60.0)), max_damping=0.0)
+
+    def singular(solve):
+        def solve_or_raise(*args, **kwargs):
+            if not (args[3:] or kwargs.get("damping")):
+                raise np.linalg.LinAlgError("singular matrix")
+            return solve(*args, **kwargs)
+        return solve_or_raise
+
+    monkeypatch.setattr(ant, "_solve_rates", singular(ant._solve_rates))
+    monkeypatch.setattr(ant, "_solve_floats", singular(ant._solve_floats))
+    for rates in (ant.joint_rates, ant.joint_rates_scalar):
+        with pytest.raises(ant.SingularityError, match="max_damping is 0"):
+            rates(theta, omega, limits=limits)

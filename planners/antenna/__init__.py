@@ -303,6 +303,8 @@ def joint_rates(theta, omega, weights=PAPER_WEIGHTS, limits: AntennaLimits | Non
     damping = _damping(gram, limits)
     if damping:
         rates = _solve_rates(jac, w_inv, omega, damping)[0]
+    elif rates is None:  # singular, and limits whose max_damping is 0 allow no damping
+        raise SingularityError("J W^-1 J^T is singular and the limits' max_damping is 0")
     limited = False
     for _ in range(4):
         ratio = np.abs(rates) / limits.rate
@@ -558,6 +560,8 @@ def _joint_rates_floats(theta, omega, w_inv, limits: AntennaLimits | None, rate_
     damping = _damping_floats(gram, limits)
     if damping:
         rates = _solve_floats(jw, gram, omega, damping)
+    elif rates is None:  # singular, and limits whose max_damping is 0 allow no damping
+        raise SingularityError("J W^-1 J^T is singular and the limits' max_damping is 0")
     limited = False
     l0, l1, l2, l3 = rate_limits
     for _ in range(4):
@@ -647,7 +651,7 @@ def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
             info.iterations = iteration
             if abs(step) * dt < tol:
                 break
-        if limits is not None:
+        if rate_limits is not None:  # (given with the limits)
             l0, l1, l2, l3 = rate_limits
             cap = min(l0 / max(abs(q0), 1e-300), l1 / max(abs(q1), 1e-300), l2 / max(abs(q2), 1e-300),
                       l3 / max(abs(q3), 1e-300))
