@@ -26,7 +26,7 @@ import tomllib
 import types
 import typing
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 from planbench.planners.errors import LimitError
 
@@ -95,7 +95,7 @@ def _format(value) -> str:
         return repr(value)
     if isinstance(value, tuple):
         return "[" + ", ".join(_format(v) for v in value) + "]"
-    if dataclasses.is_dataclass(value):
+    if isinstance(value, Params):
         return "{" + ", ".join(f"{k} = {_format(v)}" for k, v in value.to_dict().items()) + "}"
     return str(value)
 
@@ -138,6 +138,9 @@ class _Type:
 
     def __init__(self, annotation):
         self.optional = False
+        # Set by kind: item for a vector (its element's _Type), cls for a nested table.
+        self.item: Any = None
+        self.cls: Any = None
         args = typing.get_args(annotation)
         origin = typing.get_origin(annotation)
         if origin in (typing.Union, types.UnionType):
@@ -295,7 +298,7 @@ class Params:
         hints = field_types(cls)
         out = []
         for f in dataclasses.fields(cls):
-            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            default = f.default if f.default_factory is dataclasses.MISSING else f.default_factory()
             out.append((f.name, hints[f.name], f.metadata["declared"], default))
         return out
 
@@ -314,7 +317,7 @@ class Params:
 
     #: Parameters that had another name: {old name: its name now} (an old name in a file or
     #: on the command line is refused with the new name).
-    RENAMED = {}  # not annotated: no dataclass field
+    RENAMED: ClassVar[dict[str, str]] = {}  # a ClassVar: no dataclass field
 
     @classmethod
     def from_mapping(cls, mapping: dict, base: "Params | None" = None, prefix: str = "") -> "Params":
@@ -383,7 +386,7 @@ class PlantParams(Params):
 
     #: The fields that are errors of the drive trains as built (friction, stiffness, backlash,
     #: torque constant): the ideal drives have none of those elements.
-    AS_BUILT_FIELDS = ()
+    AS_BUILT_FIELDS: ClassVar[tuple[str, ...]] = ()
 
     @property
     def is_nominal(self) -> bool:
@@ -409,7 +412,9 @@ def field_types(cls) -> dict:
     """{field name: its parsed type} of a Params class (cached on the class)."""
     cache = cls.__dict__.get("_parsed_hints")
     if cache is None:
-        cache = {name: _Type(t) for name, t in typing.get_type_hints(cls).items() if not name.startswith("_")}
+        fields = {f.name for f in dataclasses.fields(cls)}
+        cache = {name: _Type(t) for name, t in typing.get_type_hints(cls).items()
+                 if name in fields and not name.startswith("_")}
         setattr(cls, "_parsed_hints", cache)
     return cache
 
@@ -477,7 +482,7 @@ def set_overrides(cls: type[Params], assignments: list[str], prefix: str = "") -
     """``--set KEY=VALUE`` (repeatable) as a mapping for ``from_mapping`` (``prefix``: how
     the keys were written, for the errors: "plant.")."""
     hints = field_types(cls)
-    out = {}
+    out: dict[str, Any] = {}
     for text in assignments:
         key, sep, value = text.partition("=")
         key = key.strip()
@@ -541,7 +546,7 @@ def readme_tables() -> str:
     (``python -m planbench.params`` prints them; tests/test_scenario_params.py keeps the README equal)."""
     from planbench import scenarios
 
-    by_class = {}
+    by_class: dict[Any, list[str]] = {}  # Params class -> scenario names
     for s in [*scenarios.SCENARIOS.values(), *scenarios.PLANS.values()]:
         by_class.setdefault(type(s.params), []).append(s.name)
     parts = []

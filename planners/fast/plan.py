@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
@@ -71,6 +72,10 @@ class Segment:
     t0: float
     duration: float
     accel_limit: float
+    # The multi-feed angle that FastPlan gives a segment without angles of its own (``angle``):
+    # None until it does.
+    angle_profile: Any = field(default=None, init=False, repr=False)
+    angle_start: float = field(default=0.0, init=False, repr=False)
 
     def evaluate(self, tau):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -90,9 +95,9 @@ class Segment:
 class LineSegment(Segment):
     """A straight line from ``start`` to ``end`` with a speed profile along it."""
 
-    start: np.ndarray = None
-    end: np.ndarray = None
-    profile: prof.Profile = None
+    start: np.ndarray
+    end: np.ndarray
+    profile: prof.Profile
 
     def evaluate(self, tau):
         d = self.end - self.start
@@ -108,9 +113,9 @@ class ArcSegment(Segment):
     """A great-circle arc of the focal sphere from ``start`` toward ``direction`` (unit tangent
     at the start), with a speed profile in arc length (m)."""
 
-    start: np.ndarray = None
-    direction: np.ndarray = None
-    profile: prof.Profile = None
+    start: np.ndarray
+    direction: np.ndarray
+    profile: prof.Profile
     radius: float = R_FOCAL
 
     def evaluate(self, tau):
@@ -132,7 +137,7 @@ class SampledSegment(Segment):
     """A path given by samples (the observation, the transitions): a C2 cubic spline (scipy)
     through feed positions at local times; velocity and acceleration are its derivatives."""
 
-    spline: CubicSpline = None
+    spline: CubicSpline
     angles: CubicSpline | None = None  # the multi-feed angle along an observation
 
     def evaluate(self, tau):
@@ -317,7 +322,7 @@ def observation_segment(times, directions, t0: float = 0.0, name: str = "observa
         angles = check_values(angles, lambda i: f"observation angle[{i[0]}]", "rad")
     points = fast.feed_position(directions)
     spline = CubicSpline(times - times[0], points, axis=0)
-    angle_spline = None
+    angle_spline: CubicSpline | None = None
     if angles is not None:
         angles = np.unwrap(np.asarray(angles, dtype=float))
         # The 19 beams sit on a hexagon: a turn by 60 deg maps the pattern onto itself, so the
@@ -525,7 +530,7 @@ class FastPlan:
                 q, qd = (float(x[0]) for x in segs[k - 1].angle(np.array([segs[k - 1].duration])))
                 seg.angle_profile = _rate_ramp(qd, 0.0, seg.duration)
                 seg.angle_start = q
-        has_angle = lambda seg: isinstance(seg, SampledSegment) or hasattr(seg, "angle_profile")
+        has_angle = lambda seg: isinstance(seg, SampledSegment) or seg.angle_profile is not None
         k = 0
         while k < len(segs):
             if has_angle(segs[k]):
@@ -692,7 +697,7 @@ def _rate_ramp(v0: float, v1: float, duration: float) -> prof.Profile:
     if duration <= 0 or v0 == v1:
         return prof.cruise(v0, max(duration, 0.0))
     peak = 2.0 * (v1 - v0) / duration
-    return prof.Profile([duration / 2, duration / 2], [0.0, peak, 0.0], 0.0, v0)
+    return prof.Profile(np.array([duration / 2, duration / 2]), np.array([0.0, peak, 0.0]), 0.0, v0)
 
 
 class _Window:

@@ -66,6 +66,7 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import linalg
 
 from planbench.planners.errors import LimitError, PlanningError
@@ -147,12 +148,12 @@ class CubicBSplineTrajectory:
 
     def __init__(
         self,
-        times: Sequence[float],
-        key_points: np.ndarray,
+        times: ArrayLike,
+        key_points: ArrayLike,
         labels: Sequence[str] | None = None,
-        lower: Sequence[float] | None = None,
-        upper: Sequence[float] | None = None,
-        margin: float | Sequence[float] = 0.0,
+        lower: ArrayLike | None = None,
+        upper: ArrayLike | None = None,
+        margin: ArrayLike = 0.0,
     ):
         try:
             times = np.asarray(times, dtype=float)
