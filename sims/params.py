@@ -114,7 +114,7 @@ def range_text(declared: Declared, column: int | None = None) -> str:
     if isinstance(declared.low, tuple) and column is None:
         units = declared.unit if isinstance(declared.unit, tuple) else (declared.unit,) * len(declared.low)
         return "per column " + ", ".join(
-            f"[{_g(lo)}, {_g(hi)}]" + (f" {u}" if u else "") for lo, hi, u in zip(declared.low, declared.high, units))
+            f"[{_g(lo)}, {_g(hi)}]" + (f" {u}" if u else "") for lo, hi, u in zip(declared.low, declared.high, units, strict=True))
     if low is None and high is None:
         return ""
     unit = f" {unit_of(declared, column)}" if unit_of(declared, column) else ""

@@ -141,7 +141,7 @@ def test_dish_orientation_in_the_deck_frame_equals_f(model, seed):
     np.testing.assert_allclose(r_deck.T @ r_dish, f(theta), atol=1e-12)
     # The dish_quat sensor (world frame) is the same rotation.
     np.testing.assert_allclose(quat_to_mat(data.sensor("dish_quat").data), world_from_deck(*deck[1:]) @ f(theta), atol=1e-9)
-    for name, value in zip(ANTENNA_JOINTS, theta):
+    for name, value in zip(ANTENNA_JOINTS, theta, strict=True):
         assert data.sensor(f"{name}_pos").data[0] == pytest.approx(value, abs=1e-12)
 
 
@@ -429,7 +429,7 @@ def test_antenna_spec_matches_the_compiled_model(model):
     spec = models.antenna_spec()
     assert spec.names == list(ANTENNA_JOINTS) and spec.frame == "deck"
     np.testing.assert_allclose(spec.base_pos, [0, 0, MAST_TOP])
-    for i, joint in enumerate(spec.joints):
+    for _i, joint in enumerate(spec.joints):
         jid = model.joint(joint.name).id
         aid = model.actuator(joint.name).id
         np.testing.assert_allclose(joint.axis, model.jnt_axis[jid], atol=1e-12)

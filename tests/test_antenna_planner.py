@@ -178,7 +178,8 @@ def test_crr_increment_keeps_the_rk4_rotation_ratio():
     theta0 = np.radians(ant.PAPER_THETA0_DEG)
     new, info = ant.crr_step(theta0, attitudes[0], attitudes[1], ant.PAPER_DT)
     omega = ant.angular_velocity_eq6(attitudes[0], attitudes[1], ant.PAPER_DT)
-    rate = lambda th: ant.joint_rates(th, omega)[0]
+    def rate(th):
+        return ant.joint_rates(th, omega)[0]
     dt = ant.PAPER_DT
     k1 = rate(theta0)
     k2 = rate(theta0 + dt / 2 * k1)
@@ -305,8 +306,9 @@ def _spherical_formulas(lat, lon, sat):
 def test_look_angles_on_a_sphere_equal_the_spherical_formulas(lat, lon, sat, monkeypatch):
     import erfa
 
-    sphere = lambda n, lon_, lat_, h: 6378137.0 * np.array(
-        [np.cos(lat_) * np.cos(lon_), np.cos(lat_) * np.sin(lon_), np.sin(lat_)])
+    def sphere(n, lon_, lat_, h):
+        return 6378137.0 * np.array(
+            [np.cos(lat_) * np.cos(lon_), np.cos(lat_) * np.sin(lon_), np.sin(lat_)])
     monkeypatch.setattr(erfa, "gd2gc", sphere)
     az, el, pol = look_angles(sat * DEG, lat * DEG, lon * DEG)
     az_s, el_s, skew = _spherical_formulas(lat, lon, sat)
@@ -438,7 +440,6 @@ def test_scalar_joint_rates_equal_joint_rates(theta, omega, weights, limits):
     """Eq. (7)/(9) with the safeguards (damping, rate-aware weights, scaling) in floats:
     the rates to round-off (relative to the system's condition) and the same flags."""
     jac = ant.jacobian(theta)
-    gram = (jac / weights) @ jac.T
     if limits is None and ant.weighted_singular_value(jac, weights) < 1e-3:
         return  # undamped near the singular set the solution itself is ill-conditioned
     try:
@@ -501,7 +502,7 @@ def test_scalar_crr_follows_the_paper_path(omega_method, limited):
                                  limits if limits is not None else ant.AntennaLimits(), update_dt=ant.PAPER_DT)
     planner.reset(problem)
     planner.attitude = attitudes[0]
-    online = np.array([planner.step(ti, n) for ti, n in zip(t[1:], attitudes[1:])])
+    online = np.array([planner.step(ti, n) for ti, n in zip(t[1:], attitudes[1:], strict=True)])
     reference = ant.solve_joint_path(attitudes, ant.PAPER_DT, theta0, "crr", limits=problem.limits,
                                      omega_method=omega_method)
     np.testing.assert_allclose(online, reference.theta[1:], rtol=0, atol=1e-12)

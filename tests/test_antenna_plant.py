@@ -28,7 +28,7 @@ QUIET = dict(imu={"attitude_noise_deg": 0.0, "gyro_noise_deg_s": 0.0}, drives="i
 #: Every field off nominal at once, inside its range.
 EVERYTHING = dict(mass_error=0.1, imbalance_offset=(4.0, -3.0, 2.0), joint_friction=1.0, torque_limit_scale=0.8,
                   imu_bias=(0.05, -0.02, 0.1))
-JOINT_IDS = dict(zip(antenna.JOINTS, range(4, 8)))  # the antenna's dofs and actuators follow the deck's four
+JOINT_IDS = dict(zip(antenna.JOINTS, range(4, 8), strict=True))  # the antenna's dofs and actuators follow the deck's four
 
 
 def plant_model(**fields) -> mujoco.MjModel:

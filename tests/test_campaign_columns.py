@@ -46,7 +46,7 @@ def test_run_seeds_are_numpys_seed_sequence():
         samples, replicates = rng.integers(0, 10**7, 200), rng.integers(0, 100_000, 200)
         samples[:2], replicates[:2] = (0, 2**32 - 1), (0, 99_999)
         got = run_seeds(seed, samples, replicates)
-        for s, r, value in zip(samples, replicates, got):
+        for s, r, value in zip(samples, replicates, got, strict=True):
             state = np.random.SeedSequence(seed, spawn_key=(2, int(s), int(r))).generate_state(2, np.uint32)
             assert int(value) == (int(state[0]) << 31 ^ int(state[1])) & (2**63 - 1)
 
@@ -113,7 +113,7 @@ def test_columns_are_iter_runs(tmp_path):
         assert (columns["run"][run.index], columns["point"][run.index], columns["sample"][run.index],
                 columns["replicate"][run.index], columns["seed"][run.index]) == \
             (run.index, run.point, run.sample, run.replicate, run.seed)
-        for axis, value in zip(spec.axes, run.values):
+        for axis, value in zip(spec.axes, run.values, strict=True):
             assert columns[axis.column][run.index] == value and type(columns[axis.column][run.index].item()) \
                 is type(value)
 

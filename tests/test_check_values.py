@@ -266,7 +266,7 @@ def test_loader_keypoint_error(loader):
     names, hinge = _loader_joints(w)
     q = w.qpos_of(names)
     errors = []
-    for t_key, point in zip(w.plan.key_times, w.plan.key_points):
+    for t_key, point in zip(w.plan.key_times, w.plan.key_points, strict=True):
         assert t_key <= w.t[-1] + 1e-9  # every key point is reached in these whole runs
         i = int(np.argmin(np.abs(w.t - t_key)))
         assert abs(w.t[i] - t_key) < 1e-9  # key times are control ticks
@@ -700,7 +700,8 @@ def _catenary_tension(chord, l0, span):
     (Irvine; models/fast/README.md), by bisection then Newton to convergence."""
     ea, weight = fast_physics.CABLE_EA, fast_physics.CABLE_WEIGHT
     a = (weight * span) ** 2 * l0 / 24.0
-    f = lambda t: l0 * (1.0 + t / ea) - a / t**2 - chord
+    def f(t):
+        return l0 * (1.0 + t / ea) - a / t**2 - chord
     lo, hi = np.full_like(chord, 1e3), np.full_like(chord, 1e7)
     assert (f(lo) < 0).all() and (f(hi) > 0).all()
     for _ in range(60):
@@ -911,7 +912,8 @@ def test_planner_and_controller_solve_with_the_paper_weights():
                                rtol=1e-10, atol=1e-14)
 
     def rk4_direction(weights):
-        rate = lambda th: _least_norm_rates(ant.jacobian(th), omega, weights)
+        def rate(th):
+            return _least_norm_rates(ant.jacobian(th), omega, weights)
         k1 = rate(theta0)
         k2 = rate(theta0 + dt / 2 * k1)
         k3 = rate(theta0 + dt / 2 * k2)

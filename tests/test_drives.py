@@ -108,7 +108,7 @@ def test_backlash_is_a_dead_band_of_the_transmission():
     b = 1e-4
     model = axis_model(drive(backlash=b))
     data = mujoco.MjData(model)
-    motor, load = model.joint("axis_motor").qposadr[0], model.joint("axis").qposadr[0]
+    load = model.joint("axis").qposadr[0]
     tendon = model.tendon("axis_transmission").id
     np.testing.assert_allclose(model.tendon_lengthspring[tendon], [-b / 2, b / 2])
     for offset, force in ((0.4 * b, 0.0), (-0.4 * b, 0.0), (0.6 * b, -5e7 * 0.1 * b), (-0.6 * b, 5e7 * 0.1 * b)):

@@ -407,7 +407,7 @@ def test_motion_scan_path_in_the_horizon_frame():
     assert path.t[-1] == pytest.approx(scan.duration)
     assert path.on_leg.sum() > 0 and (~path.on_leg).sum() > 0
     inside = np.zeros_like(path.on_leg)
-    for a, b in zip(scan.leg_start, scan.leg_end):
+    for a, b in zip(scan.leg_start, scan.leg_end, strict=True):
         inside |= (path.t >= a) & (path.t <= b)
     np.testing.assert_array_equal(path.on_leg, inside)
     az, el = fs.observed_azel(path.ra, path.dec, (path.jd1, path.jd2))

@@ -138,7 +138,7 @@ def arrival_rows(result):
 
 
 def moves_of(targets, synchronous):
-    return tuple(sh.HexapodMove(tuple(t), s) for t, s in zip(targets, synchronous))
+    return tuple(sh.HexapodMove(tuple(t), s) for t, s in zip(targets, synchronous, strict=True))
 
 
 #: Four moves of 0.1 ... 0.3 mm and 0.01 deg, two of each mode (each ~1.5 s).

@@ -242,7 +242,8 @@ def test_a_camera_com_offset_adds_its_moment(nominal_hold):
 def test_a_softer_drive_deflects_more_under_the_same_load(nominal_hold):
     nominal, _ = nominal_hold
     result, setup = run(dict(drive_stiffness_error=-0.3), **HOLD)
-    deflection = lambda r: r.log.act[-1, :6] - r.log.qpos[-1, setup.physics.drive_qpos]
+    def deflection(r):
+        return r.log.act[-1, :6] - r.log.qpos[-1, setup.physics.drive_qpos]
     # The same static force through 0.7 kp: the servo's deflection (set-point - the position
     # its loop reads, the motor's) / 0.7.
     np.testing.assert_allclose(deflection(result), deflection(nominal) / 0.7, rtol=2e-3)

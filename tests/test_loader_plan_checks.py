@@ -78,7 +78,7 @@ def test_fast_path_equals_sampling_every_tick():
     rng = np.random.default_rng(5)
     sets = list(random_key_points(6, rng, spread_deg=3.0)) + list(random_key_points(4, rng))
     runs = params_of(sets[:7]) + params_of(sets[7:], key_interval=0.7)
-    for params, checks in zip(runs, judge_plans(runs)):
+    for params, checks in zip(runs, judge_plans(runs), strict=True):
         task = problem(params)
         fast, ticks = by_name(checks), by_name(judge_trajectory(task, unlimited_spline(task)))
         assert fast["plan_keypoint_error"].value == ticks["plan_keypoint_error"].value
@@ -110,7 +110,7 @@ def test_batch_equals_one_at_a_time_bit_for_bit():
     runs = (params_of(random_key_points(8, rng, spread_deg=3.0)) + params_of(random_key_points(4, rng))
             + params_of(random_key_points(3, rng, keys=4, spread_deg=2.0), key_interval=0.6))
     rng.shuffle(runs)
-    for params, checks in zip(runs, judge_plans(runs)):
+    for params, checks in zip(runs, judge_plans(runs), strict=True):
         [alone] = judge_plans([params])
         assert [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in checks] == \
             [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in alone]
@@ -180,7 +180,7 @@ def test_key_points_whose_spline_leaves_the_joint_range_fail_with_the_planners_r
 def key_point_sets(draw):
     """2 to 5 key points inside the joint ranges (Table 1's units), a key interval."""
     n = draw(st.integers(2, 5))
-    points = [[draw(st.floats(float(lo), float(hi), allow_nan=False)) for lo, hi in zip(LOW, HIGH)]
+    points = [[draw(st.floats(float(lo), float(hi), allow_nan=False)) for lo, hi in zip(LOW, HIGH, strict=True)]
               for _ in range(n)]
     return points, draw(st.sampled_from([0.3, 0.5, 1.0]))
 
@@ -286,7 +286,7 @@ def test_a_key_point_beyond_the_tolerance_is_refused_and_fails_joint_range():
     assert spec.lower[0] == 0.0
 
 
-LIMITS = list(zip(LOW, HIGH))
+LIMITS = list(zip(LOW, HIGH, strict=True))
 
 
 @st.composite

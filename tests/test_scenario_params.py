@@ -61,7 +61,7 @@ def _fraction(draw, low, high, inner=1.0):
 @st.composite
 def loader_params(draw):
     k = draw(st.integers(2, 5))
-    rows = [tuple(_fraction(draw, lo, hi, 0.4) for lo, hi in zip(loader.params._KEY_LOW, loader.params._KEY_HIGH))
+    rows = [tuple(_fraction(draw, lo, hi, 0.4) for lo, hi in zip(loader.params._KEY_LOW, loader.params._KEY_HIGH, strict=True))
             for _ in range(k)]
     return loader.LoaderParams(key_points=tuple(rows), key_interval=draw(st.floats(0.4, 2.0)),
                                settle=draw(st.floats(0.0, 1.0)), payload_mass=draw(st.floats(0.0, 90.0)),
@@ -71,7 +71,7 @@ def loader_params(draw):
 @st.composite
 def hexapod_params(draw):
     def pose():
-        return tuple(_fraction(draw, lo, hi, 0.25) for lo, hi in zip(hexapod.params._POSE_LOW, hexapod.params._POSE_HIGH))
+        return tuple(_fraction(draw, lo, hi, 0.25) for lo, hi in zip(hexapod.params._POSE_LOW, hexapod.params._POSE_HIGH, strict=True))
     start = pose()
     moves = tuple(hexapod.HexapodMove(pose(), draw(st.booleans())) for _ in range(draw(st.integers(1, 3))))
     try:  # a move of zero length (no strut length changes) is refused; the rest must build
@@ -195,7 +195,7 @@ def test_every_single_out_of_range_field_is_refused_with_its_name(cls):
     plant = cls in _plant_classes()
     base = scenario.plant if plant else scenario.params
     checked = 0
-    for name, kind, declared, default in cls.declarations():
+    for name, kind, declared, _default in cls.declarations():
         if declared.low is None and declared.high is None and declared.choices is None:
             continue
         if kind.kind in ("int", "float"):
@@ -261,7 +261,7 @@ def test_the_help_of_a_scenario_names_its_parameters_and_no_others(capsys, name)
     mine = set(cls.names())
     for other_name in {n for c in _classes() for n in c.names()} - mine:
         assert f"--{other_name.replace('_', '-')} " not in text and f"  {other_name}:" not in text, other_name
-    for key, kind, declared, default in cls.declarations():
+    for key, kind, declared, _default in cls.declarations():
         line = f"--{key.replace('_', '-')} " if kind.scalar else f"  {key}:"
         assert line in text, key
         assert declared.help.split(";")[0][:40] in " ".join(text.split()), key

@@ -161,7 +161,8 @@ def test_paper_motion_derivatives_match_finite_differences(motion):
                                            (9.0, 14.0, 7.0), (0.3, 3.0, 1.5)])
 def test_jonswap_variance_is_hs2_over_16_and_peak_at_omega_p(hs, tp, gamma):
     wp = 2 * np.pi / tp
-    f = lambda w: float(jonswap_spectrum(w, hs, tp, gamma))
+    def f(w):
+        return float(jonswap_spectrum(w, hs, tp, gamma))
     m0 = sum(integrate.quad(f, a * wp, b * wp, epsrel=1e-11, limit=200)[0]
              for a, b in ((0.2, 1.0), (1.0, 4.0), (4.0, np.inf)))
     assert m0 == pytest.approx(hs**2 / 16, rel=1e-8)
@@ -286,7 +287,7 @@ def test_raos_are_finite_with_speed_and_short_waves_are_filtered():
 def test_same_seed_same_motion_different_seed_different():
     t = np.linspace(0.0, 300.0, 3001)
     a, b, c = _sea(7).sample(t), _sea(7).sample(t), _sea(8).sample(t)
-    for x, y, z in zip(a.joint_arrays(), b.joint_arrays(), c.joint_arrays()):
+    for x, y, z in zip(a.joint_arrays(), b.joint_arrays(), c.joint_arrays(), strict=True):
         np.testing.assert_array_equal(x, y)
         assert np.abs(x - z).max() > 0.1 * np.abs(x).max()
     np.testing.assert_array_equal(_sea(7).wave_elevation(t), _sea(7).wave_elevation(t))
@@ -325,16 +326,16 @@ def test_sea_state_scalar_and_blocked_samples_agree():
     uneven[7] += 1e-3  # no longer a uniform grid: the direct sum of cosines
     direct = m.sample(uneven)
     keep = np.arange(t.size) != 7
-    for x, y in zip(whole.joint_arrays(), direct.joint_arrays()):
+    for x, y in zip(whole.joint_arrays(), direct.joint_arrays(), strict=True):
         np.testing.assert_allclose(x[keep], y[keep], rtol=0, atol=1e-12 * np.abs(x).max())
     np.testing.assert_allclose(m.wave_elevation(t)[keep], m.wave_elevation(uneven)[keep],
                                rtol=0, atol=1e-12)
-    for x, y in zip(direct.joint_arrays(), m.sample(uneven[7]).joint_arrays()):
+    for x, y in zip(direct.joint_arrays(), m.sample(uneven[7]).joint_arrays(), strict=True):
         np.testing.assert_allclose(x[7], y[0], rtol=1e-12, atol=1e-12)
     for i in (0, 4567, 12000):
         one = m.sample(float(t[i]))
         assert len(one) == 1
-        for x, y in zip(one.joint_arrays(), whole.joint_arrays()):
+        for x, y in zip(one.joint_arrays(), whole.joint_arrays(), strict=True):
             np.testing.assert_allclose(x[0], y[i], rtol=1e-12, atol=1e-12)
 
 

@@ -673,7 +673,7 @@ def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
             new = (new[0] + delta[0], new[1] + delta[1], new[2] + delta[2], new[3] + delta[3])
             info.iterations += 1
     f = _fk_floats(*new)
-    info.error_fro = math.sqrt(sum((a - b) * (a - b) for a, b in zip(f, target)))
+    info.error_fro = math.sqrt(sum((a - b) * (a - b) for a, b in zip(f, target, strict=True)))
     return np.array(new), info
 
 
@@ -773,7 +773,7 @@ def check_rates(rates, limits: AntennaLimits, where: str = "") -> None:
     """Raise LimitError naming the joint whose rate (rad/s, (n, 4)) breaks its limit."""
     rates = np.atleast_2d(rates)
     peak = np.abs(rates).max(axis=0)
-    for name, value, limit in zip(JOINT_LABELS, peak, limits.rate):
+    for name, value, limit in zip(JOINT_LABELS, peak, limits.rate, strict=True):
         if value > limit:
             raise LimitError(f"{name} rate {np.degrees(value):.2f} deg/s is beyond its limit "
                              f"{np.degrees(limit):.2f} deg/s{where}")

@@ -17,6 +17,7 @@ are the controller's).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -530,7 +531,8 @@ class FastPlan:
                 q, qd = (float(x[0]) for x in segs[k - 1].angle(np.array([segs[k - 1].duration])))
                 seg.angle_profile = _rate_ramp(qd, 0.0, seg.duration)
                 seg.angle_start = q
-        has_angle = lambda seg: isinstance(seg, SampledSegment) or seg.angle_profile is not None
+        def has_angle(seg):
+            return isinstance(seg, SampledSegment) or seg.angle_profile is not None
         k = 0
         while k < len(segs):
             if has_angle(segs[k]):
@@ -667,7 +669,7 @@ def _transition_peaks(scan, start, step: float, dut1: float = 0.0) -> list[float
         mask = (path.t >= scan.leg_start[k] - 1e-9) & (path.t <= scan.leg_end[k] + 1e-9)
         legs.append(observation_segment(path.t[mask], directions[mask]))
     peaks = []
-    for a, b in zip(legs, legs[1:]):
+    for a, b in itertools.pairwise(legs):
         p0, v0, _ = (x[0] for x in a.evaluate(np.array([a.duration])))
         p1, v1, _ = (x[0] for x in b.evaluate(np.array([0.0])))
         peaks.append(hermite_peak_acceleration(p0, v0, p1, v1, scan.t2))
@@ -679,7 +681,8 @@ def minimum_t2(make_scan, start, step: float = 1.0, a_limit: float = fast.A_T_MA
     """The shortest t2 (to ``tolerance`` s) whose transitions all keep |a| <= A_t-max: the
     geometric t2. ``make_scan(t2)`` builds the MotionScan; the sky turns during t2, so the
     legs' end states depend on it and every trial rebuilds the raster (bisection)."""
-    feasible = lambda t2: max(_transition_peaks(make_scan(t2), start, step, dut1), default=0.0) <= a_limit
+    def feasible(t2):
+        return max(_transition_peaks(make_scan(t2), start, step, dut1), default=0.0) <= a_limit
     lo, hi = 0.0, 1.0
     while not feasible(hi):
         lo, hi = hi, 2.0 * hi

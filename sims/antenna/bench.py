@@ -30,8 +30,8 @@ def antenna_update_rate(duration: float = 60.0) -> list[dict]:
                                        ("crr, safeguards on", "crr", limits, False),
                                        ("crr, floats", "crr", None, True),
                                        ("crr, safeguards on, floats", "crr", limits, True)):
-        best, path = best_time(lambda: antenna.solve_joint_path(attitudes, antenna.PAPER_DT, theta0, method,
-                                                                 limits=lim, scalar=scalar))
+        best, path = best_time(lambda method=method, lim=lim, scalar=scalar: antenna.solve_joint_path(
+            attitudes, antenna.PAPER_DT, theta0, method, limits=lim, scalar=scalar))
         updates = t.size - 1
         rows.append({"method": label, "updates": updates, "wall_s": best,
                      "updates_per_s": updates / best, "error_fro_max": float(path.error_fro.max())})

@@ -353,7 +353,8 @@ def jonswap_normalization(gamma: float) -> float:
     gamma = float(gamma)
     if not math.isfinite(gamma) or gamma < 1.0:
         raise ShipMotionError(f"JONSWAP peak enhancement gamma = {gamma!r} must be >= 1")
-    f = lambda u: float(_jonswap_shape(u, gamma))
+    def f(u):
+        return float(_jonswap_shape(u, gamma))
     # Split at the peak (sigma changes there); below 0.3 the shape is < 1e-50.
     total = sum(integrate.quad(f, a, b, epsabs=0.0, epsrel=1e-12, limit=200)[0]
                 for a, b in ((0.3, 1.0), (1.0, 3.0), (3.0, np.inf)))

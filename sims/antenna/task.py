@@ -161,7 +161,7 @@ class AntennaEvaluation:
         records = self.planner.records()
         # One matrix at a time: the same arithmetic as the planner's own residual, to the bit.
         records["error_fro"] = np.array([float(ant.frobenius_error(ant.forward_kinematics(theta), n))
-                                         for theta, n in zip(records["theta"], records["attitude"])])
+                                         for theta, n in zip(records["theta"], records["attitude"], strict=True)])
         return records
 
     def errors_deg(self, log: RunLog):
@@ -212,9 +212,9 @@ class AntennaEvaluation:
             "pointing_error_rms_deg": float(np.sqrt(np.mean(pointing**2))),
             "pointing_error_p99_deg": float(np.percentile(pointing, 99)),
             "polarization_error_rms_deg": float(np.sqrt(np.mean(polarization**2))),
-            "peak_joint_rate_deg_s": dict(zip(JOINTS, np.degrees(np.abs(qd).max(0)).round(3).tolist())),
-            "commanded_rate_of_limit": dict(zip(JOINTS, ctrl_ratio.round(4).tolist())),
-            "peak_torque_N_m": dict(zip(JOINTS, np.abs(torque).max(0).round(3).tolist())),
+            "peak_joint_rate_deg_s": dict(zip(JOINTS, np.degrees(np.abs(qd).max(0)).round(3).tolist(), strict=True)),
+            "commanded_rate_of_limit": dict(zip(JOINTS, ctrl_ratio.round(4).tolist(), strict=True)),
+            "peak_torque_N_m": dict(zip(JOINTS, np.abs(torque).max(0).round(3).tolist(), strict=True)),
             "joint_range_deg": {n: [float(np.degrees(q[:, j].min()).round(3)), float(np.degrees(q[:, j].max()).round(3))]
                                 for j, n in enumerate(JOINTS)},
             "planner_updates": int(updates["t"].size),

@@ -357,7 +357,7 @@ class CampaignSpec:
                     out[axis.column] = np.asarray(column, dtype=dtype)[where]
                 else:
                     out[axis.column] = [column[i] for i in where]
-        for axis, drawn in zip(self.random, draws):
+        for axis, drawn in zip(self.random, draws, strict=True):
             out[axis.column] = np.asarray(drawn, dtype=np.float64)[sample]
         return out
 
@@ -366,7 +366,7 @@ class CampaignSpec:
         change, with the run's seed, as mappings for ``from_mapping`` on the base."""
         params, plant = {"seed": run.seed}, {}
         base = {False: None, True: None}
-        for axis, value in zip(self.axes, run.values):
+        for axis, value in zip(self.axes, run.values, strict=True):
             target = plant if axis.plant else params
             top = axis.path[0]
             if len(axis.path) == 1:
@@ -390,7 +390,7 @@ class CampaignSpec:
             raise ParamError(f"run {run.index} ({self.describe(run)}): {e}") from None
 
     def describe(self, run: Run) -> str:
-        return ", ".join(f"{a.column} = {_show(v)}" for a, v in zip(self.axes, run.values)) + f", seed {run.seed}"
+        return ", ".join(f"{a.column} = {_show(v)}" for a, v in zip(self.axes, run.values, strict=True)) + f", seed {run.seed}"
 
 
 def _show(value) -> str:

@@ -252,7 +252,7 @@ def discretized_spec(segments: int, spec: mujoco.MjSpec | None = None, ea: float
         for k in range(1, segments):
             node = spec.worldbody.add_body(name=f"cable{i}_node{k}", pos=top + (anchor - top) * k / segments,
                                            gravcomp=node_gravcomp(segments))
-            for axis, label in zip(np.eye(3), "xyz"):
+            for axis, label in zip(np.eye(3), "xyz", strict=True):
                 node.add_joint(name=f"cable{i}_node{k}_{label}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=axis,
                                damping=2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)
             node.add_geom(name=f"cable{i}_node{k}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.3, 0, 0],

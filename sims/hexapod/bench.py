@@ -23,8 +23,8 @@ def planning_throughput(n_moves: int = PLANNING_MOVES, seed: int = 0) -> list[di
     rows = []
     for synchronous in (True, False):
         for method in ("closed", "iteration"):
-            best, moves = best_time(lambda: hexapod.plan_moves(start, target, synchronous=synchronous,
-                                                                method=method))
+            best, moves = best_time(lambda synchronous=synchronous, method=method: hexapod.plan_moves(
+                start, target, synchronous=synchronous, method=method))
             rows.append({"mode": "sync" if synchronous else "async", "method": method,
                          "moves": len(moves), "wall_s": best, "moves_per_s": len(moves) / best})
     return rows

@@ -73,7 +73,7 @@ def hexapod_speed_check(peaks, what: str) -> Check:
     names = hexapod_planner.HEXAPOD_SPEED_LABELS
     return Check("hexapod_speed", float(peaks[worst]), 1.0, "ratio",
                  note=f"{what} pose speed over the hexapod-space limit, peak of each: "
-                      + ", ".join(f"{n} {v:.3f}" for n, v in zip(names, peaks)) + f" (worst {names[worst]})")
+                      + ", ".join(f"{n} {v:.3f}" for n, v in zip(names, peaks, strict=True)) + f" (worst {names[worst]})")
 
 
 def strut_tolerances(start, target) -> tuple[np.ndarray, np.ndarray]:
@@ -302,13 +302,13 @@ class HexapodEvaluation:
         metrics = {
             "elevation_deg": p.elevation_deg,
             "move_duration_s": move_end,
-            "arrival_times_s": dict(zip(STRUT_LABELS, [None if np.isnan(a) else a for a in arrivals.round(4).tolist()])),
+            "arrival_times_s": dict(zip(STRUT_LABELS, [None if np.isnan(a) else a for a in arrivals.round(4).tolist()], strict=True)),
             "arrival_spread_s": last["spread"],
             "final_translation_error_um": (1e6 * pose_diff[:3]).round(4).tolist(),
             "final_rotation_error_urad": (1e6 * pose_diff[3:]).round(4).tolist(),
-            "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist() if during.size else [0.0] * 6)),
-            "peak_drive_force_N": dict(zip(STRUT_LABELS, np.abs(demanded).max(0).round(1).tolist())),
-            "static_drive_force_start_N": dict(zip(STRUT_LABELS, demanded[0].round(1).tolist())),
+            "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist() if during.size else [0.0] * 6, strict=True)),
+            "peak_drive_force_N": dict(zip(STRUT_LABELS, np.abs(demanded).max(0).round(1).tolist(), strict=True)),
+            "static_drive_force_start_N": dict(zip(STRUT_LABELS, demanded[0].round(1).tolist(), strict=True)),
             "encoder_settle_s": last["encoder_settle"],
             "measured_peak_strut_speed_um_s": float(1e6 * np.abs(qd).max()),
             "loop_closure_um": float(1e6 * self.closure_mismatch(log)[window].max()),
@@ -323,7 +323,7 @@ class HexapodEvaluation:
                 "following_error_um": float(j["following"].max()),
                 "pose_error_um": j["pose_error"] if j["ended"] else None,
                 "encoder_settle_s": j["encoder_settle"],
-            } for i, (m, j) in enumerate(zip(self.moves, judged))]
+            } for i, (m, j) in enumerate(zip(self.moves, judged, strict=True))]
         if self.wind is not None and self.wind.speed is not None:
             n = log.t.size
             metrics["wind_mean_m_s"] = self.wind.mean_speed

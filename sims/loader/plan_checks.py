@@ -318,7 +318,7 @@ class _Collision:
         model, data, pairs, fromto = self.model, self.data, self.pairs, self.fromto
         order = np.argsort(bound, kind="stable") if order is None else order
         best, pair = DISTMAX_M, -1
-        for lower, index in zip(bound[order].tolist(), order.tolist()):
+        for lower, index in zip(bound[order].tolist(), order.tolist(), strict=True):
             if lower > best:
                 break
             r, o = pairs[index]
@@ -494,7 +494,7 @@ def _judge_group(tasks: Sequence[LoaderProblem]) -> list[dict]:
     clearances = min_clearances(np.moveaxis(q, 1, 0), travel.T)
     out = []
     labels = first.labels
-    for i, task in enumerate(tasks):
+    for i in range(len(tasks)):
         cols = slice(i * m, (i + 1) * m)
         worst_key = np.unravel_index(int(np.argmax(key_deg[:, i, 1:])), key_deg[:, i, 1:].shape)
         rr, rt = range_ratio[:, cols], rate_ratio[:, cols]
@@ -591,7 +591,7 @@ def judge_plans(params_list: Sequence[LoaderParams], planner=None) -> list[list[
         size = int(min(CHUNK_RUNS, max(1, CHUNK_TICKS // ticks)))
         for lo in range(0, len(members), size):
             chunk = members[lo:lo + size]
-            for i, judged in zip(chunk, _judge_group([tasks[i] for i in chunk])):
+            for i, judged in zip(chunk, _judge_group([tasks[i] for i in chunk]), strict=True):
                 out[i] = _checks(judged, _refusal(tasks[i]) if judged["range"] > 1.0 else "")
     return out
 

@@ -89,7 +89,8 @@ class LoaderEvaluation:
         pairs = obstacle_contact_pairs(log.contacts, robot, obstacles)
         clear, closest = self.clearance(log)
         i_min = int(np.argmin(clear))
-        names = lambda pair: f"{model.geom(int(pair[0])).name}/{model.geom(int(pair[1])).name}"
+        def names(pair):
+            return f"{model.geom(int(pair[0])).name}/{model.geom(int(pair[1])).name}"
         contact_note = ", ".join(
             f"{names(p)} from t = {log.t[v[0]]:.3f} s for {v[1]} ticks, {1e3 * v[2]:.1f} mm deep"
             for p, v in sorted(pairs.items(), key=lambda kv: kv[1][0])
@@ -112,9 +113,9 @@ class LoaderEvaluation:
         metrics = {
             "keypoint_error_slide_mm": float(key_err_slide_mm.max()) if key_err_slide_mm.size else None,
             "tracking_error_slide_mm": float(1e3 * np.abs(err[:, 0]).max()),
-            "tracking_error_deg_per_joint": dict(zip(self.spec.names[1:], err_deg.max(0).round(6).tolist())),
-            "peak_torque_per_joint": dict(zip(self.spec.names, np.abs(tau).max(0).round(3).tolist())),
-            "torque_limit_per_joint": dict(zip(self.spec.names, self.force_limit.tolist())),
+            "tracking_error_deg_per_joint": dict(zip(self.spec.names[1:], err_deg.max(0).round(6).tolist(), strict=True)),
+            "peak_torque_per_joint": dict(zip(self.spec.names, np.abs(tau).max(0).round(3).tolist(), strict=True)),
+            "torque_limit_per_joint": dict(zip(self.spec.names, self.force_limit.tolist(), strict=True)),
             "final_shell_tip_m": self._shell_tip(log)[-1].tolist(),
             "contact_ticks": int(sum(v[1] for v in pairs.values())),
         }
