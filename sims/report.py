@@ -24,7 +24,8 @@ def plan_plot(sample, labels, kinds, path, title: str, key_times=None, key_point
         axes,
         (sample.position, sample.velocity, sample.acceleration),
         ("position", "velocity", "acceleration"),
-    , strict=True):
+        strict=True,
+    ):
         shown = _to_display(data, kinds)
         for j, label in enumerate(labels):
             ax.plot(sample.t, shown[:, j], label=f"{label} [{units[j]}]")
