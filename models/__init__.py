@@ -253,7 +253,11 @@ def _serial_chain(xml_path: Path, root_body: str, frame: str | None = None) -> S
             raise ValueError(f"body {child.get('name')!r} has more than one joint")
         node = child
     return SerialChainSpec(
-        joints=tuple(joints), bodies=tuple(bodies), sites=sites, base_pos=base_pos, base_quat=base_quat,
+        joints=tuple(joints),
+        bodies=tuple(bodies),
+        sites=sites,
+        base_pos=base_pos,
+        base_quat=base_quat,
         frame=frame or "world",
     )
 

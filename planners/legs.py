@@ -23,8 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def leg_vectors(anchors: np.ndarray, points: np.ndarray, position: np.ndarray,
-                rotation: np.ndarray) -> np.ndarray:
+def leg_vectors(anchors: np.ndarray, points: np.ndarray, position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     """Leg vectors from the fixed anchors to the moving points, l_i = p + R b_i - a_i.
 
     Args:
@@ -44,8 +43,9 @@ def leg_vectors(anchors: np.ndarray, points: np.ndarray, position: np.ndarray,
     return position[..., None, :] + moved - anchors
 
 
-def leg_vector_components(anchors: np.ndarray, points: np.ndarray, position: np.ndarray,
-                          rotation: np.ndarray) -> tuple[tuple, tuple]:
+def leg_vector_components(
+    anchors: np.ndarray, points: np.ndarray, position: np.ndarray, rotation: np.ndarray
+) -> tuple[tuple, tuple]:
     """``leg_vectors`` of M poses as components: ((l_x, l_y, l_z), (R b_x, R b_y, R b_z)),
     each (M, n), m.
 
@@ -64,8 +64,11 @@ def leg_vector_components(anchors: np.ndarray, points: np.ndarray, position: np.
     points = np.asarray(points, dtype=float)
     position = np.asarray(position, dtype=float)
     rotation = np.asarray(rotation, dtype=float)
-    arms = tuple((rotation[:, j, 0, None] * points[:, 0] + rotation[:, j, 2, None] * points[:, 2])
-                 + rotation[:, j, 1, None] * points[:, 1] for j in range(3))
+    arms = tuple(
+        (rotation[:, j, 0, None] * points[:, 0] + rotation[:, j, 2, None] * points[:, 2])
+        + rotation[:, j, 1, None] * points[:, 1]
+        for j in range(3)
+    )
     vectors = tuple((position[:, j, None] + arms[j]) - anchors[:, j] for j in range(3))
     return vectors, arms
 

@@ -159,14 +159,12 @@ class Profile:
         dt = np.array(self.durations, dtype=float).reshape(-1)
         accel = np.array(self.accel, dtype=float).reshape(-1)
         if accel.size != dt.size + 1:
-            raise PlanningError(f"a profile of {dt.size} pieces needs {dt.size + 1} "
-                                f"accelerations, got {accel.size}")
+            raise PlanningError(f"a profile of {dt.size} pieces needs {dt.size + 1} accelerations, got {accel.size}")
         check_values(dt, "profile durations", "s")
         check_values(accel, "profile accel", "m/s^2")
         if np.any(dt <= 0):
             i = int(np.argmax(dt <= 0))
-            raise PlanningError(f"profile piece durations must be > 0: durations[{i}] = "
-                                f"{_fmt(dt[i])} s")
+            raise PlanningError(f"profile piece durations must be > 0: durations[{i}] = {_fmt(dt[i])} s")
         p0, v0 = _finite("p0", self.p0, "m"), _finite("v0", self.v0, "m/s")
         a0, a1 = accel[:-1], accel[1:]
         velocities = v0 + np.concatenate(([0.0], np.cumsum(0.5 * (a0 + a1) * dt)))
@@ -175,32 +173,41 @@ class Profile:
         jerk = np.diff(accel) / dt
         breaks = np.concatenate(([0.0], np.cumsum(dt)))
         # Derived values: within the same magnitude, so sampling (t * v ...) stays finite.
-        for name, value, unit in (("break time", breaks, "s"), ("position", positions, "m"),
-                                  ("velocity", velocities, "m/s"), ("jerk", jerk, "m/s^3")):
+        for name, value, unit in (
+            ("break time", breaks, "s"),
+            ("position", positions, "m"),
+            ("velocity", velocities, "m/s"),
+            ("jerk", jerk, "m/s^3"),
+        ):
             check_values(value, lambda i, name=name: f"profile {name} at break {i[0]}", unit)
-        for name, value in (("durations", dt), ("accel", accel), ("breaks", breaks),
-                            ("positions", positions), ("velocities", velocities),
-                            ("jerk", jerk)):
+        for name, value in (
+            ("durations", dt),
+            ("accel", accel),
+            ("breaks", breaks),
+            ("positions", positions),
+            ("velocities", velocities),
+            ("jerk", jerk),
+        ):
             value.setflags(write=False)
             object.__setattr__(self, name, value)
         object.__setattr__(self, "p0", p0)
         object.__setattr__(self, "v0", v0)
 
     @classmethod
-    def from_breaks(cls, breaks, accel, p0: float = 0.0, v0: float = 0.0,
-                    label: str = "s") -> Profile:
+    def from_breaks(cls, breaks, accel, p0: float = 0.0, v0: float = 0.0, label: str = "s") -> Profile:
         """From break times (k+1,) s: breaks[0] == 0, strictly increasing."""
         breaks = np.array(breaks, dtype=float).reshape(-1)
         if breaks.size < 1 or not np.all(np.isfinite(breaks)):
             raise PlanningError(f"profile breaks {breaks} s must be >= 1 finite times")
         if breaks[0] != 0.0:
-            raise PlanningError(f"a profile starts at t = 0 s, got breaks[0] = "
-                                f"{_fmt(breaks[0])} s")
+            raise PlanningError(f"a profile starts at t = 0 s, got breaks[0] = {_fmt(breaks[0])} s")
         dt = np.diff(breaks)
         if np.any(dt <= 0):
             i = int(np.argmax(dt <= 0))
-            raise PlanningError(f"profile breaks must increase strictly: breaks[{i + 1}] = "
-                                f"{_fmt(breaks[i + 1])} s <= breaks[{i}] = {_fmt(breaks[i])} s")
+            raise PlanningError(
+                f"profile breaks must increase strictly: breaks[{i + 1}] = "
+                f"{_fmt(breaks[i + 1])} s <= breaks[{i}] = {_fmt(breaks[i])} s"
+            )
         return cls(dt, accel, p0, v0, label)
 
     # ----------------------------------------------------------------- properties
@@ -245,7 +252,7 @@ class Profile:
     def peak_speed(self) -> float:
         """max |v| over the profile, m/s: at a break or where a piece's acceleration crosses 0."""
         a0, a1 = self.accel[:-1], self.accel[1:]
-        cross = (a0 * a1 < 0)
+        cross = a0 * a1 < 0
         tau = np.where(cross, -a0 / np.where(self.jerk != 0, self.jerk, 1.0), 0.0)
         inner = self.velocities[:-1] + a0 * tau + 0.5 * self.jerk * tau * tau
         return float(max(np.max(np.abs(self.velocities)), np.max(np.abs(inner), initial=0.0)))
@@ -291,15 +298,15 @@ class Profile:
         """
         t = sample_times(t)
         s = self.evaluate(t)
-        return TrajectorySample(t=t, position=s.position[:, None], velocity=s.velocity[:, None],
-                                acceleration=s.acceleration[:, None])
+        return TrajectorySample(
+            t=t, position=s.position[:, None], velocity=s.velocity[:, None], acceleration=s.acceleration[:, None]
+        )
 
     # ----------------------------------------------------------------- composition
 
     def with_start(self, position: float) -> Profile:
         """The same motion started at ``position`` (m)."""
-        return Profile(self.durations, self.accel, _finite("position", position, "m"), self.v0,
-                       self.label)
+        return Profile(self.durations, self.accel, _finite("position", position, "m"), self.v0, self.label)
 
     def then(self, *others: Profile) -> Profile:
         """``concatenate([self, *others])``."""
@@ -327,21 +334,24 @@ def concatenate(profiles: Sequence[Profile], rtol: float = 1e-9) -> Profile:
         v_scale_i = max(v_scale, np.max(np.abs(nxt.velocities)))
         a_scale_i = max(a_scale, np.max(np.abs(nxt.accel)))
         if abs(nxt.v0 - v_end) > rtol * v_scale_i:
-            raise PlanningError(f"profile {i} starts at v0 = {_fmt(nxt.v0)} m/s but the one "
-                                f"before it ends at {_fmt(v_end)} m/s (tolerance "
-                                f"{rtol * v_scale_i:.3g} m/s)")
+            raise PlanningError(
+                f"profile {i} starts at v0 = {_fmt(nxt.v0)} m/s but the one "
+                f"before it ends at {_fmt(v_end)} m/s (tolerance "
+                f"{rtol * v_scale_i:.3g} m/s)"
+            )
         if abs(nxt.a0 - a_end) > rtol * a_scale_i:
-            raise PlanningError(f"profile {i} starts at a0 = {_fmt(nxt.a0)} m/s^2 but the one "
-                                f"before it ends at {_fmt(a_end)} m/s^2 (tolerance "
-                                f"{rtol * a_scale_i:.3g} m/s^2)")
+            raise PlanningError(
+                f"profile {i} starts at a0 = {_fmt(nxt.a0)} m/s^2 but the one "
+                f"before it ends at {_fmt(a_end)} m/s^2 (tolerance "
+                f"{rtol * a_scale_i:.3g} m/s^2)"
+            )
         durations.append(nxt.durations)
         accel.append(nxt.accel[1:])
         v_scale, a_scale = v_scale_i, a_scale_i
         if nxt.durations.size:
             v_end += nxt.end_velocity - nxt.v0
             a_end = nxt.end_acceleration
-    return Profile(np.concatenate(durations), np.concatenate(accel), first.p0, first.v0,
-                   first.label)
+    return Profile(np.concatenate(durations), np.concatenate(accel), first.p0, first.v0, first.label)
 
 
 def cruise(velocity: float, duration: float, start: float = 0.0, label: str = "s") -> Profile:
@@ -371,8 +381,7 @@ def velocity_change(v0: float, v1: float, a_max: float) -> Profile:
     return Profile([half, half], [0.0, np.sign(dv) * a_max, 0.0], 0.0, v0)
 
 
-def min_move_time(distance: float, v_max: float, a_max: float, v0: float = 0.0,
-                  v1: float = 0.0) -> float:
+def min_move_time(distance: float, v_max: float, a_max: float, v0: float = 0.0, v1: float = 0.0) -> float:
     """The minimum time (s) of ``move_min_time`` (same arguments), without building it.
 
     For the paper's eq. (10): the largest of the mechanisms' minimum times sets T_line.
@@ -380,8 +389,7 @@ def min_move_time(distance: float, v_max: float, a_max: float, v0: float = 0.0,
     return _plan_min(distance, v_max, a_max, v0, v1)[-1]
 
 
-def move_min_time(distance: float, v_max: float, a_max: float, v0: float = 0.0,
-                  v1: float = 0.0) -> Profile:
+def move_min_time(distance: float, v_max: float, a_max: float, v0: float = 0.0, v1: float = 0.0) -> Profile:
     """The fastest profile of the family that moves ``distance`` m (signed) from v0 to v1.
 
     Args:
@@ -398,8 +406,9 @@ def move_min_time(distance: float, v_max: float, a_max: float, v0: float = 0.0,
     return _build(s, u0, up, tau, down, a)
 
 
-def move_in_time(distance: float, duration: float, v_max: float, a_max: float, v0: float = 0.0,
-                 v1: float = 0.0) -> Profile:
+def move_in_time(
+    distance: float, duration: float, v_max: float, a_max: float, v0: float = 0.0, v1: float = 0.0
+) -> Profile:
     """A profile of the family that moves ``distance`` m from v0 to v1 in exactly ``duration`` s.
 
     Both pulses at the full peak a_max, the cruise takes the rest of the time, the cruise speed
@@ -410,16 +419,17 @@ def move_in_time(distance: float, duration: float, v_max: float, a_max: float, v
     the family allows covers more than the distance; otherwise as ``move_min_time``.
     """
     T = _duration(duration)
-    s, u0, u1, a, _, up_fast, down_fast, tau_fast, t_min = _plan_min(distance, v_max, a_max,
-                                                                      v0, v1)
+    s, u0, u1, a, _, up_fast, down_fast, tau_fast, t_min = _plan_min(distance, v_max, a_max, v0, v1)
     d = abs(float(distance))
     v_max = float(v_max)
     if T < t_min:
         if T < t_min * (1.0 - _RTOL):
-            raise LimitError(f"duration {_fmt(T)} s is shorter than the minimum time "
-                             f"{_fmt(t_min)} s to move {_fmt(distance)} m from v0 = {_fmt(v0)} "
-                             f"to v1 = {_fmt(v1)} m/s under v_max = {_fmt(v_max)} m/s, "
-                             f"a_max = {_fmt(a_max)} m/s^2")
+            raise LimitError(
+                f"duration {_fmt(T)} s is shorter than the minimum time "
+                f"{_fmt(t_min)} s to move {_fmt(distance)} m from v0 = {_fmt(v0)} "
+                f"to v1 = {_fmt(v1)} m/s under v_max = {_fmt(v_max)} m/s, "
+                f"a_max = {_fmt(a_max)} m/s^2"
+            )
         T_plan = t_min
     else:
         T_plan = T
@@ -434,10 +444,12 @@ def move_in_time(distance: float, duration: float, v_max: float, a_max: float, v
 
     d_low = h(v_bot)
     if d < d_low * (1.0 - _RTOL):
-        raise LimitError(f"duration {_fmt(T)} s is too long to move {_fmt(distance)} m from "
-                         f"v0 = {_fmt(v0)} to v1 = {_fmt(v1)} m/s: slowing down (to "
-                         f"{_fmt(s * v_bot)} m/s at the most, a_max = {_fmt(a_max)} m/s^2) and "
-                         f"back still covers {_fmt(s * d_low)} m, and the profiles never reverse")
+        raise LimitError(
+            f"duration {_fmt(T)} s is too long to move {_fmt(distance)} m from "
+            f"v0 = {_fmt(v0)} to v1 = {_fmt(v1)} m/s: slowing down (to "
+            f"{_fmt(s * v_bot)} m/s at the most, a_max = {_fmt(a_max)} m/s^2) and "
+            f"back still covers {_fmt(s * d_low)} m, and the profiles never reverse"
+        )
     if d >= h(hi):  # cruise above both boundary speeds: 2 v^2 - B v + C = 0, lower root
         B = 2.0 * (u0 + u1) + a * T_plan
         C = u0 * u0 + u1 * u1 + a * d
@@ -505,20 +517,22 @@ def _plan_min(distance, v_max, a_max, v0, v1):
     v1 = _finite("v1", v1, "m/s")
     for name, value in (("v0", v0), ("v1", v1)):
         if abs(value) > v_max:
-            raise LimitError(f"|{name}| = {_fmt(abs(value))} m/s exceeds v_max = "
-                             f"{_fmt(v_max)} m/s")
+            raise LimitError(f"|{name}| = {_fmt(abs(value))} m/s exceeds v_max = {_fmt(v_max)} m/s")
     s = np.sign(dist) or np.sign(v0) or np.sign(v1) or 1.0
     s = float(s)
     for name, value in (("v0", v0), ("v1", v1)):
         if s * value < 0:
-            raise LimitError(f"{name} = {_fmt(value)} m/s points against the distance "
-                             f"{_fmt(dist)} m; the profiles never reverse")
+            raise LimitError(
+                f"{name} = {_fmt(value)} m/s points against the distance {_fmt(dist)} m; the profiles never reverse"
+            )
     d, u0, u1 = abs(dist), s * v0 + 0.0, s * v1 + 0.0
     d_min = abs(u1 * u1 - u0 * u0) / a
     if d < d_min * (1.0 - _RTOL):
-        raise LimitError(f"distance {_fmt(dist)} m is too short to change speed from v0 = "
-                         f"{_fmt(v0)} to v1 = {_fmt(v1)} m/s at a_max = {_fmt(a)} m/s^2 without "
-                         f"reversing: it needs at least {_fmt(s * d_min)} m")
+        raise LimitError(
+            f"distance {_fmt(dist)} m is too short to change speed from v0 = "
+            f"{_fmt(v0)} to v1 = {_fmt(v1)} m/s at a_max = {_fmt(a)} m/s^2 without "
+            f"reversing: it needs at least {_fmt(s * d_min)} m"
+        )
     lo, hi = min(u0, u1), max(u0, u1)
     # v_p^2 - hi^2 = (a d - (hi^2 - lo^2)) / 2 = a (d - d_min) / 2: the peak's excess over the
     # higher boundary speed without the cancellation of sqrt((a d + u0^2 + u1^2) / 2) - hi
@@ -590,8 +604,7 @@ def _build(s, u0, up, tau, down, a, total=None) -> Profile:
         tau -= 2.0 * (h_min - h2)
         h2, peak2 = h_min, abs(down) / h_min
     tau = max(tau, 0.0)  # no cruise to take it from: the move is longer by < 32 eps T
-    pieces = [(h1, np.sign(up) * peak1), (h1, 0.0), (tau, 0.0), (h2, np.sign(down) * peak2),
-              (h2, 0.0)]
+    pieces = [(h1, np.sign(up) * peak1), (h1, 0.0), (tau, 0.0), (h2, np.sign(down) * peak2), (h2, 0.0)]
     pieces = [(dt, acc) for dt, acc in pieces if dt > 0]
     if total is not None and not pieces and total > 0:
         pieces = [(total, 0.0)]  # nothing to change: only wait (safety; tau carries it)

@@ -19,8 +19,9 @@ this and the limit; ``sample_times`` validates the times of every ``Trajectory.s
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Protocol, Sequence, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -46,12 +47,13 @@ class TrajectorySample:
     velocity: np.ndarray
     acceleration: np.ndarray
 
-    def rows(self, start: int, stop: int) -> "TrajectorySample":
+    def rows(self, start: int, stop: int) -> TrajectorySample:
         """The sample at the times ``t[start:stop]``."""
-        return TrajectorySample(self.t[start:stop], self.position[start:stop], self.velocity[start:stop],
-                                self.acceleration[start:stop])
+        return TrajectorySample(
+            self.t[start:stop], self.position[start:stop], self.velocity[start:stop], self.acceleration[start:stop]
+        )
 
-    def head(self, n: int) -> "TrajectorySample":
+    def head(self, n: int) -> TrajectorySample:
         """The sample at the first ``n`` times."""
         return self.rows(0, n)
 
@@ -82,14 +84,16 @@ class ChunkedSample:
         if self._whole is not None:
             return self._whole.rows(start, stop)
         if self.stored is not None:
-            return TrajectorySample(self.t[start:stop], *(self.stored.span(name, start, stop)
-                                                          for name in ("position", "velocity", "acceleration")))
+            return TrajectorySample(
+                self.t[start:stop],
+                *(self.stored.span(name, start, stop) for name in ("position", "velocity", "acceleration")),
+            )
         if held is None or start < first or stop > first + held.t.size:
-            first, held = start, self.sample(self.t[start:max(stop, start + self.chunk)])
+            first, held = start, self.sample(self.t[start : max(stop, start + self.chunk)])
             self._held = (first, held)
         return held.rows(start - first, stop - first)
 
-    def head(self, n: int) -> "ChunkedSample":
+    def head(self, n: int) -> ChunkedSample:
         """The sample at the first ``n`` times."""
         return ChunkedSample(self.sample, self.t[:n], self.chunk, self.stored)
 
@@ -101,8 +105,13 @@ class ChunkedSample:
             if not parts:
                 self._whole = self.sample(self.t)
             else:
-                self._whole = TrajectorySample(self.t, *(np.concatenate([getattr(p, name) for p in parts])
-                                                         for name in ("position", "velocity", "acceleration")))
+                self._whole = TrajectorySample(
+                    self.t,
+                    *(
+                        np.concatenate([getattr(p, name) for p in parts])
+                        for name in ("position", "velocity", "acceleration")
+                    ),
+                )
             self._held = (0, None)
         return self._whole
 
@@ -149,9 +158,12 @@ def _as_float_array(values, what: str) -> np.ndarray:
         raise PlanningError(f"{what} must be numbers, got {text}") from None
 
 
-def check_values(values, name: str | Callable[[tuple[int, ...]], str],
-                 unit: str | Callable[[tuple[int, ...]], str] = "",
-                 max_abs: float = MAX_MAGNITUDE) -> np.ndarray:
+def check_values(
+    values,
+    name: str | Callable[[tuple[int, ...]], str],
+    unit: str | Callable[[tuple[int, ...]], str] = "",
+    max_abs: float = MAX_MAGNITUDE,
+) -> np.ndarray:
     """``values`` as a float array, after checking every entry is finite and |x| <= max_abs.
 
     Args:
@@ -179,10 +191,13 @@ def check_values(values, name: str | Callable[[tuple[int, ...]], str],
     unit = unit(index) if callable(unit) else unit
     u = f" {unit}" if unit else ""
     if not np.isfinite(value):
-        raise PlanningError(f"{label} = {fmt_number(value)}{u} is non-finite (NaN or inf); "
-                            f"planners take finite numbers within +/-{max_abs:g}{u}")
-    raise PlanningError(f"{label} = {fmt_number(value)}{u} is beyond +/-{max_abs:g}{u}, the "
-                        f"largest magnitude planners take")
+        raise PlanningError(
+            f"{label} = {fmt_number(value)}{u} is non-finite (NaN or inf); "
+            f"planners take finite numbers within +/-{max_abs:g}{u}"
+        )
+    raise PlanningError(
+        f"{label} = {fmt_number(value)}{u} is beyond +/-{max_abs:g}{u}, the largest magnitude planners take"
+    )
 
 
 def check_positive(value, name: str, unit: str = "") -> float:
@@ -208,8 +223,7 @@ def sample_times(t) -> np.ndarray:
     """
     arr = np.atleast_1d(_as_float_array(t, "sample times"))
     if arr.ndim != 1:
-        raise PlanningError(f"sample times must be a number or a 1-D array, got shape "
-                            f"{arr.shape}")
+        raise PlanningError(f"sample times must be a number or a 1-D array, got shape {arr.shape}")
     return check_values(arr, lambda i: f"sample time t[{i[0]}]", "s")
 
 
@@ -234,8 +248,12 @@ class PiecewiseTrajectory:
     def __init__(self, pieces, starts):
         self.pieces = list(pieces)
         self.starts = np.asarray(starts, dtype=float)
-        if not self.pieces or self.starts.shape != (len(self.pieces),) or self.starts[0] != 0.0 \
-                or np.any(np.diff(self.starts) < [p.duration for p in self.pieces[:-1]]):
+        if (
+            not self.pieces
+            or self.starts.shape != (len(self.pieces),)
+            or self.starts[0] != 0.0
+            or np.any(np.diff(self.starts) < [p.duration for p in self.pieces[:-1]])
+        ):
             raise ValueError("pieces must start at 0 and each after the one before has ended")
 
     @property

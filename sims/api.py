@@ -19,8 +19,9 @@ from planbench import outputs, pipeline, runner, scenarios
 from planbench.task import PluginError, check_controller, check_planner
 
 
-def run(scenario: str, *, planner=None, controller=None, params=None, plant=None,
-        out=None, video=None, quiet: bool = True) -> runner.RunResult:
+def run(
+    scenario: str, *, planner=None, controller=None, params=None, plant=None, out=None, video=None, quiet: bool = True
+) -> runner.RunResult:
     """Run the scenario ``scenario`` and return its ``runner.RunResult``.
 
     Args:
@@ -60,8 +61,9 @@ def run(scenario: str, *, planner=None, controller=None, params=None, plant=None
     video_file = None if video is None else outputs.VideoFile(video, target)
 
     def execute():
-        return pipeline.execute(spec, params, plant, planner=planner, controller=controller, out=target,
-                                video=video_file, quiet=quiet)[1]
+        return pipeline.execute(
+            spec, params, plant, planner=planner, controller=controller, out=target, video=video_file, quiet=quiet
+        )[1]
 
     if target is None:
         return execute()
@@ -93,14 +95,17 @@ def plan(scenario: str, *, planner=None, params=None):
     if planner is None:
         return spec.plan(params)
     if spec.online_planner:
-        raise PluginError(f"{spec.name}'s planner is online (reset and step during the run): "
-                          "planbench.run judges it, plan has no trajectory to give")
+        raise PluginError(
+            f"{spec.name}'s planner is online (reset and step during the run): "
+            "planbench.run judges it, plan has no trajectory to give"
+        )
     check_planner(planner, online=False)
     return spec.build(params, planner=planner).components.trajectory
 
 
-def sweep(spec, out, *, engine: str = "local", workers: int | None = None, address: str | None = None,
-          quiet: bool = True):
+def sweep(
+    spec, out, *, engine: str = "local", workers: int | None = None, address: str | None = None, quiet: bool = True
+):
     """Run (or resume) the campaign of the TOML file ``spec`` into the directory ``out``, as
     ``planbench sweep`` does (README, "Campaigns"); returns its ``Outcome`` (summary, the
     runs run now, the results table, the worst runs).
@@ -110,8 +115,15 @@ def sweep(spec, out, *, engine: str = "local", workers: int | None = None, addre
     """
     from planbench import campaign
 
-    return campaign.sweep(spec, out, engine=engine, workers=workers, address=address, quiet=quiet,
-                          echo=(lambda *args, **kwargs: None) if quiet else print)
+    return campaign.sweep(
+        spec,
+        out,
+        engine=engine,
+        workers=workers,
+        address=address,
+        quiet=quiet,
+        echo=(lambda *args, **kwargs: None) if quiet else print,
+    )
 
 
 def environment(scenario: str, random=None, **params):

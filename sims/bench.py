@@ -49,8 +49,9 @@ def best_time(function, repeats: int = REPEATS):
 def benchmarks() -> list[tuple[str, int]]:
     """(scenario, runs) of every scenario tagged "benchmark" (planbench.scenarios), with its
     mechanism's ``benchmark_runs``."""
-    return [(s.name, record.benchmark_runs) for record in scenarios.mechanisms()
-            for s in record.tagged(scenarios.BENCHMARK)]
+    return [
+        (s.name, record.benchmark_runs) for record in scenarios.mechanisms() for s in record.tagged(scenarios.BENCHMARK)
+    ]
 
 
 def bare_steps_per_second(setup, n_steps: int) -> float:
@@ -89,8 +90,10 @@ def bench_scenario(name: str, repeats: int = REPEATS, drives_cost: bool = True) 
     if drives_cost and "drives" in type(scenario.params).names() and scenario.params.drives != "ideal":
         # The drive trains' cost: the loop's wall time per tick against the ideal drives'.
         ideal = scenario.params.replace(drives="ideal")
-        ideal_loop = max(result.log.physics_steps / result.log.loop_wall_s
-                         for _, result in (pipeline.execute(scenario, ideal) for _ in range(repeats)))
+        ideal_loop = max(
+            result.log.physics_steps / result.log.loop_wall_s
+            for _, result in (pipeline.execute(scenario, ideal) for _ in range(repeats))
+        )
         cost = ideal_loop / best_loop - 1.0
     return {
         "scenario": name,
@@ -114,8 +117,10 @@ def run_all() -> list[dict]:
     """Every scenario's row: those tagged "benchmark" with their mechanism's runs and the drive
     trains' cost, the others from one run each (their ratios are the noisier for it)."""
     tagged = dict(benchmarks())
-    return [bench_scenario(name, tagged[name]) if name in tagged else bench_scenario(name, 1, drives_cost=False)
-            for name in scenarios.SCENARIOS]
+    return [
+        bench_scenario(name, tagged[name]) if name in tagged else bench_scenario(name, 1, drives_cost=False)
+        for name in scenarios.SCENARIOS
+    ]
 
 
 def format_table(rows: list[dict]) -> str:
@@ -133,28 +138,38 @@ def format_table(rows: list[dict]) -> str:
     lines.append(f"{'the loop, of its wall time':<28} {'physics':>8} {'planner + controller':>21} {'testbed':>8}")
     for r in rows:
         testbed = 1.0 - r["physics_share"] - r["code_under_test_share"]
-        lines.append(f"{r['scenario']:<28} {100 * r['physics_share']:>7.0f}% {100 * r['code_under_test_share']:>20.0f}% "
-                     f"{100 * testbed:>7.0f}%")
+        lines.append(
+            f"{r['scenario']:<28} {100 * r['physics_share']:>7.0f}% {100 * r['code_under_test_share']:>20.0f}% "
+            f"{100 * testbed:>7.0f}%"
+        )
     for r in rows:
         if r.get("planner_wall_s"):
             loop_wall = r["physics_steps"] / r["loop_steps_per_s"]
             share = r["planner_wall_s"] / loop_wall
-            lines.append(f"{r['scenario']}: the online planner's updates take {r['planner_wall_s']:.2f} s "
-                         f"({100 * share:.0f} % of the loop); without them loop/bare would be "
-                         f"{r['loop_ratio'] / (1 - share):.2f}")
+            lines.append(
+                f"{r['scenario']}: the online planner's updates take {r['planner_wall_s']:.2f} s "
+                f"({100 * share:.0f} % of the loop); without them loop/bare would be "
+                f"{r['loop_ratio'] / (1 - share):.2f}"
+            )
     for r in rows:
         if r.get("drives_cost") is not None:
-            lines.append(f"{r['scenario']}: the drive trains as built take {100 * r['drives_cost']:+.0f} % wall time "
-                         f"per physics step of the loop against the ideal drives (target <= +20 %)")
+            lines.append(
+                f"{r['scenario']}: the drive trains as built take {100 * r['drives_cost']:+.0f} % wall time "
+                f"per physics step of the loop against the ideal drives (target <= +20 %)"
+            )
     for r in rows:
         if r["scenario"] == "fast-tracking":
-            lines.append(f"fast-tracking: 20 min of observation (the plan's {r['sim_time_s']:.0f} s with the "
-                         f"switch) in {r['wall_time_s']:.1f} s of wall time (target <= 60 s)")
+            lines.append(
+                f"fast-tracking: 20 min of observation (the plan's {r['sim_time_s']:.0f} s with the "
+                f"switch) in {r['wall_time_s']:.1f} s of wall time (target <= 60 s)"
+            )
     one = [r["scenario"] for r in rows if not r.get("benchmark", True)]
     if one:
         lines.append(f"from one run each (the others the best of their mechanism's): {', '.join(one)}")
-    lines.append("targets: loop/bare >= 0.8 (the antenna's >= 0.5), the testbed's share <= 10 %; "
-                 "realtime x = simulated / wall time of the whole run")
+    lines.append(
+        "targets: loop/bare >= 0.8 (the antenna's >= 0.5), the testbed's share <= 10 %; "
+        "realtime x = simulated / wall time of the whole run"
+    )
     return "\n".join(lines)
 
 
@@ -203,8 +218,14 @@ def campaign_throughput(repeats: int = 2) -> list[dict]:
         runs = iter(range(10**6))
 
         def sweep(key, engine, workers=None):
-            outcome = campaign.sweep(spec, Path(tmp) / f"campaign-{next(runs)}", engine=engine, workers=workers,
-                                     quiet=True, echo=lambda *_: None)
+            outcome = campaign.sweep(
+                spec,
+                Path(tmp) / f"campaign-{next(runs)}",
+                engine=engine,
+                workers=workers,
+                quiet=True,
+                echo=lambda *_: None,
+            )
             outcomes.setdefault(key, []).append(outcome)
 
         for _ in range(repeats):
@@ -236,30 +257,55 @@ def campaign_throughput(repeats: int = 2) -> list[dict]:
         if state == "warming":
             continue
         best = min(done, key=lambda o: o.engine_wall_s)
-        rows.append({"engine": engine, "workers": workers, "state": state, "campaigns": len(done), "runs": best.ran,
-                     "wall_s": best.engine_wall_s, "runs_per_s": best.ran / best.engine_wall_s,
-                     "campaign_s": min(o.campaign_wall_s for o in done), "same_table": same})
+        rows.append(
+            {
+                "engine": engine,
+                "workers": workers,
+                "state": state,
+                "campaigns": len(done),
+                "runs": best.ran,
+                "wall_s": best.engine_wall_s,
+                "runs_per_s": best.ran / best.engine_wall_s,
+                "campaign_s": min(o.campaign_wall_s for o in done),
+                "same_table": same,
+            }
+        )
     return rows
 
 
 def format_campaign(rows: list[dict]) -> str:
     """The campaign table: each row against the local engine's x1 and x2 in the same state."""
     local = {(r["workers"], r["state"]): r for r in rows if r["engine"] == "local"}
-    lines = [f"{'campaign throughput (8 runs)':<44} {'wall s':>7} {'runs/s':>7} {'vs local x1':>11} "
-             f"{'vs local x2':>11} {'campaign s':>10}"]
+    lines = [
+        f"{'campaign throughput (8 runs)':<44} {'wall s':>7} {'runs/s':>7} {'vs local x1':>11} "
+        f"{'vs local x2':>11} {'campaign s':>10}"
+    ]
     for r in rows:
-        what = (f"{r['engine']} x{r['workers']}, " + ("pool started with it" if r["engine"] == "local" else "first on its cluster")
-                if r["state"] == "started" else
-                f"{r['engine']} x{r['workers']}, " + ("pool held" if r["engine"] == "local" else "cluster up"))
+        what = (
+            f"{r['engine']} x{r['workers']}, "
+            + ("pool started with it" if r["engine"] == "local" else "first on its cluster")
+            if r["state"] == "started"
+            else f"{r['engine']} x{r['workers']}, " + ("pool held" if r["engine"] == "local" else "cluster up")
+        )
         if r["campaigns"] > 1:
             what += f" (best of {r['campaigns']})"
-        ratios = [f"{r['runs_per_s'] / local[(w, r['state'])]['runs_per_s']:>11.2f}" if (w, r["state"]) in local
-                  else f"{'':>11}" for w in (1, 2)]
-        lines.append(f"{what:<44} {r['wall_s']:>7.2f} {r['runs_per_s']:>7.3f} {' '.join(ratios)} {r['campaign_s']:>10.2f}")
-    lines.append("wall s: first run sent to last row written; campaign s: the whole campaign to its last row (the "
-                 "spec's reading, and a started engine's workers' start, included; Ray's cluster itself already up)")
-    lines.append("targets: local x2 >= 1.85 x local x1; local x2 no slower than ray x2; tables equal run for run: "
-                 + ("yes" if rows and rows[0]["same_table"] else "NO"))
+        ratios = [
+            f"{r['runs_per_s'] / local[(w, r['state'])]['runs_per_s']:>11.2f}"
+            if (w, r["state"]) in local
+            else f"{'':>11}"
+            for w in (1, 2)
+        ]
+        lines.append(
+            f"{what:<44} {r['wall_s']:>7.2f} {r['runs_per_s']:>7.3f} {' '.join(ratios)} {r['campaign_s']:>10.2f}"
+        )
+    lines.append(
+        "wall s: first run sent to last row written; campaign s: the whole campaign to its last row (the "
+        "spec's reading, and a started engine's workers' start, included; Ray's cluster itself already up)"
+    )
+    lines.append(
+        "targets: local x2 >= 1.85 x local x1; local x2 no slower than ray x2; tables equal run for run: "
+        + ("yes" if rows and rows[0]["same_table"] else "NO")
+    )
     return "\n".join(lines)
 
 
@@ -286,15 +332,23 @@ def planner_only_throughput(workers: int = 2, samples: int = PLAN_SAMPLES) -> di
         spec.write_text(text)
         outcome = campaign.sweep(spec, Path(tmp) / "out", workers=workers, quiet=True, echo=lambda *_: None)
     counted = outcome.summary["overall"]["counted"]
-    return {"runs": outcome.ran, "valid": counted, "wall_s": outcome.engine_wall_s, "workers": workers,
-            "runs_per_s": outcome.ran / outcome.engine_wall_s, "valid_per_s": counted / outcome.engine_wall_s,
-            "campaign_s": outcome.campaign_wall_s}
+    return {
+        "runs": outcome.ran,
+        "valid": counted,
+        "wall_s": outcome.engine_wall_s,
+        "workers": workers,
+        "runs_per_s": outcome.ran / outcome.engine_wall_s,
+        "valid_per_s": counted / outcome.engine_wall_s,
+        "campaign_s": outcome.campaign_wall_s,
+    }
 
 
 def format_planner_only(row: dict) -> str:
-    return (f"planner-only campaign, {row['runs']} random hexapod moves ({row['valid']} valid), local x{row['workers']}: "
-            f"{row['wall_s']:.2f} s, {row['runs_per_s']:.0f} moves/s ({row['valid_per_s']:.0f} valid/s; "
-            f"{row.get('campaign_s', float('nan')):.2f} s from the call to the last row); target >= 100000 moves/s")
+    return (
+        f"planner-only campaign, {row['runs']} random hexapod moves ({row['valid']} valid), local x{row['workers']}: "
+        f"{row['wall_s']:.2f} s, {row['runs_per_s']:.0f} moves/s ({row['valid_per_s']:.0f} valid/s; "
+        f"{row.get('campaign_s', float('nan')):.2f} s from the call to the last row); target >= 100000 moves/s"
+    )
 
 
 #: The runs whose peak memory ``planbench bench`` measures: FAST's tracking at these lengths, s.
@@ -335,10 +389,12 @@ def peak_memory(scenario: str, duration: float | None) -> float:
     with tempfile.TemporaryDirectory(prefix="planbench-bench-") as tmp:
         # Its outputs (written as a run writes them) go to a directory of the bench's own, never
         # to the default results/NAME, which may hold a run of the user's.
-        command = ["run", scenario, "--quiet", "--out", str(Path(tmp) / "run")] + \
-            ([] if duration is None else ["--duration", repr(duration)])
-        done = subprocess.run([sys.executable, "-c", _PEAK_CHILD, *command], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True)
+        command = ["run", scenario, "--quiet", "--out", str(Path(tmp) / "run")] + (
+            [] if duration is None else ["--duration", repr(duration)]
+        )
+        done = subprocess.run(
+            [sys.executable, "-c", _PEAK_CHILD, *command], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+        )
     peaks = [line.split()[1] for line in done.stderr.splitlines() if line.startswith("PEAK_KB ")]
     if done.returncode not in (0, 1) or not peaks:  # 1: a check failed, which still ran the whole run
         raise RuntimeError(f"planbench {' '.join(command)} exited {done.returncode}: {done.stderr[-500:]}")
@@ -355,8 +411,13 @@ def memory_by_run_length(six_hours: bool = False) -> list[dict]:
     for duration in (*MEMORY_DURATIONS_S, SIX_HOURS_S):
         length = task.duration if duration is None else duration
         measured = duration != SIX_HOURS_S or six_hours
-        rows.append({"duration_s": length, "peak_mb": peak_memory(MEMORY_SCENARIO, duration) if measured else None,
-                     "log_mb": scenario.resolve(duration=length).log_bytes_per_tick() * length / task.control_dt / 2**20})
+        rows.append(
+            {
+                "duration_s": length,
+                "peak_mb": peak_memory(MEMORY_SCENARIO, duration) if measured else None,
+                "log_mb": scenario.resolve(duration=length).log_bytes_per_tick() * length / task.control_dt / 2**20,
+            }
+        )
     return rows
 
 
@@ -370,8 +431,10 @@ def format_memory(rows: list[dict]) -> str:
         lines.append(f"{'':<30}{r['duration_s']:>12.0f} {peak:>9}  {log:>15}{note}")
     if len(measured) >= 2:
         first, last = measured[0], measured[-1]
-        lines.append(f"{last['duration_s']:.0f} s over {first['duration_s']:.0f} s: {last['peak_mb'] / first['peak_mb']:.2f} x "
-                     f"(target: a 6 h run within 1.3 x the {first['duration_s']:.0f} s one's peak)")
+        lines.append(
+            f"{last['duration_s']:.0f} s over {first['duration_s']:.0f} s: {last['peak_mb'] / first['peak_mb']:.2f} x "
+            f"(target: a 6 h run within 1.3 x the {first['duration_s']:.0f} s one's peak)"
+        )
     return "\n".join(lines)
 
 

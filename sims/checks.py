@@ -36,8 +36,7 @@ class Check:
             object.__setattr__(self, "note", f"{NOT_EVALUATED}: {reason}")
 
     @classmethod
-    def not_evaluated(cls, name: str, limit: float, unit: str, comparison: str = "<=",
-                      reason: str = "") -> "Check":
+    def not_evaluated(cls, name: str, limit: float, unit: str, comparison: str = "<=", reason: str = "") -> Check:
         """A failed check whose value could not be measured, with the reason why."""
         return cls(name, float("nan"), limit, unit, comparison, note=reason)
 

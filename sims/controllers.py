@@ -7,9 +7,8 @@ import copy
 import mujoco
 import numpy as np
 
-from planbench.planners.trajectory import TrajectorySample
 from planbench.drives import load_joint, transmission_stiffness
-
+from planbench.planners.trajectory import TrajectorySample
 
 
 class ServoFeedforwardController:
@@ -45,9 +44,12 @@ class ServoFeedforwardController:
       force_limit: (nu,) drive force limits, bounding the integral; None: the model's.
     """
 
-    def __init__(self, kp=None, kv=None, feedforward: bool = True,
-                 integral_time: float | None = None, force_limit=None):
-        as_array = lambda x: None if x is None else np.asarray(x, dtype=float)
+    def __init__(
+        self, kp=None, kv=None, feedforward: bool = True, integral_time: float | None = None, force_limit=None
+    ):
+        def as_array(x):
+            return None if x is None else np.asarray(x, dtype=float)
+
         self.kp = as_array(kp)
         self.kv = as_array(kv)
         self.feedforward = feedforward
@@ -87,9 +89,10 @@ class ServoFeedforwardController:
         if own.size:
             qpos_adr = np.concatenate([qpos_adr, model.jnt_qposadr[motors[own]]])
             dofs = np.concatenate([dofs, model.jnt_dofadr[motors[own]]])
-            reference = TrajectorySample(reference.t, *(np.hstack([x, x[:, own]]) for x in
-                                                       (reference.position, reference.velocity,
-                                                        reference.acceleration)))
+            reference = TrajectorySample(
+                reference.t,
+                *(np.hstack([x, x[:, own]]) for x in (reference.position, reference.velocity, reference.acceleration)),
+            )
         n = reference.t.size
         tau = np.zeros((n, nu))
         # A copy of the model (MjModel's copy is a full mj_copyModel) with contacts
@@ -127,13 +130,14 @@ class ServoFeedforwardController:
         if self.force_limit is None and self.integral_time is not None:
             self.force_limit = model.actuator_forcerange[ids, 1].copy()
         n = reference.t.size
-        self.tau_ff = (self.feedforward_forces(context) if self.feedforward else np.zeros((n, nu)))
+        self.tau_ff = self.feedforward_forces(context) if self.feedforward else np.zeros((n, nu))
         self.reference = reference.position
         self.setpoints = reference.position + (self.tau_ff + self.kv * reference.velocity) / self.kp
         # A compliant transmission (as-built drives) deflects by f / k between the motor,
         # which the drive positions, and the load the reference is for.
-        stiffness = np.array([transmission_stiffness(model, model.joint(int(j)).name)
-                              for j in (load_joint(model, int(a)) for a in ids)])
+        stiffness = np.array(
+            [transmission_stiffness(model, model.joint(int(j)).name) for j in (load_joint(model, int(a)) for a in ids)]
+        )
         self.compliance = None  # m/N or rad/(N m) per drive; None: rigid transmissions
         if np.isfinite(stiffness).any():
             self.compliance = np.where(np.isfinite(stiffness), 1.0 / stiffness, 0.0)
@@ -142,8 +146,11 @@ class ServoFeedforwardController:
         self._gain = 0.0 if self.integral_time is None else context.control_dt / self.integral_time
         if self._gain:
             # The set-point offset that makes the drive's largest force at the load.
-            self._bound = self.force_limit / self.kp if self.compliance is None else \
-                self.force_limit * (1.0 / self.kp + self.compliance)
+            self._bound = (
+                self.force_limit / self.kp
+                if self.compliance is None
+                else self.force_limit * (1.0 / self.kp + self.compliance)
+            )
         self._inv_dt = 1.0 / context.control_dt
         self._command = context.command  # written in place every tick
         self._last_tick = self.setpoints.shape[0] - 1
@@ -156,8 +163,9 @@ class ServoFeedforwardController:
             z = self.z + self._gain * (self.reference[tick] - observation["joint_positions"])
             self.z = np.clip(z, -self._bound, self._bound)
             target = target + self.z
-        np.multiply(np.subtract(target, observation["setpoints"], out=self._difference), self._inv_dt,
-                    out=self._command)
+        np.multiply(
+            np.subtract(target, observation["setpoints"], out=self._difference), self._inv_dt, out=self._command
+        )
 
 
 def demanded_force(kp, kv, act, qpos, qvel) -> np.ndarray:

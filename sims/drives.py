@@ -41,8 +41,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from planbench.planners.errors import LimitError
 from planbench.params import param
+from planbench.planners.errors import LimitError
 
 #: Mass and inertia of a motor body (kg, kg m^2): the rotor's inertia is the dof's armature;
 #: MuJoCo needs a moving body to have some mass of its own.
@@ -106,7 +106,7 @@ class DriveTrain:
     @property
     def reflected_inertia(self) -> float:
         """J_m N^2: the rotor's inertia seen at the joint, kg or kg m^2."""
-        return self.rotor_inertia * self.ratio ** 2
+        return self.rotor_inertia * self.ratio**2
 
     @property
     def peak_force(self) -> float:
@@ -127,26 +127,38 @@ class DriveTrain:
     def rigid(self) -> bool:
         return math.isinf(self.stiffness)
 
-    def with_errors(self, friction: float = 0.0, stiffness: float = 0.0, backlash: float = 0.0,
-                    torque_constant: float = 0.0) -> "DriveTrain":
+    def with_errors(
+        self, friction: float = 0.0, stiffness: float = 0.0, backlash: float = 0.0, torque_constant: float = 0.0
+    ) -> DriveTrain:
         """This drive train as a plant off its datasheet: its Coulomb and viscous friction, its
         transmission's stiffness, its backlash and its motor's torque constant each times
         (1 + error). A torque constant off by e scales every force the drive makes: its loops'
         gains and its peak (the drive's current limit stays)."""
         torque = 1.0 + torque_constant
         return dataclasses.replace(
-            self, coulomb_friction=self.coulomb_friction * (1.0 + friction),
-            viscous_friction=self.viscous_friction * (1.0 + friction), stiffness=self.stiffness * (1.0 + stiffness),
-            backlash=self.backlash * (1.0 + backlash), torque_constant=self.torque_constant * torque,
-            kp=self.kp * torque, kv=self.kv * torque)
+            self,
+            coulomb_friction=self.coulomb_friction * (1.0 + friction),
+            viscous_friction=self.viscous_friction * (1.0 + friction),
+            stiffness=self.stiffness * (1.0 + stiffness),
+            backlash=self.backlash * (1.0 + backlash),
+            torque_constant=self.torque_constant * torque,
+            kp=self.kp * torque,
+            kv=self.kv * torque,
+        )
 
 
 def torque_constant_error(motors: str):
     """The plant-uncertainty field (``planbench.params.param``) of the torque constant of
     ``motors`` (in words) against their datasheet's, for ``DriveTrain.with_errors``."""
-    return param(0.0, f"as-built drives: {motors}' torque constant relative to the datasheet's (every force the "
-                 "drive makes scales with it)", "fraction", low=-0.1, high=0.1,
-                 reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)")
+    return param(
+        0.0,
+        f"as-built drives: {motors}' torque constant relative to the datasheet's (every force the "
+        "drive makes scales with it)",
+        "fraction",
+        low=-0.1,
+        high=0.1,
+        reason="motor datasheets give K_t to +-10 % (assumption; magnet temperature and tolerance)",
+    )
 
 
 def servo_gains(inertia: float, bandwidth_hz: float, damping_ratio: float) -> tuple[float, float]:
@@ -154,7 +166,7 @@ def servo_gains(inertia: float, bandwidth_hz: float, damping_ratio: float) -> tu
     of natural frequency ``bandwidth_hz`` and damping ratio ``damping_ratio``:
     kp = m w^2, kv = 2 zeta m w (m qddot + kv qdot + kp q = kp s)."""
     omega = 2.0 * math.pi * bandwidth_hz
-    return inertia * omega ** 2, 2.0 * damping_ratio * inertia * omega
+    return inertia * omega**2, 2.0 * damping_ratio * inertia * omega
 
 
 def add_drive_train(spec: mujoco.MjSpec, joint: str, actuator: str, drive: DriveTrain) -> None:
@@ -171,16 +183,24 @@ def add_drive_train(spec: mujoco.MjSpec, joint: str, actuator: str, drive: Drive
     target = load
     if not drive.rigid:
         body = load.parent
-        rotor = body.parent.add_body(name=joint + MOTOR_SUFFIX, pos=body.pos, quat=body.quat,
-                                     mass=ROTOR_BODY_MASS, inertia=[ROTOR_BODY_INERTIA] * 3)
+        rotor = body.parent.add_body(
+            name=joint + MOTOR_SUFFIX,
+            pos=body.pos,
+            quat=body.quat,
+            mass=ROTOR_BODY_MASS,
+            inertia=[ROTOR_BODY_INERTIA] * 3,
+        )
         target = rotor.add_joint(name=joint + MOTOR_SUFFIX, type=load.type, axis=load.axis, pos=load.pos)
         load.armature = 0.0
         load.frictionloss = 0.0
         load.damping = [0.0, 0.0, 0.0]
         # MjSpec's stiffness and damping are polynomials (linear, quadratic, cubic terms).
-        tendon = spec.add_tendon(name=joint + TRANSMISSION_SUFFIX, stiffness=[drive.stiffness, 0.0, 0.0],
-                                 damping=[drive.transmission_damping, 0.0, 0.0],
-                                 springlength=[-0.5 * drive.backlash, 0.5 * drive.backlash])
+        tendon = spec.add_tendon(
+            name=joint + TRANSMISSION_SUFFIX,
+            stiffness=[drive.stiffness, 0.0, 0.0],
+            damping=[drive.transmission_damping, 0.0, 0.0],
+            springlength=[-0.5 * drive.backlash, 0.5 * drive.backlash],
+        )
         tendon.wrap_joint(joint, 1.0)
         tendon.wrap_joint(joint + MOTOR_SUFFIX, -1.0)
         act.target = target.name
@@ -250,13 +270,17 @@ def keyframe_with_motors(spec: mujoco.MjSpec, nominal: mujoco.MjModel) -> None:
     qpos = model.qpos0.copy()
     for j in range(nominal.njnt):
         name = nominal.joint(j).name
-        value = nominal.key_qpos[0][nominal.jnt_qposadr[j]:nominal.jnt_qposadr[j] + _QPOS_SIZE[nominal.jnt_type[j]]]
+        value = nominal.key_qpos[0][nominal.jnt_qposadr[j] : nominal.jnt_qposadr[j] + _QPOS_SIZE[nominal.jnt_type[j]]]
         for target in {model.joint(name).id, motor_joint(model, name)}:
             adr = model.jnt_qposadr[target]
-            qpos[adr:adr + value.size] = value
+            qpos[adr : adr + value.size] = value
     spec.key("home").qpos = qpos
 
 
 #: qpos values per joint type (free, ball, slide, hinge).
-_QPOS_SIZE = {int(mujoco.mjtJoint.mjJNT_FREE): 7, int(mujoco.mjtJoint.mjJNT_BALL): 4,
-              int(mujoco.mjtJoint.mjJNT_SLIDE): 1, int(mujoco.mjtJoint.mjJNT_HINGE): 1}
+_QPOS_SIZE = {
+    int(mujoco.mjtJoint.mjJNT_FREE): 7,
+    int(mujoco.mjtJoint.mjJNT_BALL): 4,
+    int(mujoco.mjtJoint.mjJNT_SLIDE): 1,
+    int(mujoco.mjtJoint.mjJNT_HINGE): 1,
+}

@@ -94,8 +94,9 @@ class TaskAdapter(base.Task):
         model = physics.model.ptr
         lo, hi = model.actuator_ctrlrange[self._controlled].T
         limited = model.actuator_ctrllimited[self._controlled].astype(bool)
-        return specs.BoundedArray((self._controlled.size,), float, np.where(limited, lo, -np.inf),
-                                  np.where(limited, hi, np.inf), name="ctrl")
+        return specs.BoundedArray(
+            (self._controlled.size,), float, np.where(limited, lo, -np.inf), np.where(limited, hi, np.inf), name="ctrl"
+        )
 
     def get_observation(self, physics):
         k = min(self.tick, self._last)
@@ -166,8 +167,9 @@ def antenna_environment(sea_state: bool = True, duration: float | None = None) -
     return make("antenna-sea-state" if sea_state else "antenna-paper-motion", **_given(duration=duration))
 
 
-def fast_environment(duration: float = 60.0, wind: float | None = None, seed: int | None = None,
-                     cable_segments: int | None = None) -> control.Environment:
+def fast_environment(
+    duration: float = 60.0, wind: float | None = None, seed: int | None = None, cable_segments: int | None = None
+) -> control.Environment:
     """FAST's feed support: ``duration`` s of tracking 3C 286 (no switch: the episode starts
     on the source at rest), in ``wind`` m/s, seeded by ``seed``, on the cables of
     ``cable_segments`` (None: each the default of planbench.fast.FastParams). The action is every

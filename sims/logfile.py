@@ -47,9 +47,16 @@ _MAGIC_BYTES = 8
 
 def model_shapes(model) -> dict[str, tuple[int, ...]]:
     """Each logged array's per-tick shape for a compiled ``mujoco.MjModel``."""
-    return {"qpos": (model.nq,), "qvel": (model.nv,), "act": (model.na,), "ctrl": (model.nu,),
-            "actuator_force": (model.nu,), "sensordata": (model.nsensordata,),
-            "mocap_pos": (model.nmocap, 3), "mocap_quat": (model.nmocap, 4)}
+    return {
+        "qpos": (model.nq,),
+        "qvel": (model.nv,),
+        "act": (model.na,),
+        "ctrl": (model.nu,),
+        "actuator_force": (model.nu,),
+        "sensordata": (model.nsensordata,),
+        "mocap_pos": (model.nmocap, 3),
+        "mocap_quat": (model.nmocap, 4),
+    }
 
 
 def _width(shape) -> int:
@@ -58,8 +65,9 @@ def _width(shape) -> int:
 
 def _schema(shapes: dict) -> pa.Schema:
     fields = [pa.field("t", pa.float64())]
-    fields += [pa.field(name, pa.list_(pa.float64(), _width(shape)))
-               for name, shape in shapes.items() if _width(shape) > 0]
+    fields += [
+        pa.field(name, pa.list_(pa.float64(), _width(shape))) for name, shape in shapes.items() if _width(shape) > 0
+    ]
     meta = {"format": _FORMAT, "shapes": {name: list(shape) for name, shape in shapes.items()}}
     return pa.schema(fields, metadata={_META: json.dumps(meta).encode()})
 
@@ -78,8 +86,9 @@ class ChunkWriter:
     ``mj_getState`` of qpos, qvel, act and the mocap poses); their ``buffers`` are views of
     it."""
 
-    def __init__(self, path, shapes: dict, times: np.ndarray, chunk: int = CHUNK_TICKS, history: int = 0,
-                 block: tuple = ()):
+    def __init__(
+        self, path, shapes: dict, times: np.ndarray, chunk: int = CHUNK_TICKS, history: int = 0, block: tuple = ()
+    ):
         if chunk < 1:
             raise ValueError(f"chunk of {chunk} ticks: at least 1")
         self.path = Path(path)
@@ -91,11 +100,12 @@ class ChunkWriter:
         self.buffers, at = {}, 0
         for name in block:
             width = _width(self.shapes[name])
-            view = self.block[:, at:at + width]
+            view = self.block[:, at : at + width]
             view.shape = (rows, *self.shapes[name])  # in place: raises rather than copy
             self.buffers[name], at = view, at + width
-        self.buffers.update({name: np.zeros((rows, *shape)) for name, shape in self.shapes.items()
-                             if name not in self.buffers})
+        self.buffers.update(
+            {name: np.zeros((rows, *shape)) for name, shape in self.shapes.items() if name not in self.buffers}
+        )
         self.base = -self.history  # run row of buffer row 0
         self.written = 0  # run rows in the file
         self.schema = _schema(self.shapes)
@@ -119,7 +129,7 @@ class ChunkWriter:
         h = self.history
         for a in self.buffers.values():
             if h:
-                a[:h] = a[self.chunk:self.chunk + h]  # (the block's views move the block)
+                a[:h] = a[self.chunk : self.chunk + h]  # (the block's views move the block)
             a[h:] = 0.0  # a row no tick writes reads 0, as in a fresh buffer
         self.base += self.chunk
 
@@ -131,7 +141,7 @@ class ChunkWriter:
 
     def _write_rows(self, arrays: dict, stop: int) -> None:
         """Append ``arrays`` ({name: rows}), the run's rows up to ``stop``, as a chunk."""
-        columns = [pa.array(self.times[self.written:stop])]
+        columns = [pa.array(self.times[self.written : stop])]
         for name, shape in self.shapes.items():
             width = _width(shape)
             if width:
@@ -154,7 +164,7 @@ class ChunkWriter:
             self.flush()
         return self.buffers[name][i - self.base]
 
-    def read_back(self, rows: int) -> "LogFile":
+    def read_back(self, rows: int) -> LogFile:
         """``close(rows)`` and the log read back, once (later calls return it); a temporary
         log's file (``temporary_writer``) is then removed, the open file keeping its data."""
         if self._read is None:
@@ -239,7 +249,7 @@ class LogFile:
         self._known(name)
         parts, start = [], 0
         for k, rows in enumerate(self.rows):
-            parts.append(self._array(self.batch(k), name)[-start % stride::stride].copy())
+            parts.append(self._array(self.batch(k), name)[-start % stride :: stride].copy())
             start += rows
         shape = () if name == "t" else tuple(self.shapes[name])
         return np.concatenate(parts) if parts else np.zeros((0, *shape))
@@ -252,7 +262,7 @@ class LogFile:
         for k, rows in enumerate(self.rows):
             if first < stop and start < first + rows:
                 part = self._array(self.batch(k), name)
-                parts.append(part[max(start - first, 0):stop - first])
+                parts.append(part[max(start - first, 0) : stop - first])
             first += rows
         shape = () if name == "t" else tuple(self.shapes[name])
         return np.concatenate(parts) if parts else np.zeros((0, *shape))
@@ -269,7 +279,7 @@ class LogFile:
         row = 0
         for k in range(self.num_chunks):
             part = self._array(self.batch(k), name)
-            out[row:row + part.shape[0]] = part
+            out[row : row + part.shape[0]] = part
             row += part.shape[0]
         return out
 
@@ -330,8 +340,9 @@ def read_log(path) -> LogFile:
     return LogFile(path, complete, shapes, schema, source, offsets, rows)
 
 
-def temporary_writer(shapes: dict, times: np.ndarray, chunk: int = CHUNK_TICKS,
-                     prefix: str = "planbench-log-") -> ChunkWriter:
+def temporary_writer(
+    shapes: dict, times: np.ndarray, chunk: int = CHUNK_TICKS, prefix: str = "planbench-log-"
+) -> ChunkWriter:
     """A ChunkWriter (no history) to a log file in a temporary directory of its own, removed
     when the writer is dropped or read back (``ChunkWriter.read_back``): per-tick records of a
     run's parts (the sensors' estimates, the plant's loads) kept on disk, not in memory."""

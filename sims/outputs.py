@@ -57,8 +57,10 @@ VIDEO_TAG = "written by planbench"
 RUN_FILES = ("summary.json", "timeseries.npz", "report.png", "log.arrow", MANIFEST)
 PLAN_FILES = ("plan.npz", "plan.png", MANIFEST)
 #: Longest name planbench writes inside an output directory besides a video's.
-_LONGEST_INNER = max(len(n) for n in (*RUN_FILES, *PLAN_FILES, "segments.json", "figures.png",
-                                      "methods.png", "methods.npz", STAGING_MARKER))
+_LONGEST_INNER = max(
+    len(n)
+    for n in (*RUN_FILES, *PLAN_FILES, "segments.json", "figures.png", "methods.png", "methods.npz", STAGING_MARKER)
+)
 _RENAME_EXCHANGE = 2
 _AT_FDCWD = -100
 #: The signals that interrupt a run (the CLI turns them into exit 128 + signal).
@@ -120,13 +122,16 @@ def _check_lengths(what: str, path: Path, deepest_inner: int) -> None:
         n = len(os.fsencode(part))
         if n > name_max:
             shown = part if len(part) <= 40 else part[:37] + "..."
-            raise OutputError(f"{what} {shown!r}: a name of {n} bytes, longer than the file "
-                              f"system's limit of {name_max}")
+            raise OutputError(
+                f"{what} {shown!r}: a name of {n} bytes, longer than the file system's limit of {name_max}"
+            )
     staging = len(STAGING_PREFIX) + 8
     n = len(os.fsencode(str(path.parent))) + 1 + max(len(os.fsencode(path.name)), staging) + 1 + deepest_inner
     if n >= path_max:
-        raise OutputError(f"{what} {str(path)[:40]}...: its files' paths would be {n} bytes, "
-                          f"longer than the file system's limit of {path_max - 1}")
+        raise OutputError(
+            f"{what} {str(path)[:40]}...: its files' paths would be {n} bytes, "
+            f"longer than the file system's limit of {path_max - 1}"
+        )
 
 
 def _probe(what: str, path: Path) -> None:
@@ -137,14 +142,12 @@ def _probe(what: str, path: Path) -> None:
     try:
         probe = tempfile.mkdtemp(prefix=PROBE_PREFIX, dir=anchor)
     except OSError as e:
-        raise OutputError(f"{what} {path}: nothing can be created in {anchor} "
-                          f"({e.strerror or e})") from None
+        raise OutputError(f"{what} {path}: nothing can be created in {anchor} ({e.strerror or e})") from None
     try:
         with open(os.path.join(probe, "probe"), "wb") as f:
             f.write(b"planbench")
     except OSError as e:
-        raise OutputError(f"{what} {path}: files cannot be written in {anchor} "
-                          f"({e.strerror or e})") from None
+        raise OutputError(f"{what} {path}: files cannot be written in {anchor} ({e.strerror or e})") from None
     finally:
         shutil.rmtree(probe, ignore_errors=True)
 
@@ -172,9 +175,12 @@ def read_manifest(directory: Path) -> dict | None:
         manifest = json.loads((Path(directory) / MANIFEST).read_text())
     except (OSError, ValueError, UnicodeDecodeError):
         return None
-    if not isinstance(manifest, dict) or manifest.get("written_by") != "planbench" \
-            or not isinstance(manifest.get("files"), list) \
-            or not all(_safe_relative(f) for f in manifest["files"]):
+    if (
+        not isinstance(manifest, dict)
+        or manifest.get("written_by") != "planbench"
+        or not isinstance(manifest.get("files"), list)
+        or not all(_safe_relative(f) for f in manifest["files"])
+    ):
         return None
     return manifest
 
@@ -296,8 +302,7 @@ class _Target:
             except FileExistsError:
                 continue
             except OSError as e:
-                raise OutputError(f"{self.what} {self.path}: cannot create {d} "
-                                  f"({e.strerror or e})") from None
+                raise OutputError(f"{self.what} {self.path}: cannot create {d} ({e.strerror or e})") from None
             self._created.append(d)
 
 
@@ -365,8 +370,10 @@ class OutputRoot:
             raise OutputError(f"{self.what} {path} cannot be read ({e.strerror or e})") from None
         foreign = [n for n in names if n not in inner and not _written_by_planbench(path / n)]
         if foreign:
-            raise OutputError(f"{self.what} {path} holds files planbench did not write ({_shown(foreign)}); "
-                              f"choose another {option} or move them away")
+            raise OutputError(
+                f"{self.what} {path} holds files planbench did not write ({_shown(foreign)}); "
+                f"choose another {option} or move them away"
+            )
 
     def __str__(self) -> str:
         return str(self.path)
@@ -400,8 +407,7 @@ class OutputDir(_Target):
                 raise OutputError(f"{what} {path} exists and is not a directory")
             self._check_replaceable()
             if not os.access(path, os.W_OK | os.X_OK):
-                raise OutputError(f"{what} {path} cannot be replaced: it is not writable "
-                                  "(read-only or immutable)")
+                raise OutputError(f"{what} {path} cannot be replaced: it is not writable (read-only or immutable)")
         _probe(what, path)
 
     def _check_replaceable(self) -> None:
@@ -409,11 +415,13 @@ class OutputDir(_Target):
         if foreign is None:
             raise OutputError(
                 f"{self.what} {self.path} is not empty and planbench did not write it (no "
-                f"{MANIFEST}); choose another {self.option} or empty it yourself")
+                f"{MANIFEST}); choose another {self.option} or empty it yourself"
+            )
         if foreign:
             raise OutputError(
                 f"{self.what} {self.path} holds files planbench did not write "
-                f"({_shown(foreign)}); choose another {self.option} or move them away")
+                f"({_shown(foreign)}); choose another {self.option} or move them away"
+            )
 
     @contextlib.contextmanager
     def staging(self, info: dict | None = None):
@@ -428,10 +436,15 @@ class OutputDir(_Target):
             yield tmp
             with signals_deferred():
                 files = [f for f in _entries(tmp)[0] if f != STAGING_MARKER]
-                manifest = {"written_by": "planbench", "version": _version(), "kind": self.kind,
-                            "target": self.path.name, "files": sorted(files + [MANIFEST]),
-                            "written_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                            **(info or {})}
+                manifest = {
+                    "written_by": "planbench",
+                    "version": _version(),
+                    "kind": self.kind,
+                    "target": self.path.name,
+                    "files": sorted(files + [MANIFEST]),
+                    "written_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                    **(info or {}),
+                }
                 (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
                 (tmp / STAGING_MARKER).unlink()
                 _usual_mode(tmp, 0o777)
@@ -445,14 +458,15 @@ class OutputDir(_Target):
                     shutil.rmtree(tmp, ignore_errors=True)
             raise
 
-
     def _check_unchanged(self, tmp: Path) -> None:
         """Just before the swap: if files planbench did not write appeared in the target
         while it ran, keep them and the target as they are, move this run's output beside it
         (``TARGET.new-<UTC time>``) and refuse."""
         if not os.path.lexists(self.path):
             return
-        foreign = _foreign_entries(self.path) if self.path.is_dir() and not self.path.is_symlink() else ["(not a directory)"]
+        foreign = (
+            _foreign_entries(self.path) if self.path.is_dir() and not self.path.is_symlink() else ["(not a directory)"]
+        )
         if foreign is None or foreign:
             stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
             kept = self.path.with_name(f"{self.path.name}.new-{stamp}")
@@ -461,8 +475,10 @@ class OutputDir(_Target):
             (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
             os.rename(tmp, kept)
             what = "files planbench did not write" if foreign is None else f"{_shown(foreign)}"
-            raise OutputError(f"{self.what} {self.path} gained {what} during the run; it was left "
-                              f"as it is and this run's output is in {kept}")
+            raise OutputError(
+                f"{self.what} {self.path} gained {what} during the run; it was left "
+                f"as it is and this run's output is in {kept}"
+            )
 
 
 def _remove_all_but(folder: Path, keep: tuple) -> None:
@@ -547,8 +563,11 @@ def _owned_leftover(entry: Path, target_name: str) -> bool:
             content = json.loads((entry / marker).read_text())
         except (OSError, ValueError, UnicodeDecodeError):
             continue
-        if isinstance(content, dict) and content.get("written_by") == "planbench" \
-                and content.get("target") == target_name:
+        if (
+            isinstance(content, dict)
+            and content.get("written_by") == "planbench"
+            and content.get("target") == target_name
+        ):
             return True
     return False
 
@@ -565,8 +584,7 @@ def remove_leftovers(target: Path) -> list[Path]:
     removed = []
     with contextlib.suppress(OSError):
         for entry in target.parent.iterdir():
-            if not entry.name.startswith((STAGING_PREFIX, PROBE_PREFIX)) or entry.is_symlink() \
-                    or not entry.is_dir():
+            if not entry.name.startswith((STAGING_PREFIX, PROBE_PREFIX)) or entry.is_symlink() or not entry.is_dir():
                 continue
             if _owned_leftover(entry, target.name):
                 if (entry / STAGING_MARKER).exists() or entry.name.startswith(PROBE_PREFIX):
@@ -588,8 +606,13 @@ def partial_log(target: Path, name: str = "log.arrow") -> Path | None:
     found = []
     with contextlib.suppress(OSError):
         for entry in target.parent.iterdir():
-            if entry.name.startswith(STAGING_PREFIX) and not entry.is_symlink() and entry.is_dir() \
-                    and (entry / STAGING_MARKER).is_file() and _owned_leftover(entry, target.name):
+            if (
+                entry.name.startswith(STAGING_PREFIX)
+                and not entry.is_symlink()
+                and entry.is_dir()
+                and (entry / STAGING_MARKER).is_file()
+                and _owned_leftover(entry, target.name)
+            ):
                 log = entry / name
                 if log.is_file() and not log.is_symlink():
                     found.append((log.stat().st_mtime, log))
@@ -614,8 +637,10 @@ def _acquire_lock(target: Path, what: str, option: str) -> int:
         except BlockingIOError:
             holder = os.pread(fd, 64, 0).decode(errors="replace").strip() or "?"
             os.close(fd)
-            raise OutputError(f"{what} {target} is being written by another planbench run "
-                              f"(pid {holder}); wait for it or choose another {option}") from None
+            raise OutputError(
+                f"{what} {target} is being written by another planbench run "
+                f"(pid {holder}); wait for it or choose another {option}"
+            ) from None
         # The file may have been unlinked by the previous holder between open and flock.
         try:
             same = os.stat(path).st_ino == os.fstat(fd).st_ino
@@ -644,22 +669,24 @@ class VideoFile(_Target):
 
     what = "video"
 
-    def __init__(self, raw, out_dir: OutputDir | None = None, reserved_names=RUN_FILES,
-                 option: str = "--video"):
+    def __init__(self, raw, out_dir: OutputDir | None = None, reserved_names=RUN_FILES, option: str = "--video"):
         super().__init__(raw, option)
         self.relative: Path | None = None
         self._staged: Path | None = None
         path = self.path
         if path.suffix.lower() not in VIDEO_SUFFIXES:
-            raise OutputError(f"video {path}: suffix {path.suffix or '(none)'!r} is not one of "
-                              f"{', '.join(VIDEO_SUFFIXES)} (H.264 containers ffmpeg writes)")
+            raise OutputError(
+                f"video {path}: suffix {path.suffix or '(none)'!r} is not one of "
+                f"{', '.join(VIDEO_SUFFIXES)} (H.264 containers ffmpeg writes)"
+            )
         if out_dir is not None and path.is_relative_to(out_dir.path):
             if path == out_dir.path:
                 raise OutputError(f"video {path} is the output directory itself")
             relative = path.relative_to(out_dir.path)
             if relative.parts[0] in reserved_names or relative.parts[0] == MANIFEST:
-                raise OutputError(f"video {path} would overwrite the run's own "
-                                  f"{relative.parts[0]}; choose another name")
+                raise OutputError(
+                    f"video {path} would overwrite the run's own {relative.parts[0]}; choose another name"
+                )
             _check_lengths(self.what, out_dir.path, len(os.fsencode(str(relative))))
             self.relative = relative
             return
@@ -672,8 +699,9 @@ class VideoFile(_Target):
             if not path.is_file():
                 raise OutputError(f"video {path} exists and is not a regular file")
             if not is_planbench_video(path):
-                raise OutputError(f"video {path} exists and planbench did not write it; "
-                                  f"choose another {option} or remove it yourself")
+                raise OutputError(
+                    f"video {path} exists and planbench did not write it; choose another {option} or remove it yourself"
+                )
         _probe(self.what, path)
 
     @property
@@ -710,7 +738,8 @@ class VideoFile(_Target):
             _usual_mode(rendered, 0o666)
             # Checked again: a file of someone else's may have appeared there during the run.
             taken = os.path.lexists(self.path) and (
-                os.path.islink(self.path) or not self.path.is_file() or not is_planbench_video(self.path))
+                os.path.islink(self.path) or not self.path.is_file() or not is_planbench_video(self.path)
+            )
             if taken:
                 stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
                 kept = self.path.with_name(f"{self.path.stem}.new-{stamp}{self.path.suffix}")
@@ -720,8 +749,10 @@ class VideoFile(_Target):
             shutil.rmtree(self._staged, ignore_errors=True)
             self._staged = None
         if taken:
-            raise OutputError(f"video {self.path} appeared during the run and planbench did not "
-                              f"write it; it was left as it is and this run's video is {kept}")
+            raise OutputError(
+                f"video {self.path} appeared during the run and planbench did not "
+                f"write it; it was left as it is and this run's video is {kept}"
+            )
 
     def discard(self) -> None:
         if self._staged is not None:
@@ -735,8 +766,11 @@ def is_planbench_video(path: Path) -> bool:
     import imageio_ffmpeg
 
     try:
-        proc = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-nostdin",
-                               "-i", str(path)], capture_output=True, timeout=30)
+        proc = subprocess.run(
+            [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-nostdin", "-i", str(path)],
+            capture_output=True,
+            timeout=30,
+        )
     except (OSError, subprocess.TimeoutExpired):
         return False
     text = proc.stderr.decode(errors="replace")
@@ -755,8 +789,13 @@ def software_versions() -> dict:
         planbench = importlib.metadata.version("planbench")
     except importlib.metadata.PackageNotFoundError:
         planbench = "not installed"
-    return {"planbench": planbench, "python": platform.python_version(), "mujoco": mujoco.__version__,
-            "numpy": np.__version__, "scipy": scipy.__version__}
+    return {
+        "planbench": planbench,
+        "python": platform.python_version(),
+        "mujoco": mujoco.__version__,
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+    }
 
 
 def read_log(path):
@@ -800,7 +839,7 @@ class _StridedLog:
 
     def parts(self):
         for start, part in self.log.chunks([self.name]):
-            yield np.ascontiguousarray(part[self.name][-start % self.stride::self.stride])
+            yield np.ascontiguousarray(part[self.name][-start % self.stride :: self.stride])
 
 
 def save_timeseries(path, arrays: dict) -> None:
@@ -813,16 +852,26 @@ def save_timeseries(path, arrays: dict) -> None:
         for name, value in arrays.items():
             with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
                 if isinstance(value, _StridedLog):
-                    npy.write_array_header_1_0(member, {"descr": npy.dtype_to_descr(np.dtype(float)),
-                                                        "fortran_order": False, "shape": value.shape})
+                    npy.write_array_header_1_0(
+                        member,
+                        {"descr": npy.dtype_to_descr(np.dtype(float)), "fortran_order": False, "shape": value.shape},
+                    )
                     for part in value.parts():
                         member.write(part.tobytes())
                 else:
                     npy.write_array(member, np.asanyarray(value), allow_pickle=True)
 
 
-def write_run(result, setup, out_dir, video=None, camera: str = "overview",
-              quiet: bool = True, more_videos: tuple = (), staging: Path | None = None) -> dict:
+def write_run(
+    result,
+    setup,
+    out_dir,
+    video=None,
+    camera: str = "overview",
+    quiet: bool = True,
+    more_videos: tuple = (),
+    staging: Path | None = None,
+) -> dict:
     """Write summary.json, timeseries.npz, report.png (and the video) of ``result``.
 
     ``staging``: the staging directory of ``out_dir`` the caller holds (``planbench.pipeline``
@@ -848,22 +897,33 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
         if video is not None and not video.is_reserved:
             stack.enter_context(video.reserved())
         try:
-            held = contextlib.nullcontext(staging) if staging is not None else \
-                target.staging({"scenario": result.scenario})
+            held = (
+                contextlib.nullcontext(staging)
+                if staging is not None
+                else target.staging({"scenario": result.scenario})
+            )
             with held as tmp:
                 summary = summary_dict(result)
                 log_file = getattr(result.log, "file", None)
                 if log_file is not None and not (tmp / "log.arrow").exists():
                     log_file.copy_to(tmp / "log.arrow")  # streamed elsewhere (a run not staged here)
                 if log_file is not None:
-                    summary["log"] = {"path": "log.arrow", "ticks": log_file.n, "complete": log_file.complete,
-                                      "chunks": log_file.num_chunks}
+                    summary["log"] = {
+                        "path": "log.arrow",
+                        "ticks": log_file.n,
+                        "complete": log_file.complete,
+                        "chunks": log_file.num_chunks,
+                    }
                 log = result.log
                 stride = setup.output.output_stride
                 names = ("t", "qpos", "qvel", "ctrl", "act", "actuator_force", "sensordata")
                 if hasattr(log, "every"):  # from the log file (save_timeseries copies a chunk at a time)
-                    arrays = {name: log.every(name, stride) if log.file is None or log.held(name)
-                              else _StridedLog(log, name, stride) for name in names}
+                    arrays = {
+                        name: log.every(name, stride)
+                        if log.file is None or log.held(name)
+                        else _StridedLog(log, name, stride)
+                        for name in names
+                    }
                     t_every = log.every("t", stride)
                 else:
                     arrays = {name: getattr(log, name)[::stride] for name in names}
@@ -893,7 +953,8 @@ def write_run(result, setup, out_dir, video=None, camera: str = "overview",
                 for name, extra_camera in more_videos:
                     frames = render_video(setup.physics.model.ptr, log, tmp / name, camera=extra_camera, **render)
                     summary.setdefault("more_videos", []).append(
-                        {"path": str(target.path / name), "frames": frames, "camera": extra_camera})
+                        {"path": str(target.path / name), "frames": frames, "camera": extra_camera}
+                    )
                 (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         except BaseException:
             if video is not None:

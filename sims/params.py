@@ -75,14 +75,40 @@ class Declared:
     high_open: bool = False
 
 
-def param(default, help: str, unit="", low=None, high=None, reason: str = "", choices=None,
-          length: int | None = None, min_items: int | None = None, max_items: int | None = None,
-          excludes: tuple = (), path: bool = False, low_open: bool = False, high_open: bool = False):
+def param(
+    default,
+    help: str,
+    unit="",
+    low=None,
+    high=None,
+    reason: str = "",
+    choices=None,
+    length: int | None = None,
+    min_items: int | None = None,
+    max_items: int | None = None,
+    excludes: tuple = (),
+    path: bool = False,
+    low_open: bool = False,
+    high_open: bool = False,
+):
     """A declared field of a ``Params`` dataclass (see ``Declared``; ``path``: a file name,
     which a scenario file's relative value names from the file's own directory;
     ``low_open``, ``high_open``: the bound itself is outside, as for a period that must be > 0)."""
-    declared = Declared(help, unit, low, high, reason, None if choices is None else tuple(choices), length,
-                        min_items, max_items, tuple(excludes), path, low_open, high_open)
+    declared = Declared(
+        help,
+        unit,
+        low,
+        high,
+        reason,
+        None if choices is None else tuple(choices),
+        length,
+        min_items,
+        max_items,
+        tuple(excludes),
+        path,
+        low_open,
+        high_open,
+    )
     return field(default=default, metadata={"declared": declared})
 
 
@@ -107,14 +133,16 @@ def _bound(bound, column: int | None):
 
 
 def range_text(declared: Declared, column: int | None = None) -> str:
-    """"[lo, hi] unit", "one of a, b", "" for the help and the errors."""
+    """ "[lo, hi] unit", "one of a, b", "" for the help and the errors."""
     if declared.choices is not None:
         return "one of " + ", ".join(str(c) for c in declared.choices)
     low, high = _bound(declared.low, column), _bound(declared.high, column)
     if isinstance(declared.low, tuple) and column is None:
         units = declared.unit if isinstance(declared.unit, tuple) else (declared.unit,) * len(declared.low)
         return "per column " + ", ".join(
-            f"[{_g(lo)}, {_g(hi)}]" + (f" {u}" if u else "") for lo, hi, u in zip(declared.low, declared.high, units, strict=True))
+            f"[{_g(lo)}, {_g(hi)}]" + (f" {u}" if u else "")
+            for lo, hi, u in zip(declared.low, declared.high, units, strict=True)
+        )
     if low is None and high is None:
         return ""
     unit = f" {unit_of(declared, column)}" if unit_of(declared, column) else ""
@@ -122,8 +150,7 @@ def range_text(declared: Declared, column: int | None = None) -> str:
 
 
 def _interval(declared: Declared, low, high) -> str:
-    return (f"{'(' if declared.low_open else '['}{_g(low)}, {_g(high)}"
-            f"{')' if declared.high_open else ']'}")
+    return f"{'(' if declared.low_open else '['}{_g(low)}, {_g(high)}{')' if declared.high_open else ']'}"
 
 
 def _g(bound) -> str:
@@ -203,9 +230,11 @@ def _convert(kind: _Type, value, key: str, declared: Declared, column: int | Non
             unset = ""
             if kind.optional and value.strip().lower() in ("none", "null"):
                 # A typed value (a scenario file's) is never parsed: "none" is the flag syntax.
-                unset = (f"; to leave {key} unset, omit it from the file"
-                         + (f" (and give {', '.join(declared.excludes)})" if declared.excludes else "")
-                         + f" or pass --set {key}=none")
+                unset = (
+                    f"; to leave {key} unset, omit it from the file"
+                    + (f" (and give {', '.join(declared.excludes)})" if declared.excludes else "")
+                    + f" or pass --set {key}=none"
+                )
             raise ParamError(f"{key} = {value!r} is not {range_text(declared)}{unset}")
         return value
     if kind.kind == "nested":
@@ -307,12 +336,14 @@ class Params:
     def to_dict(self) -> dict:
         """Every field, JSON- and TOML-ready (tuples as lists, nested tables as dicts; None
         stays None in JSON and is left out of TOML)."""
+
         def plain(v):
             if isinstance(v, Params):
                 return v.to_dict()
             if isinstance(v, tuple):
                 return [plain(x) for x in v]
             return v
+
         return {f.name: plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
 
     #: Parameters that had another name: {old name: its name now} (an old name in a file or
@@ -320,7 +351,7 @@ class Params:
     RENAMED: ClassVar[dict[str, str]] = {}  # a ClassVar: no dataclass field
 
     @classmethod
-    def from_mapping(cls, mapping: dict, base: "Params | None" = None, prefix: str = "") -> "Params":
+    def from_mapping(cls, mapping: dict, base: Params | None = None, prefix: str = "") -> Params:
         """``base`` (default: the declared defaults) with the keys of ``mapping`` replaced.
 
         An unknown key, a value of the wrong type or out of its range is a ParamError naming
@@ -331,8 +362,10 @@ class Params:
         names = cls.names()
         unknown = [k for k in mapping if k not in names]
         if unknown:
-            raise ParamError(f"unknown parameter '{prefix}{unknown[0]}'{_renamed(cls, unknown[0])}; "
-                             f"{cls.__name__} has: {', '.join(names)}")
+            raise ParamError(
+                f"unknown parameter '{prefix}{unknown[0]}'{_renamed(cls, unknown[0])}; "
+                f"{cls.__name__} has: {', '.join(names)}"
+            )
         values = {} if base is None else {n: getattr(base, n) for n in names}
         declared = {n: d for n, _, d, _ in cls.declarations()}
         kinds = {n: k for n, k, _, _ in cls.declarations()}
@@ -352,7 +385,7 @@ class Params:
                 raise ParamError(f"{prefix}{e}") from None
             raise
 
-    def replace(self, **changes) -> "Params":
+    def replace(self, **changes) -> Params:
         """A copy with ``changes`` (as ``from_mapping``: validated, exclusions applied)."""
         return type(self).from_mapping(changes, base=self)
 
@@ -361,8 +394,13 @@ class Params:
 class ScenarioParams(Params):
     """The parameters of a run: the seed, then each mechanism's and scenario's fields."""
 
-    seed: int = param(0, "seed of every random process of the run (disturbances, noise)", low=0,
-                      high=2**63 - 1, reason="numpy's SeedSequence takes non-negative 64-bit integers")
+    seed: int = param(
+        0,
+        "seed of every random process of the run (disturbances, noise)",
+        low=0,
+        high=2**63 - 1,
+        reason="numpy's SeedSequence takes non-negative 64-bit integers",
+    )
 
     def log_bytes_per_tick(self) -> float:
         """Bytes a run of these parameters holds per control tick: the runner's log and what
@@ -400,11 +438,16 @@ class PlantParams(Params):
         if drives != "ideal":
             return
         nominal = type(self)()
-        given = [f"{name} = {getattr(self, name)!r}" for name in self.AS_BUILT_FIELDS
-                 if getattr(self, name) != getattr(nominal, name)]
+        given = [
+            f"{name} = {getattr(self, name)!r}"
+            for name in self.AS_BUILT_FIELDS
+            if getattr(self, name) != getattr(nominal, name)
+        ]
         if given:
-            raise ParamError(f"plant {', '.join(given)}: an error of the drive trains as built; "
-                             "the ideal drives have none (drives = as-built)")
+            raise ParamError(
+                f"plant {', '.join(given)}: an error of the drive trains as built; "
+                "the ideal drives have none (drives = as-built)"
+            )
 
 
 @typing.no_type_check
@@ -413,9 +456,12 @@ def field_types(cls) -> dict:
     cache = cls.__dict__.get("_parsed_hints")
     if cache is None:
         fields = {f.name for f in dataclasses.fields(cls)}
-        cache = {name: _Type(t) for name, t in typing.get_type_hints(cls).items()
-                 if name in fields and not name.startswith("_")}
-        setattr(cls, "_parsed_hints", cache)
+        cache = {
+            name: _Type(t)
+            for name, t in typing.get_type_hints(cls).items()
+            if name in fields and not name.startswith("_")
+        }
+        cls._parsed_hints = cache
     return cache
 
 
@@ -429,12 +475,15 @@ def _one_toml_value(text: str, shown: str):
     try:
         document = tomllib.loads(f"v = {text}")
     except RecursionError:
-        raise ParamError(f"{shown}: a value nested too deep to read (lists or tables within "
-                         "one another, thousands of levels)") from None
+        raise ParamError(
+            f"{shown}: a value nested too deep to read (lists or tables within one another, thousands of levels)"
+        ) from None
     if len(document) > 1:
         extra = next(k for k in document if k != "v")
-        raise ParamError(f"{shown} = {text!r} holds a line break and then {extra!r}: give one value per "
-                         "option (a second key needs its own --set)")
+        raise ParamError(
+            f"{shown} = {text!r} holds a line break and then {extra!r}: give one value per "
+            "option (a second key needs its own --set)"
+        )
     return document["v"]
 
 
@@ -495,8 +544,10 @@ def set_overrides(cls: type[Params], assignments: list[str], prefix: str = "") -
             out.setdefault(head, {}).update(inner)
             continue
         if key not in hints:
-            raise ParamError(f"--set: unknown parameter {prefix + key!r}{_renamed(cls, key)}; "
-                             f"{cls.__name__} has: {', '.join(cls.names())}")
+            raise ParamError(
+                f"--set: unknown parameter {prefix + key!r}{_renamed(cls, key)}; "
+                f"{cls.__name__} has: {', '.join(cls.names())}"
+            )
         out[key] = parse_value(hints[key], value, f"--set {prefix}{key}")
     return out
 
@@ -522,7 +573,7 @@ def describe(kind: _Type, declared: Declared, default) -> str:
 
 
 def _renamed(cls, key: str) -> str:
-    """", now NEW" for a parameter that was renamed (``Params.RENAMED``), else ""."""
+    """ ", now NEW" for a parameter that was renamed (``Params.RENAMED``), else ""."""
     new = getattr(cls, "RENAMED", {}).get(key)
     return f" (its name is now {new!r})" if new else ""
 
@@ -555,8 +606,11 @@ def readme_tables() -> str:
         tables = [(name, k.cls) for name, k, _, _ in cls.declarations() if k.kind == "nested"]
         parts.append(f"#### `{cls.__name__}`: {', '.join(f'`{n}`' for n in names)}\n\n{markdown_table(cls)}")
         parts += [f"Each of `{cls.__name__}`'s list items, `{c.__name__}`:\n\n{markdown_table(c)}" for c in nested]
-        parts += [f"`{cls.__name__}`'s table `{key}`, `{c.__name__}` (`--set {key}.KEY=VALUE`):\n\n{markdown_table(c)}"
-                  for key, c in tables if f"`{c.__name__}`" not in "\n".join(parts)]
+        parts += [
+            f"`{cls.__name__}`'s table `{key}`, `{c.__name__}` (`--set {key}.KEY=VALUE`):\n\n{markdown_table(c)}"
+            for key, c in tables
+            if f"`{c.__name__}`" not in "\n".join(parts)
+        ]
     return "\n\n".join(parts)
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import tempfile
-from typing import Callable
+from collections.abc import Callable
 
 from planbench import run_limits, runner
 from planbench.logfile import LOG_FILE
@@ -23,10 +23,23 @@ def build(scenario, params, plant=None, planner=None, controller=None) -> runner
     return scenario.build(params, planner=planner, controller=controller, **extra)
 
 
-def execute(scenario, params, plant=None, *, plugins: dict | None = None, planner=None, controller=None,
-            out=None, video=None, camera: str | None = None, more_videos: tuple = (), quiet: bool = True,
-            profile: bool = False, on_built: Callable | None = None,
-            on_judged: Callable | None = None) -> tuple[runner.Setup, runner.RunResult]:
+def execute(
+    scenario,
+    params,
+    plant=None,
+    *,
+    plugins: dict | None = None,
+    planner=None,
+    controller=None,
+    out=None,
+    video=None,
+    camera: str | None = None,
+    more_videos: tuple = (),
+    quiet: bool = True,
+    profile: bool = False,
+    on_built: Callable | None = None,
+    on_judged: Callable | None = None,
+) -> tuple[runner.Setup, runner.RunResult]:
     """Build, run and (with ``out``) write one run of ``scenario``; returns (setup, result).
 
     Args:
@@ -71,8 +84,16 @@ def execute(scenario, params, plant=None, *, plugins: dict | None = None, planne
         if on_judged is not None:
             on_judged(result)
         supervise.phase("writing the outputs (planbench's own code)")
-        outputs.write_run(result, setup, target, video=video, camera=camera or scenario.camera, quiet=quiet,
-                          more_videos=more_videos, staging=tmp)
+        outputs.write_run(
+            result,
+            setup,
+            target,
+            video=video,
+            camera=camera or scenario.camera,
+            quiet=quiet,
+            more_videos=more_videos,
+            staging=tmp,
+        )
     return setup, result
 
 
@@ -89,5 +110,4 @@ def check_log_space(setup: runner.Setup, params, directory) -> None:
         return
     task = setup.task
     where = tempfile.gettempdir() if directory is None else directory
-    run_limits.check_duration(float(task.duration), task.control_dt, bytes_per_tick,
-                              run_limits.log_space_limit(where))
+    run_limits.check_duration(float(task.duration), task.control_dt, bytes_per_tick, run_limits.log_space_limit(where))

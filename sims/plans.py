@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from planbench.planners.trajectory import control_ticks
 from planbench.outputs import OutputDir
+from planbench.planners.trajectory import control_ticks
 from planbench.report import plan_plot
 
 PLAN_DT = 0.001  # s, sampling of plan.npz and the plot
@@ -24,16 +24,28 @@ def write_plan(scenario, out_dir, params=None) -> Path:
     sample = trajectory.sample(control_ticks(trajectory.duration, dt))
     kinds = scenario.kinds()
     with target.staging({"scenario": scenario.name}) as tmp:
-        arrays = dict(t=sample.t, position=sample.position, velocity=sample.velocity,
-                      acceleration=sample.acceleration, labels=np.array(trajectory.labels),
-                      kinds=np.array(kinds))
+        arrays = dict(
+            t=sample.t,
+            position=sample.position,
+            velocity=sample.velocity,
+            acceleration=sample.acceleration,
+            labels=np.array(trajectory.labels),
+            kinds=np.array(kinds),
+        )
         key_times = getattr(trajectory, "key_times", None)
         key_points = getattr(trajectory, "key_points", None)
         if key_times is not None:
             arrays.update(key_times=key_times, key_points=key_points)
         np.savez_compressed(tmp / "plan.npz", **arrays)
-        plan_plot(sample, trajectory.labels, kinds, tmp / "plan.png",
-                  title=f"{scenario.name}: planned motion", key_times=key_times, key_points=key_points)
+        plan_plot(
+            sample,
+            trajectory.labels,
+            kinds,
+            tmp / "plan.png",
+            title=f"{scenario.name}: planned motion",
+            key_times=key_times,
+            key_points=key_points,
+        )
         if scenario.plan_extras is not None:
             scenario.plan_extras(trajectory, tmp)
     return target.path

@@ -11,8 +11,9 @@ import mujoco
 import numpy as np
 
 
-def set_inertial(spec: mujoco.MjSpec, nominal: mujoco.MjModel, body: str, mass_factor: float = 1.0,
-                 com_shift=None) -> None:
+def set_inertial(
+    spec: mujoco.MjSpec, nominal: mujoco.MjModel, body: str, mass_factor: float = 1.0, com_shift=None
+) -> None:
     """Give ``body`` of ``spec`` an explicit inertial: the compiled ``nominal`` model's mass
     (kg) and inertia about the centre of mass (kg m^2) times ``mass_factor``, the same
     principal axes, the centre of mass moved by ``com_shift`` (3,) m in the body frame.

@@ -19,7 +19,6 @@ from pathlib import Path
 from planbench import supervise
 from planbench.task import PluginError, _callable_with, check_controller, check_planner, fault_text
 
-
 #: The top-level names planbench's modules had before they moved under ``planbench`` (0.2.0),
 #: with their names now: a plug-in that imports an old name is told the new one in one line.
 #: To be dropped in the release after 0.2.0.
@@ -32,8 +31,10 @@ def _old_name_text(error: ModuleNotFoundError) -> str | None:
     if top not in OLD_NAMES:
         return None
     new = OLD_NAMES[top]
-    return (f"it imports {error.name!r}, a name of planbench's modules before 0.2.0: import "
-            f"{new!r} instead ({top}.X is {new}.X)")
+    return (
+        f"it imports {error.name!r}, a name of planbench's modules before 0.2.0: import "
+        f"{new!r} instead ({top}.X is {new}.X)"
+    )
 
 
 def is_file(module_name: str) -> bool:
@@ -45,8 +46,10 @@ def split_spec(spec: str, role: str) -> tuple[str, str]:
     """(MODULE, FACTORY) of ``MODULE:FACTORY``; PluginError otherwise."""
     module_name, sep, attribute = spec.rpartition(":")
     if not sep or not module_name or not attribute:
-        raise PluginError(f"--{role} {spec!r} must be MODULE:FACTORY (a module or .py file, a colon, "
-                          "and the callable that makes the object)")
+        raise PluginError(
+            f"--{role} {spec!r} must be MODULE:FACTORY (a module or .py file, a colon, "
+            "and the callable that makes the object)"
+        )
     return module_name, attribute
 
 
@@ -81,8 +84,9 @@ def _module(name: str, role: str):
         old = _old_name_text(e)
         if old:
             raise PluginError(f"--{role} {name}: {old}") from None
-        raise PluginError(f"--{role} {name}: no module named {e.name!r} (give an importable module or a "
-                          "path to a .py file)") from None
+        raise PluginError(
+            f"--{role} {name}: no module named {e.name!r} (give an importable module or a path to a .py file)"
+        ) from None
     except (Exception, SystemExit) as e:
         raise PluginError(f"--{role} {name}: importing it raised {fault_text(e)}") from None
 

@@ -34,9 +34,18 @@ def frame_ticks(t: np.ndarray, speed: float, fps: int = FPS) -> np.ndarray:
     return np.clip(np.searchsorted(t, frame_times - 1e-9), 0, t.size - 1)
 
 
-def render_video(model: mujoco.MjModel, log, path, camera: str = "overview", speed: float = 1.0,
-                 width: int = WIDTH, height: int = HEIGHT, fps: int = FPS, quiet: bool = True,
-                 frame_qpos=None) -> int:
+def render_video(
+    model: mujoco.MjModel,
+    log,
+    path,
+    camera: str = "overview",
+    speed: float = 1.0,
+    width: int = WIDTH,
+    height: int = HEIGHT,
+    fps: int = FPS,
+    quiet: bool = True,
+    frame_qpos=None,
+) -> int:
     """Write the run ``log`` as an H.264 video at ``path``; returns the number of frames.
 
     ``frame_qpos``: optional (log, ticks) -> (len(ticks), nq) states to show instead of the
@@ -56,10 +65,12 @@ def render_video(model: mujoco.MjModel, log, path, camera: str = "overview", spe
     renderer = mujoco.Renderer(model, height=height, width=width)
     try:
         # The tag is planbench's proof that it may replace this file later (planbench.outputs).
-        with mediapy.VideoWriter(path, shape=(height, width), fps=fps, codec="h264", qp=20,
-                                 ffmpeg_args=["-metadata", f"comment={VIDEO_TAG}"]) as writer:
-            for frame, i in enumerate(tqdm(ticks, unit="frame", disable=quiet, delay=2.0,
-                                           leave=False, desc="rendering")):
+        with mediapy.VideoWriter(
+            path, shape=(height, width), fps=fps, codec="h264", qp=20, ffmpeg_args=["-metadata", f"comment={VIDEO_TAG}"]
+        ) as writer:
+            for frame, i in enumerate(
+                tqdm(ticks, unit="frame", disable=quiet, delay=2.0, leave=False, desc="rendering")
+            ):
                 data.qpos[:] = qpos[frame]
                 data.qvel[:] = log.qvel[i]
                 if model.nmocap:

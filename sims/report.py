@@ -55,9 +55,16 @@ def checks_text(checks) -> str:
 
 def finish(fig, axes, text_ax, checks, path, top: bool) -> None:
     """Checks in a box on ``text_ax``, grids, layout, save at 90 dpi, close."""
-    text_ax.text(0.02, 0.97 if top else 0.03, checks_text(checks), transform=text_ax.transAxes,
-                 va="top" if top else "bottom", fontsize=7, family="monospace",
-                 bbox=dict(facecolor="white", alpha=0.8))
+    text_ax.text(
+        0.02,
+        0.97 if top else 0.03,
+        checks_text(checks),
+        transform=text_ax.transAxes,
+        va="top" if top else "bottom",
+        fontsize=7,
+        family="monospace",
+        bbox=dict(facecolor="white", alpha=0.8),
+    )
     for a in axes.flat:
         a.grid(alpha=0.3)
     fig.tight_layout()

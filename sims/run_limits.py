@@ -37,8 +37,9 @@ from planbench.params import ParamError
 #: Angle options are refused beyond +- this, deg (one turn either way).
 ANGLE_LIMIT_DEG = 360.0
 #: The range of an angle parameter (``planbench.params.param`` keywords).
-ANGLE = dict(unit="deg", low=-ANGLE_LIMIT_DEG, high=ANGLE_LIMIT_DEG,
-             reason="one turn either way; angles are not wrapped")
+ANGLE = dict(
+    unit="deg", low=-ANGLE_LIMIT_DEG, high=ANGLE_LIMIT_DEG, reason="one turn either way; angles are not wrapped"
+)
 
 _BYTES_PER_FLOAT = 8
 
@@ -76,8 +77,7 @@ def format_bytes(n: float) -> str:
         return "more than 1e308 B"
     if n >= 2**70:
         return f"{n:.2g} B"
-    for unit, scale in (("EiB", 2**60), ("PiB", 2**50), ("TiB", 2**40), ("GiB", 2**30),
-                        ("MiB", 2**20), ("KiB", 2**10)):
+    for unit, scale in (("EiB", 2**60), ("PiB", 2**50), ("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
         if n >= scale:
             v = n / scale
             return f"{v:.0f} {unit}" if v >= 10 else f"{v:.2g} {unit}"
@@ -90,8 +90,7 @@ def runlog_floats_per_tick(model, channels: int) -> int:
     (3 + 4 per mocap body), streamed to the log file, and what stays in memory per tick:
     the reference's position, velocity and acceleration (``channels`` each) and two arrays of
     the ticks' times (the reference's t, the episode's)."""
-    return (3 + model.nq + model.nv + model.na + 2 * model.nu + model.nsensordata
-            + 7 * model.nmocap + 3 * channels)
+    return 3 + model.nq + model.nv + model.na + 2 * model.nu + model.nsensordata + 7 * model.nmocap + 3 * channels
 
 
 def floats(n: float) -> float:
@@ -99,8 +98,9 @@ def floats(n: float) -> float:
     return _BYTES_PER_FLOAT * n
 
 
-def check_duration(duration: float | None, control_dt: float, bytes_per_tick: float,
-                   limit: tuple[float, str] | None = None) -> float | None:
+def check_duration(
+    duration: float | None, control_dt: float, bytes_per_tick: float, limit: tuple[float, str] | None = None
+) -> float | None:
     """The duration (s) if it is at least one control tick and its log fits the disk-space limit;
     a RunLimitError naming the value and the limit otherwise.
 
@@ -117,14 +117,16 @@ def check_duration(duration: float | None, control_dt: float, bytes_per_tick: fl
     if not math.isfinite(duration):
         raise RunLimitError(f"duration {duration!r} s is not finite")
     if duration < control_dt * (1.0 - 1e-9):
-        raise RunLimitError(f"duration {duration:g} s is shorter than one control tick "
-                            f"({control_dt * 1e3:g} ms): nothing would be simulated")
+        raise RunLimitError(
+            f"duration {duration:g} s is shorter than one control tick "
+            f"({control_dt * 1e3:g} ms): nothing would be simulated"
+        )
     limit_bytes, why = log_space_limit() if limit is None else limit
     need = (duration / control_dt + 1.0) * bytes_per_tick  # ticks, to within one
     if need > limit_bytes:
-        raise RunLimitError(f"duration {duration:g} s needs {'' if math.isinf(need) else '~'}"
-                            f"{format_bytes(need)} of log, more "
-                            f"than the limit of {format_bytes(limit_bytes)} ({why})")
+        raise RunLimitError(
+            f"duration {duration:g} s needs {'' if math.isinf(need) else '~'}"
+            f"{format_bytes(need)} of log, more "
+            f"than the limit of {format_bytes(limit_bytes)} ({why})"
+        )
     return duration
-
-

@@ -30,19 +30,42 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from planbench.planners.trajectory import ChunkedSample, Trajectory, TrajectorySample, control_ticks
-from planbench.checks import Check, controller_check, divergence_check
 from planbench import supervise
-from planbench.logfile import (CHUNK_TICKS, LOG_FILE, ChunkWriter, LogFile, model_shapes, read_log, remove_quietly,
-                           temporary_writer)
-from planbench.task import (Components, ControlContext, Disturbance, Output, PluginError, Provenance, Task,
-                       check_controller, check_first_command, fault_text, sample_checked)
+from planbench.checks import Check, controller_check, divergence_check
+from planbench.logfile import (
+    CHUNK_TICKS,
+    LOG_FILE,
+    ChunkWriter,
+    LogFile,
+    model_shapes,
+    read_log,
+    remove_quietly,
+    temporary_writer,
+)
+from planbench.planners.trajectory import ChunkedSample, TrajectorySample
+from planbench.task import (
+    Components,
+    ControlContext,
+    Output,
+    PluginError,
+    Provenance,
+    Task,
+    check_controller,
+    check_first_command,
+    fault_text,
+    sample_checked,
+)
 
 #: The arrays of MuJoCo's state that the log records with one ``mj_getState`` a tick, in its
 #: order (``STATE_SPEC``): a row of the log's buffer block (``ChunkWriter(block=...)``).
 STATE_ARRAYS = ("qpos", "qvel", "act", "mocap_pos", "mocap_quat")
-STATE_SPEC = int(mujoco.mjtState.mjSTATE_QPOS | mujoco.mjtState.mjSTATE_QVEL | mujoco.mjtState.mjSTATE_ACT
-                 | mujoco.mjtState.mjSTATE_MOCAP_POS | mujoco.mjtState.mjSTATE_MOCAP_QUAT)
+STATE_SPEC = int(
+    mujoco.mjtState.mjSTATE_QPOS
+    | mujoco.mjtState.mjSTATE_QVEL
+    | mujoco.mjtState.mjSTATE_ACT
+    | mujoco.mjtState.mjSTATE_MOCAP_POS
+    | mujoco.mjtState.mjSTATE_MOCAP_QUAT
+)
 
 #: How often (in control ticks) the loop scans for divergence: NaN or inf in the logged
 #: state since the last scan, and MuJoCo's warning counters (its bad-qacc detection resets the
@@ -101,7 +124,8 @@ class RunLog:
     Arrays: t (n,), qpos, qvel, act, ctrl, actuator_force, sensordata (n, size), mocap_pos
     and mocap_quat (n, nmocap, 3|4) when the model has mocap bodies. ``reference`` is the
     planned motion sampled at ``t`` (of a simulated run, a ``ChunkedSample``: its ``rows``
-    sample a chunk of ticks, its arrays are sampled whole when first read). ``ctrl`` row i holds the controls applied from ``t[i]``;
+    sample a chunk of ticks, its arrays are sampled whole when first read). ``ctrl`` row i holds the controls
+    applied from ``t[i]``;
     the last row, after which no physics runs, the controls still held there. ``contacts``
     lists (tick, geom1, geom2, distance) of every contact seen at a tick's end. ``n`` may be
     shorter than planned when the run diverged.
@@ -152,7 +176,7 @@ class RunLog:
             return
         n = self.n
         for start in range(0, n, size):
-            yield start, {name: getattr(self, name)[start:start + size] for name in names}
+            yield start, {name: getattr(self, name)[start : start + size] for name in names}
 
     def every(self, name: str, stride: int) -> np.ndarray:
         """Rows 0, stride, 2 stride, ... of the array ``name`` (``array[::stride]``), read a
@@ -196,8 +220,7 @@ def steps_per_tick(model: mujoco.MjModel, control_dt: float) -> int:
     k = control_dt / model.opt.timestep
     if k < 1 or abs(k - round(k)) > 1e-6:
         raise ValueError(
-            f"control period {control_dt} s is not a whole multiple of the model timestep "
-            f"{model.opt.timestep} s"
+            f"control period {control_dt} s is not a whole multiple of the model timestep {model.opt.timestep} s"
         )
     return int(round(k))
 
@@ -213,9 +236,7 @@ def warning_counts(data: mujoco.MjData) -> dict[str, int]:
 
 
 _WARNINGS = [
-    (name, int(getattr(mujoco.mjtWarning, name)))
-    for name in dir(mujoco.mjtWarning)
-    if name.startswith("mjWARN_")
+    (name, int(getattr(mujoco.mjtWarning, name))) for name in dir(mujoco.mjtWarning) if name.startswith("mjWARN_")
 ]
 
 
@@ -295,7 +316,7 @@ def controlled_views(setup: Setup):
     if ids.size == model.nu:
         return data.ctrl, slice(None)
     adr = model.actuator_actadr[ids]
-    return data.ctrl[ids[0]:ids[-1] + 1], adr[adr >= 0]
+    return data.ctrl[ids[0] : ids[-1] + 1], adr[adr >= 0]
 
 
 def stored_reference(trajectory, times: np.ndarray) -> ChunkedSample:
@@ -306,9 +327,10 @@ def stored_reference(trajectory, times: np.ndarray) -> ChunkedSample:
     sample = partial(sample_checked, trajectory)
     writer = None
     for start in range(0, times.size, CHUNK_TICKS):
-        part = sample(times[start:start + CHUNK_TICKS])
-        arrays = {name: np.asarray(getattr(part, name), dtype=float)
-                  for name in ("position", "velocity", "acceleration")}
+        part = sample(times[start : start + CHUNK_TICKS])
+        arrays = {
+            name: np.asarray(getattr(part, name), dtype=float) for name in ("position", "velocity", "acceleration")
+        }
         if writer is None:
             shapes = {name: value.shape[1:] for name, value in arrays.items()}
             writer = temporary_writer(shapes, times, CHUNK_TICKS, prefix="planbench-reference-")
@@ -333,13 +355,19 @@ def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     visible = task.reference_visible
     planner = components.planner
     context = ControlContext(
-        model=task.nominal_physics().model.ptr, nominal_physics=task.nominal_physics,
-        problem=task.problem, trajectory=components.trajectory if visible else None,
+        model=task.nominal_physics().model.ptr,
+        nominal_physics=task.nominal_physics,
+        problem=task.problem,
+        trajectory=components.trajectory if visible else None,
         reference=reference if visible else None,
-        control_dt=task.control_dt, command=command, setpoint=data.act[act_adr].copy(),
-        actuators=controlled_names(setup), observation=observation,
+        control_dt=task.control_dt,
+        command=command,
+        setpoint=data.act[act_adr].copy(),
+        actuators=controlled_names(setup),
+        observation=observation,
         sensors=tuple(task.sensors.specs),
-        planner=planner if hasattr(planner, "step") else None)
+        planner=planner if hasattr(planner, "step") else None,
+    )
     # Before the first tick a plug-in that cannot start is bad input, not a failed run.
     if context.planner is not None:  # an online planner starts from the problem
         _start("planner", context.planner.reset, task.problem)
@@ -349,8 +377,14 @@ def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     return Episode(times, reference, observation, context, k)
 
 
-def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, profile: bool = False,
-             log_path=None, chunk_ticks: int = CHUNK_TICKS) -> RunLog:
+def simulate(
+    setup: Setup,
+    quiet: bool = True,
+    progress_after_s: float = 2.0,
+    profile: bool = False,
+    log_path=None,
+    chunk_ticks: int = CHUNK_TICKS,
+) -> RunLog:
     """Run the control loop of ``setup`` and return its log.
 
     ``profile``: also time the code under test (the controller's calls, the online planner's
@@ -373,8 +407,9 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     if temporary:
         log_path = Path(tempfile.mkdtemp(prefix="planbench-log-")) / LOG_FILE
     # Rows go to a chunk buffer (run row j is buffer row j - base); full chunks to the file.
-    writer = ChunkWriter(log_path, model_shapes(model), times, chunk=chunk_ticks, history=SCAN_TICKS,
-                         block=STATE_ARRAYS)
+    writer = ChunkWriter(
+        log_path, model_shapes(model), times, chunk=chunk_ticks, history=SCAN_TICKS, block=STATE_ARRAYS
+    )
     if temporary:  # also when the run raises
         weakref.finalize(writer, remove_quietly, log_path)
     buffers, state = writer.buffers, writer.block
@@ -403,8 +438,7 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     observe, before_step = task.observe, task.before_step  # the same tick as planbench.envs'
     command_now = context.command
     contacts = []  # (tick, geoms (ncon, 2), distances (ncon,)) of every tick with contacts
-    bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False,
-               desc="simulating")
+    bar = tqdm(total=n - 1, unit="tick", delay=progress_after_s, disable=quiet, leave=False, desc="simulating")
     update_every = max(1, (n - 1) // 200)
     last = n - 1
     clock = time.perf_counter
@@ -430,8 +464,9 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
             controller_wall += clock() - t0
         if not isfinite(sum(ctrl_now.tolist())):  # <1 us (numpy's sum: 2 us): no NaN command reaches MuJoCo
             if i == 0:
-                raise PluginError(_bad_command(model, data.ctrl, times[i]) + ", its first command "
-                                  "(before any physics step)")
+                raise PluginError(
+                    _bad_command(model, data.ctrl, times[i]) + ", its first command (before any physics step)"
+                )
             log.controller_error = (float(times[i]), _bad_command(model, data.ctrl, times[i]))
             last = i
             break
@@ -466,8 +501,11 @@ def simulate(setup: Setup, quiet: bool = True, progress_after_s: float = 2.0, pr
     else:  # the last good command, held
         ctrl[last - base] = ctrl[last - 1 - base] if last > 0 else initial_ctrl
     log.physics_steps = last * k
-    log.contacts = [(tick, int(g1), int(g2), float(dist)) for tick, geoms, dists in contacts
-                    for (g1, g2), dist in zip(geoms.tolist(), dists.tolist())]
+    log.contacts = [
+        (tick, int(g1), int(g2), float(dist))
+        for tick, geoms, dists in contacts
+        for (g1, g2), dist in zip(geoms.tolist(), dists.tolist(), strict=True)
+    ]
     writer.close(last + 1)  # the rows up to ``last`` and the footer: the log is complete
     log.file = read_log(log_path)
     if temporary:  # the open file keeps the data until the log is dropped
@@ -495,14 +533,31 @@ def run(name: str, setup: Setup, quiet: bool = True, profile: bool = False, log_
     metrics["physics_steps"] = log.physics_steps
     metrics["loop_wall_s"] = log.loop_wall_s
     planner = getattr(components.planner, "planner", components.planner)  # the one a RecordingPlanner holds
-    roles = (("planner", planner), ("trajectory", components.trajectory), ("controller", components.controller),
-             ("sensors", task.sensors), ("disturbance", task.disturbance))
-    described = {role: None if obj is None else f"{type(obj).__module__}.{type(obj).__qualname__}"
-                 for role, obj in roles}
+    roles = (
+        ("planner", planner),
+        ("trajectory", components.trajectory),
+        ("controller", components.controller),
+        ("sensors", task.sensors),
+        ("disturbance", task.disturbance),
+    )
+    described = {
+        role: None if obj is None else f"{type(obj).__module__}.{type(obj).__qualname__}" for role, obj in roles
+    }
     plant = provenance.plant
-    return RunResult(name, provenance.seed, log, checks, metrics, sim_time, wall, described,
-                     plugins=dict(provenance.plugins), sensors=task.sensors.describe(),
-                     parameters=_resolved(setup), plant=None if plant is None else plant.to_dict())
+    return RunResult(
+        name,
+        provenance.seed,
+        log,
+        checks,
+        metrics,
+        sim_time,
+        wall,
+        described,
+        plugins=dict(provenance.plugins),
+        sensors=task.sensors.describe(),
+        parameters=_resolved(setup),
+        plant=None if plant is None else plant.to_dict(),
+    )
 
 
 def _resolved(setup: Setup) -> dict | None:

@@ -43,8 +43,9 @@ class Source:
 def resolve(argument: str, get_scenario, known_names) -> Source:
     """A scenario name (``known_names`` win, so a file called like a scenario does not
     shadow it), a scenario file (.toml) or a run's summary.json."""
-    if argument in known_names or not (argument.endswith((".toml", ".json")) or "/" in argument
-                                       or Path(argument).is_file()):
+    if argument in known_names or not (
+        argument.endswith((".toml", ".json")) or "/" in argument or Path(argument).is_file()
+    ):
         scenario = get_scenario(argument)
         return Source(scenario, scenario.params, {}, argument, plant=scenario.plant)
     path = Path(argument)
@@ -53,18 +54,25 @@ def resolve(argument: str, get_scenario, known_names) -> Source:
     if path.suffix == ".json":
         data = _read(path, json.loads, json.JSONDecodeError, "JSON")
         if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):
-            raise ParamError(f"{path}: not a planbench summary.json with resolved \"parameters\" (written by "
-                             "planbench run since scenario files exist)")
+            raise ParamError(
+                f'{path}: not a planbench summary.json with resolved "parameters" (written by '
+                "planbench run since scenario files exist)"
+            )
         # Every value as it ran (null: an optional value unset); plug-ins as they were given.
         plugins = data.get("plugins") or {}
-        if not isinstance(plugins, dict) or any(role not in ("planner", "controller") or not isinstance(spec, str)
-                                                for role, spec in plugins.items()):
-            raise ParamError(f"{path}: \"plugins\" must be a table of planner and controller, each "
-                             f"\"MODULE:FACTORY\", got {_shown(plugins)}")
+        if not isinstance(plugins, dict) or any(
+            role not in ("planner", "controller") or not isinstance(spec, str) for role, spec in plugins.items()
+        ):
+            raise ParamError(
+                f'{path}: "plugins" must be a table of planner and controller, each '
+                f'"MODULE:FACTORY", got {_shown(plugins)}'
+            )
         seed = data["parameters"].get("seed")
         if "seed" in data and (data["seed"] != seed or type(data["seed"]) is not type(seed)):
-            raise ParamError(f"{path}: \"seed\" = {_shown(data['seed'])} disagrees with the run's "
-                             f"parameters.seed = {_shown(seed)}; the file was changed after the run")
+            raise ParamError(
+                f'{path}: "seed" = {_shown(data["seed"])} disagrees with the run\'s '
+                f"parameters.seed = {_shown(seed)}; the file was changed after the run"
+            )
         run = {"scenario": data.get("scenario"), "parameters": data["parameters"], **plugins}
         if data.get("plant") is not None:
             run["plant"] = data["plant"]
@@ -80,8 +88,9 @@ def _read(path: Path, parse, parse_error, kind: str):
     except parse_error as e:
         raise ParamError(f"{path}: not {kind}: {e}") from None
     except RecursionError:
-        raise ParamError(f"{path}: {kind} nested too deep to read (arrays or tables within one "
-                         "another, thousands of levels)") from None
+        raise ParamError(
+            f"{path}: {kind} nested too deep to read (arrays or tables within one another, thousands of levels)"
+        ) from None
 
 
 def _shown(value) -> str:
@@ -112,8 +121,10 @@ def _from_data(path: Path, data: dict, get_scenario, versions) -> Source:
     if not isinstance(overrides, dict):
         raise ParamError(f"{path}: key 'parameters' must be a table, got {overrides!r}")
     declared = {n: d for n, _, d, _ in type(scenario.params).declarations()}
-    overrides = {k: (_beside(path, v) if k in declared and declared[k].path and isinstance(v, str) else v)
-                 for k, v in overrides.items()}
+    overrides = {
+        k: (_beside(path, v) if k in declared and declared[k].path and isinstance(v, str) else v)
+        for k, v in overrides.items()
+    }
     plant = data.get("plant", {})
     if not isinstance(plant, dict):
         raise ParamError(f"{path}: key 'plant' must be a table, got {plant!r}")

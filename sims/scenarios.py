@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import functools
 import importlib
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from dm_control.utils import containers
 
@@ -214,9 +214,7 @@ def get(name: str) -> Scenario:
     try:
         return scenarios[name]
     except KeyError:
-        raise ValueError(
-            f"unknown scenario {name!r}; known: {', '.join(scenarios)}"
-        ) from None
+        raise ValueError(f"unknown scenario {name!r}; known: {', '.join(scenarios)}") from None
 
 
 def get_of(mechanism: str, name: str) -> Scenario:

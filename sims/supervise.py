@@ -57,10 +57,10 @@ class _Board:
         return self.map[:_TEXT].split(b"\0", 1)[0].decode("utf-8", "replace")
 
     def write_duration(self, seconds: float) -> None:
-        self.map[_TEXT:_TEXT + 8] = struct.pack("d", float(seconds))
+        self.map[_TEXT : _TEXT + 8] = struct.pack("d", float(seconds))
 
     def read_duration(self) -> float:
-        return struct.unpack("d", self.map[_TEXT:_TEXT + 8])[0]
+        return struct.unpack("d", self.map[_TEXT : _TEXT + 8])[0]
 
 
 _board: _Board | None = None  # set in a supervised child only
@@ -164,8 +164,8 @@ def _child(work, board: _Board, write_fd: int, parent: int) -> None:
 
 def _one_line(e: BaseException) -> bool:
     """Errors the CLI prints as one line (bad input, plug-in faults), not as a traceback."""
-    from planbench.planners.errors import PlanningError
     from planbench.outputs import OutputError
+    from planbench.planners.errors import PlanningError
     from planbench.task import PluginError
 
     return isinstance(e, (PlanningError, OutputError, PluginError, ValueError, SystemExit))
@@ -223,14 +223,18 @@ def run_supervised(work, timeout_s: float | None = None):
             fd = pipe.fileno()
             while True:
                 duration = board.read_duration()
-                limit = timeout_s if timeout_s is not None else DEFAULT_TIMEOUT_BASE_S + (
-                    0.0 if duration != duration else duration)
+                limit = (
+                    timeout_s
+                    if timeout_s is not None
+                    else DEFAULT_TIMEOUT_BASE_S + (0.0 if duration != duration else duration)
+                )
                 left = limit - (time.monotonic() - start)
                 if left <= 0:
                     where = board.read_phase()
                     reaped = _stop(pid)
-                    raise Fault(Ended(where, f"it passed the time limit of {limit:g} s", True,
-                                      time.monotonic() - start, limit))
+                    raise Fault(
+                        Ended(where, f"it passed the time limit of {limit:g} s", True, time.monotonic() - start, limit)
+                    )
                 ready, _, _ = select.select([fd], [], [], min(left, 1.0))
                 if ready:
                     data = os.read(fd, 1 << 20)

@@ -26,8 +26,9 @@ import copy
 import inspect
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable, Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import mujoco
 import numpy as np
@@ -87,7 +88,7 @@ def readonly_view(array: np.ndarray, index) -> np.ndarray:
     index = np.asarray(index, dtype=int).ravel()
     if not _is_run(index):
         raise ValueError(f"indices {index.tolist()} are not one contiguous run: no view exists")
-    view = array[int(index[0]):int(index[0]) + index.size]
+    view = array[int(index[0]) : int(index[0]) + index.size]
     view.flags.writeable = False
     return view
 
@@ -136,8 +137,9 @@ class JointEncoders(Sensors):
       resolution: per joint (or one for all), one count in the positions' unit; 0: exact.
     """
 
-    def __init__(self, qpos, dofs, acts, measures: str, unit: str, control_dt: float,
-                 noise=0.0, bias=0.0, resolution=0.0):
+    def __init__(
+        self, qpos, dofs, acts, measures: str, unit: str, control_dt: float, noise=0.0, bias=0.0, resolution=0.0
+    ):
         super().__init__()
         self.qpos = np.asarray(qpos, dtype=int)
         self.dofs = np.asarray(dofs, dtype=int)
@@ -145,17 +147,25 @@ class JointEncoders(Sensors):
         self.noise = np.broadcast_to(np.asarray(noise, dtype=float), self.qpos.shape).copy()
         self.bias = np.broadcast_to(np.asarray(bias, dtype=float), self.qpos.shape).copy()
         self.resolution = np.broadcast_to(np.asarray(resolution, dtype=float), self.qpos.shape).copy()
-        if not (np.isfinite(self.noise).all() and np.isfinite(self.bias).all() and (self.noise >= 0).all()
-                and np.isfinite(self.resolution).all() and (self.resolution >= 0).all()):
-            raise ValueError(f"encoder noise {self.noise.tolist()} and resolution {self.resolution.tolist()} must be "
-                             f"finite and >= 0 and bias {self.bias.tolist()} finite")
+        if not (
+            np.isfinite(self.noise).all()
+            and np.isfinite(self.bias).all()
+            and (self.noise >= 0).all()
+            and np.isfinite(self.resolution).all()
+            and (self.resolution >= 0).all()
+        ):
+            raise ValueError(
+                f"encoder noise {self.noise.tolist()} and resolution {self.resolution.tolist()} must be "
+                f"finite and >= 0 and bias {self.bias.tolist()} finite"
+            )
         rate = 1.0 / control_dt
         ideal = not self.noise.any() and not self.bias.any() and not self.resolution.any()
         noise_text = "none" if not self.noise.any() else f"white, {self.noise.tolist()} {unit} 1-sigma"
         bias_text = "none" if not self.bias.any() else f"{self.bias.tolist()} {unit}"
         self.specs = [
-            SensorSpec("joint_positions", measures, unit, rate, 0.0, noise_text, bias_text,
-                       float(self.resolution.max())),
+            SensorSpec(
+                "joint_positions", measures, unit, rate, 0.0, noise_text, bias_text, float(self.resolution.max())
+            ),
             SensorSpec("joint_velocities", f"rates of the {measures}", f"{unit}/s", rate),
             SensorSpec("setpoints", "the drives' position set-points (what was commanded)", unit, rate),
         ]
@@ -163,8 +173,7 @@ class JointEncoders(Sensors):
         self._noisy = bool(self.noise.any() or self.bias.any())
         self._counted = self.resolution > 0
         self._all_counted = bool(self._counted.all())
-        self._counts_per_unit = np.divide(1.0, self.resolution, out=np.zeros_like(self.resolution),
-                                          where=self._counted)
+        self._counts_per_unit = np.divide(1.0, self.resolution, out=np.zeros_like(self.resolution), where=self._counted)
         self._copies: list[tuple] = []  # (live buffer, index, out) read by __call__ every tick
         self._counted_run: tuple | None = None  # (live view, out): counted positions read in one pass
 
@@ -174,9 +183,11 @@ class JointEncoders(Sensors):
         self._data = data
         obs = {}
         self._copies = []
-        sources = [("joint_positions", lambda d: d.qpos, self.qpos),
-                   ("joint_velocities", lambda d: d.qvel, self.dofs),
-                   ("setpoints", lambda d: d.act, self.acts)]
+        sources = [
+            ("joint_positions", lambda d: d.qpos, self.qpos),
+            ("joint_velocities", lambda d: d.qvel, self.dofs),
+            ("setpoints", lambda d: d.act, self.acts),
+        ]
         self._counted_run = None
         for name, getter, index in sources:
             buffer = getter(data)
@@ -215,8 +226,9 @@ class JointEncoders(Sensors):
                 positions *= self.resolution
             elif self._counted.any():
                 counted = self._counted
-                self._positions[counted] = (np.floor(self._positions[counted] * self._counts_per_unit[counted])
-                                            * self.resolution[counted])
+                self._positions[counted] = (
+                    np.floor(self._positions[counted] * self._counts_per_unit[counted]) * self.resolution[counted]
+                )
 
 
 # ----------------------------------------------------------------------------- the task
@@ -291,7 +303,7 @@ class Task:
 
     _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 
-    def attach(self, physics) -> "Task":
+    def attach(self, physics) -> Task:
         """Record ``physics``'s present state as the task's initial state (and, without a
         nominal model, a copy of it as the controller's); returns the task."""
         model, data = physics.model.ptr, physics.data.ptr
@@ -501,16 +513,20 @@ class RecordingPlanner:
         last = float(self.t[self.count - 1]) if self.count else 0.0
         if not float(t) > last:
             since = "its previous step at" if self.count else "the problem's start (theta0) at"
-            raise StepTimeError(f"the online planner was stepped at t = {float(t):.6g} s, not after {since} "
-                                f"{last:.6g} s: steps must have increasing times")
+            raise StepTimeError(
+                f"the online planner was stepped at t = {float(t):.6g} s, not after {since} "
+                f"{last:.6g} s: steps must have increasing times"
+            )
         start = time.perf_counter()
         theta = np.array(self.planner.step(t, attitude), dtype=float)
         self.wall_s += time.perf_counter() - start
         if theta.shape != (4,):
             raise PluginError(f"the antenna planner's step returned shape {theta.shape}, not (4,) joint angles")
         if not np.isfinite(theta).all():  # before any use: NaN angles only make numpy warn downstream
-            raise PluginError(f"the antenna planner's step at t = {t:g} s returned non-finite joint angles "
-                              f"{np.array2string(theta, precision=4)}")
+            raise PluginError(
+                f"the antenna planner's step at t = {t:g} s returned non-finite joint angles "
+                f"{np.array2string(theta, precision=4)}"
+            )
         i = self.count
         if i == self.t.size:  # more updates than the IMU's rate gives: grow
             for name in ("t", "attitude", "theta", "iterations", "damped", "rate_limited"):
@@ -527,9 +543,14 @@ class RecordingPlanner:
 
     def records(self) -> dict:
         n = self.count
-        return {"t": self.t[:n], "attitude": self.attitude[:n], "theta": self.theta[:n],
-                "iterations": self.iterations[:n], "damped": self.damped[:n],
-                "rate_limited": self.rate_limited[:n]}
+        return {
+            "t": self.t[:n],
+            "attitude": self.attitude[:n],
+            "theta": self.theta[:n],
+            "iterations": self.iterations[:n],
+            "damped": self.damped[:n],
+            "rate_limited": self.rate_limited[:n],
+        }
 
 
 # ----------------------------------------------------------------------------- plug-in checks
@@ -566,8 +587,10 @@ def check_planner(planner, online: bool) -> None:
     if online:
         for method, n in (("reset", 1), ("step", 2)):
             if not callable(getattr(planner, method, None)):
-                raise PluginError(f"antenna planner {name} has no {method}() method (an online planner "
-                                  "needs reset(problem) and step(t, attitude))")
+                raise PluginError(
+                    f"antenna planner {name} has no {method}() method (an online planner "
+                    "needs reset(problem) and step(t, attitude))"
+                )
             _callable_with(getattr(planner, method), n, f"planner {name}'s {method}")
         return
     if not callable(getattr(planner, "plan", None)):
@@ -581,11 +604,11 @@ def check_trajectory(trajectory, labels: tuple, duration_min: float = 0.0) -> No
     name = type(trajectory).__name__
     for attribute in ("duration", "labels", "sample"):
         if not hasattr(trajectory, attribute):
-            raise PluginError(f"the planner returned a {name} without '{attribute}' (a Trajectory has "
-                              "duration, labels and sample(t))")
+            raise PluginError(
+                f"the planner returned a {name} without '{attribute}' (a Trajectory has duration, labels and sample(t))"
+            )
     duration = trajectory.duration
-    if not isinstance(duration, (int, float, np.floating, np.integer)) or not math.isfinite(duration) \
-            or duration <= 0:
+    if not isinstance(duration, (int, float, np.floating, np.integer)) or not math.isfinite(duration) or duration <= 0:
         raise PluginError(f"the planner's trajectory has duration {duration!r}; it must be a finite number > 0 s")
     try:
         given = tuple(str(label) for label in trajectory.labels)
@@ -594,15 +617,19 @@ def check_trajectory(trajectory, labels: tuple, duration_min: float = 0.0) -> No
     if given != tuple(labels):
         # The channels are matched by name, not by count: a trajectory whose third channel
         # is another strut's would drive the wrong actuator.
-        raise PluginError(f"the planner's trajectory has {len(given)} channels ({', '.join(given)}); this "
-                          f"task needs {len(labels)}: {', '.join(labels)}, in that order")
+        raise PluginError(
+            f"the planner's trajectory has {len(given)} channels ({', '.join(given)}); this "
+            f"task needs {len(labels)}: {', '.join(labels)}, in that order"
+        )
     t = np.linspace(0.0, float(duration), 5)
     sample = sample_checked(trajectory, t)
     for part in ("position", "velocity", "acceleration"):
         values = np.asarray(getattr(sample, part, None), dtype=float)
         if values.shape != (t.size, len(labels)):
-            raise PluginError(f"the planner's trajectory sample gives {part} of shape {values.shape} for "
-                              f"{t.size} times; expected {(t.size, len(labels))}")
+            raise PluginError(
+                f"the planner's trajectory sample gives {part} of shape {values.shape} for "
+                f"{t.size} times; expected {(t.size, len(labels))}"
+            )
         if not np.isfinite(values).all():
             raise PluginError(f"the planner's trajectory has non-finite {part} within [0, {duration:g}] s")
 
@@ -623,8 +650,9 @@ def sample_checked(trajectory, t: np.ndarray):
     try:
         return trajectory.sample(t)
     except (Exception, SystemExit) as e:
-        raise PluginError(f"the planner's trajectory ({type(trajectory).__name__}) sample() raised "
-                          f"{fault_text(e)}") from None
+        raise PluginError(
+            f"the planner's trajectory ({type(trajectory).__name__}) sample() raised {fault_text(e)}"
+        ) from None
 
 
 def check_first_command(command, nu: int, actuators) -> np.ndarray | None:
@@ -636,11 +664,14 @@ def check_first_command(command, nu: int, actuators) -> np.ndarray | None:
     try:
         values = np.asarray(command, dtype=float)
     except (TypeError, ValueError):
-        raise PluginError(f"the controller returned {type(command).__name__}, not a vector of {nu} "
-                          "actuator commands") from None
+        raise PluginError(
+            f"the controller returned {type(command).__name__}, not a vector of {nu} actuator commands"
+        ) from None
     if values.shape != (nu,):
-        raise PluginError(f"the controller returned a command of shape {values.shape}; this task has "
-                          f"{nu} actuators ({', '.join(actuators)})")
+        raise PluginError(
+            f"the controller returned a command of shape {values.shape}; this task has "
+            f"{nu} actuators ({', '.join(actuators)})"
+        )
     return values
 
 

@@ -17,7 +17,7 @@ one point's gusts act on the whole body, which overstates the load of the shorte
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -30,8 +30,9 @@ AIR_DENSITY = 1.2  # kg/m^3; about 1.0 at Rubin's 2700 m and FAST's 1000 m: cons
 #: (and any telescope) is outside its range.
 MAX_MEAN_SPEED_M_S = 50.0
 #: The range of a mean wind speed parameter (``planbench.params.param`` keywords), m/s.
-MEAN_SPEED = dict(unit="m/s", low=0.0, high=MAX_MEAN_SPEED_M_S,
-                  reason="IEC 61400-1 class I reference speed, the Kaimal model's range")
+MEAN_SPEED = dict(
+    unit="m/s", low=0.0, high=MAX_MEAN_SPEED_M_S, reason="IEC 61400-1 class I reference speed, the Kaimal model's range"
+)
 IEC_KAIMAL_LENGTH = 8.1 * 42.0  # m, IEC 61400-1 longitudinal integral scale above 60 m hub
 IEC_TURBULENCE_B = 0.14  # I_ref of IEC class B
 
@@ -43,8 +44,10 @@ def check_mean_speed(mean_speed: float) -> float:
     if not np.isfinite(value) or value < 0:
         raise ValueError(f"mean wind speed {mean_speed!r} m/s must be finite and >= 0")
     if value > MAX_MEAN_SPEED_M_S:
-        raise ValueError(f"mean wind speed {value:g} m/s is above {MAX_MEAN_SPEED_M_S:g} m/s, the "
-                         "reference wind speed of IEC 61400-1 class I (the Kaimal model's range)")
+        raise ValueError(
+            f"mean wind speed {value:g} m/s is above {MAX_MEAN_SPEED_M_S:g} m/s, the "
+            "reference wind speed of IEC 61400-1 class I (the Kaimal model's range)"
+        )
     return value
 
 
@@ -54,8 +57,9 @@ def horizontal_direction(azimuth_deg: float) -> np.ndarray:
     return np.array([math.cos(az), math.sin(az), 0.0])
 
 
-def kaimal_spectrum(f, mean_speed: float, turbulence_ref: float = IEC_TURBULENCE_B,
-                    length_scale: float = IEC_KAIMAL_LENGTH) -> np.ndarray:
+def kaimal_spectrum(
+    f, mean_speed: float, turbulence_ref: float = IEC_TURBULENCE_B, length_scale: float = IEC_KAIMAL_LENGTH
+) -> np.ndarray:
     """One-sided Kaimal spectrum of the along-wind speed, (m/s)^2/Hz, at frequencies f (Hz)."""
     f = np.asarray(f, dtype=float)
     if mean_speed <= 0:
@@ -77,9 +81,15 @@ def davenport_spectrum(f, mean_speed_10m: float, kappa: float = 0.005) -> np.nda
 SPECTRA: dict[str, Callable] = {"kaimal": kaimal_spectrum, "davenport": davenport_spectrum}
 
 
-def wind_speed_series(times: np.ndarray, mean_speed: float, rng: np.random.Generator,
-                      spectrum: str = "kaimal", f_max: float = 10.0,
-                      df: float | None = None, turbulence_intensity: float | None = None) -> np.ndarray:
+def wind_speed_series(
+    times: np.ndarray,
+    mean_speed: float,
+    rng: np.random.Generator,
+    spectrum: str = "kaimal",
+    f_max: float = 10.0,
+    df: float | None = None,
+    turbulence_intensity: float | None = None,
+) -> np.ndarray:
     """Along-wind speed u(t), m/s, at the given times (s): mean plus turbulence.
 
     Args:
@@ -133,17 +143,17 @@ def _sum_of_cosines(times, freqs, amplitude, phases, df) -> np.ndarray:
     out = np.zeros(times.shape)
     # Blocks of times keep the (times x frequencies) cosine table small.
     for start in range(0, times.size, 4096):
-        block = times[start:start + 4096]
-        out[start:start + 4096] = np.cos(2 * np.pi * np.outer(block, freqs) + phases) @ amplitude
+        block = times[start : start + 4096]
+        out[start : start + 4096] = np.cos(2 * np.pi * np.outer(block, freqs) + phases) @ amplitude
     return out
 
 
-def drag_force(speed, direction, area, drag_coefficient: float,
-               density: float = AIR_DENSITY) -> np.ndarray:
+def drag_force(speed, direction, area, drag_coefficient: float, density: float = AIR_DENSITY) -> np.ndarray:
     """F = 1/2 rho Cd A |u| u along ``direction`` (a unit vector), N; speed (...,) m/s."""
     speed = np.asarray(speed, dtype=float)
-    return (0.5 * density * drag_coefficient * np.asarray(area) * np.abs(speed) * speed)[..., None] * \
-        np.asarray(direction, dtype=float)
+    return (0.5 * density * drag_coefficient * np.asarray(area) * np.abs(speed) * speed)[..., None] * np.asarray(
+        direction, dtype=float
+    )
 
 
 def cylinder_projected_area(axis, direction, diameter: float, length: float) -> np.ndarray:
@@ -162,8 +172,15 @@ class BodyWindDrag:
     per tick, so a tilting body sees its true silhouette.
     """
 
-    def __init__(self, body: str, mean_speed: float, area: Callable, drag_coefficient: float,
-                 azimuth_deg: float = 0.0, spectrum: str = "kaimal"):
+    def __init__(
+        self,
+        body: str,
+        mean_speed: float,
+        area: Callable,
+        drag_coefficient: float,
+        azimuth_deg: float = 0.0,
+        spectrum: str = "kaimal",
+    ):
         check_mean_speed(mean_speed)
         self.body = body
         self.mean_speed = float(mean_speed)
@@ -230,22 +247,31 @@ class MeasuredWind:
                 if not rows and not header_seen:  # one header line of names before the data
                     header_seen = True
                     continue
-                raise WindFileError(f"wind file {self.path} line {number}: {line!r} is not numbers t, speed[, direction]") from None
+                raise WindFileError(
+                    f"wind file {self.path} line {number}: {line!r} is not numbers t, speed[, direction]"
+                ) from None
             if len(values) not in (2, 3):
-                raise WindFileError(f"wind file {self.path} line {number}: {len(values)} columns, not 2 or 3 "
-                                    "(t s, speed m/s[, direction deg])")
+                raise WindFileError(
+                    f"wind file {self.path} line {number}: {len(values)} columns, not 2 or 3 "
+                    "(t s, speed m/s[, direction deg])"
+                )
             if rows and len(values) != len(rows[0]):
-                raise WindFileError(f"wind file {self.path} line {number}: {len(values)} columns, the first row has "
-                                    f"{len(rows[0])}")
+                raise WindFileError(
+                    f"wind file {self.path} line {number}: {len(values)} columns, the first row has {len(rows[0])}"
+                )
             if not all(np.isfinite(values)):
                 raise WindFileError(f"wind file {self.path} line {number}: {line!r} is not finite")
             if not 0.0 <= values[1] <= MAX_MEAN_SPEED_M_S:
-                raise WindFileError(f"wind file {self.path} line {number}: speed {values[1]:g} m/s is outside "
-                                    f"[0, {MAX_MEAN_SPEED_M_S:g}] m/s (IEC 61400-1 class I)")
+                raise WindFileError(
+                    f"wind file {self.path} line {number}: speed {values[1]:g} m/s is outside "
+                    f"[0, {MAX_MEAN_SPEED_M_S:g}] m/s (IEC 61400-1 class I)"
+                )
             if len(values) == 3 and not -MAX_DIRECTION_DEG <= values[2] <= MAX_DIRECTION_DEG:
-                raise WindFileError(f"wind file {self.path} line {number}: direction {values[2]:g} deg is outside "
-                                    f"[-{MAX_DIRECTION_DEG:g}, {MAX_DIRECTION_DEG:g}] deg (one turn either way; "
-                                    "angles are not wrapped)")
+                raise WindFileError(
+                    f"wind file {self.path} line {number}: direction {values[2]:g} deg is outside "
+                    f"[-{MAX_DIRECTION_DEG:g}, {MAX_DIRECTION_DEG:g}] deg (one turn either way; "
+                    "angles are not wrapped)"
+                )
             if rows and values[0] <= rows[-1][0]:
                 raise WindFileError(f"wind file {self.path} line {number}: t = {values[0]:g} s does not increase")
             rows.append(values)
@@ -258,8 +284,10 @@ class MeasuredWind:
     def check_covers(self, duration: float) -> None:
         """A WindFileError unless the record spans the run, t = 0 ... duration."""
         if self.t[0] > 0.0 or self.t[-1] < duration:
-            raise WindFileError(f"wind file {self.path} spans t = {self.t[0]:g} ... {self.t[-1]:g} s, not the run's "
-                                f"0 ... {duration:g} s")
+            raise WindFileError(
+                f"wind file {self.path} spans t = {self.t[0]:g} ... {self.t[-1]:g} s, not the run's "
+                f"0 ... {duration:g} s"
+            )
 
     def resample(self, times: np.ndarray):
         """(speed (n,), unit direction (n, 3) or None) at ``times``."""

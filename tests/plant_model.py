@@ -14,12 +14,12 @@ import copy
 
 import mujoco
 import numpy as np
-
 from model_diff import changed_fields
 
 
-def assert_edits_only(nominal: mujoco.MjModel, plant: mujoco.MjModel, edits: dict, rtol: float = 1e-12,
-                      roundoff: tuple = ()) -> dict:
+def assert_edits_only(
+    nominal: mujoco.MjModel, plant: mujoco.MjModel, edits: dict, rtol: float = 1e-12, roundoff: tuple = ()
+) -> dict:
     """Assert that ``plant`` is ``nominal`` with ``edits`` ({field: {row: expected value}}).
 
     Rows of an edited field other than those given must be unchanged; the given ones must
@@ -34,8 +34,9 @@ def assert_edits_only(nominal: mujoco.MjModel, plant: mujoco.MjModel, edits: dic
         changed = set(diff.get(name, np.array([], dtype=int)).tolist())
         assert changed <= set(rows), f"{name}: rows {sorted(changed - set(rows))} changed, not only {sorted(rows)}"
         for row, value in rows.items():
-            np.testing.assert_allclose(getattr(plant, name)[row], value, rtol=rtol, atol=1e-15,
-                                       err_msg=f"{name}[{row}]")
+            np.testing.assert_allclose(
+                getattr(plant, name)[row], value, rtol=rtol, atol=1e-15, err_msg=f"{name}[{row}]"
+            )
     expected = copy.copy(nominal)
     for name, rows in edits.items():
         for row in rows:
@@ -44,9 +45,12 @@ def assert_edits_only(nominal: mujoco.MjModel, plant: mujoco.MjModel, edits: dic
     rest = changed_fields(expected, plant)
     for name in roundoff:
         if name in rest:
-            np.testing.assert_allclose(getattr(plant, name), getattr(expected, name), rtol=rtol, atol=1e-15,
-                                       err_msg=name)
+            np.testing.assert_allclose(
+                getattr(plant, name), getattr(expected, name), rtol=rtol, atol=1e-15, err_msg=name
+            )
             del rest[name]
-    assert rest == {}, f"fields changed beyond the edits and what MuJoCo derives from them: " \
-                       f"{ {k: v.tolist() for k, v in rest.items()} }"
+    assert rest == {}, (
+        f"fields changed beyond the edits and what MuJoCo derives from them: "
+        f"{ {k: v.tolist() for k, v in rest.items()} }"
+    )
     return diff

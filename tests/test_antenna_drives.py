@@ -9,8 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from planbench import models
-from planbench import scenarios
+from planbench import models, scenarios
 from planbench.antenna import params as antenna_params
 from planbench.antenna.physics import AntennaPhysics
 
@@ -32,7 +31,9 @@ def test_each_axis_has_its_motor_transmission_and_friction(as_built):
         assert model.dof_frictionloss[motor.dofadr[0]] == antenna_params.AXIS_FRICTION
         tendon = model.tendon(name + "_transmission").id
         belt = name == "azimuth"
-        assert model.tendon_stiffness[tendon] == (antenna_params.BELT_STIFFNESS if belt else antenna_params.GEAR_STIFFNESS)
+        assert model.tendon_stiffness[tendon] == (
+            antenna_params.BELT_STIFFNESS if belt else antenna_params.GEAR_STIFFNESS
+        )
         b = 0.0 if belt else antenna_params.GEAR_BACKLASH  # 3 arcmin = 0.873 mrad on the geared axes
         np.testing.assert_allclose(model.tendon_lengthspring[tendon], [-b / 2, b / 2])
         # The drive's loop and torque limit are the ideal model's, on the motor.
@@ -85,8 +86,10 @@ def test_the_plants_drive_train_errors_edit_their_elements():
     from planbench.antenna.params import AntennaPlant
 
     nominal = AntennaPhysics.load(drives="as-built").model.ptr
-    model = AntennaPhysics.load(AntennaPlant(transmission_stiffness_error=-0.3, gear_backlash_error=2.0,
-                                             torque_constant_error=0.1), drives="as-built").model.ptr
+    model = AntennaPhysics.load(
+        AntennaPlant(transmission_stiffness_error=-0.3, gear_backlash_error=2.0, torque_constant_error=0.1),
+        drives="as-built",
+    ).model.ptr
     for name in JOINTS:
         tendon = model.tendon(name + "_transmission").id
         assert model.tendon_stiffness[tendon] == pytest.approx(0.7 * nominal.tendon_stiffness[tendon])

@@ -7,7 +7,8 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from planbench import runner
@@ -77,13 +78,24 @@ def _run(imu: ImuModel, controller=None, duration: float = 1.5):
     return runner.simulate(antenna_task.build(params, controller=controller, antenna_options=options))
 
 
-IMUS = [ImuModel(), ImuModel(attitude_noise_deg=0.0), ImuModel(gyro_noise_deg_s=0.0),
-        ImuModel(attitude_noise_deg=0.0, gyro_noise_deg_s=0.0), ImuModel(latency_s=0.0, rate_hz=100.0),
-        ImuModel(attitude_noise_time_s=0.0)]
+IMUS = [
+    ImuModel(),
+    ImuModel(attitude_noise_deg=0.0),
+    ImuModel(gyro_noise_deg_s=0.0),
+    ImuModel(attitude_noise_deg=0.0, gyro_noise_deg_s=0.0),
+    ImuModel(latency_s=0.0, rate_hz=100.0),
+    ImuModel(attitude_noise_time_s=0.0),
+]
 
 
-@pytest.mark.parametrize("imu", IMUS, ids=lambda m: f"{m.rate_hz:g}Hz-{m.latency_s:g}s-{m.attitude_noise_deg:g}deg-"
-                                                     f"{m.attitude_noise_time_s:g}s-{m.gyro_noise_deg_s:g}dps")
+@pytest.mark.parametrize(
+    "imu",
+    IMUS,
+    ids=lambda m: (
+        f"{m.rate_hz:g}Hz-{m.latency_s:g}s-{m.attitude_noise_deg:g}deg-"
+        f"{m.attitude_noise_time_s:g}s-{m.gyro_noise_deg_s:g}dps"
+    ),
+)
 def test_the_imu_noise_drawn_once_is_the_per_sample_noise(imu, monkeypatch):
     original_reset = antenna_sensors.AntennaImu.reset
 
@@ -124,8 +136,11 @@ def test_the_imu_draws_more_noise_when_a_run_outlasts_its_times():
         np.testing.assert_array_equal(row, expected, err_msg=f"sample {k}")
 
 
-@pytest.mark.parametrize("imu", [ImuModel(), ImuModel(latency_s=0.0, rate_hz=100.0), ImuModel(rate_hz=20.0)],
-                         ids=["default", "no-latency", "20Hz"])
+@pytest.mark.parametrize(
+    "imu",
+    [ImuModel(), ImuModel(latency_s=0.0, rate_hz=100.0), ImuModel(rate_hz=20.0)],
+    ids=["default", "no-latency", "20Hz"],
+)
 def test_the_tabulated_ramps_are_the_per_tick_ramps(imu):
     tabulated = _run(imu, AntennaController())
     per_tick = _run(imu, PerTickController())

@@ -62,11 +62,13 @@ def f(theta):
 def satellite_attitude(az, el, sigma):
     """eTs of eq. (1) with REFERENCE.md's correction of the first row."""
     ca, sa, ce, se, cs, ss = np.cos(az), np.sin(az), np.cos(el), np.sin(el), np.cos(sigma), np.sin(sigma)
-    return np.array([
-        [ca * ss - cs * sa * se, ca * cs + sa * se * ss, ce * sa],
-        [-sa * ss - ca * cs * se, -cs * sa + ca * se * ss, ca * ce],
-        [ce * cs, -ce * ss, se],
-    ])
+    return np.array(
+        [
+            [ca * ss - cs * sa * se, ca * cs + sa * se * ss, ce * sa],
+            [-sa * ss - ca * cs * se, -cs * sa + ca * se * ss, ca * ce],
+            [ce * cs, -ce * ss, se],
+        ]
+    )
 
 
 def quat_to_mat(quat):
@@ -99,8 +101,9 @@ def _random_data(model, seed):
 
 def _random_pose(rng):
     deck = np.array([rng.uniform(-5, 5), rng.uniform(-np.pi, np.pi), *rng.uniform(-1.0, 1.0, 2)])
-    theta = np.array([rng.uniform(-np.pi, np.pi), rng.uniform(-3.0, 0.08),
-                      rng.uniform(-1.7, 1.7), rng.uniform(-np.pi, np.pi)])
+    theta = np.array(
+        [rng.uniform(-np.pi, np.pi), rng.uniform(-3.0, 0.08), rng.uniform(-1.7, 1.7), rng.uniform(-np.pi, np.pi)]
+    )
     return deck, theta
 
 
@@ -108,8 +111,18 @@ def test_structure_names_and_order(model):
     assert model.nq == model.nv == 8 and model.nu == 8 and model.na == 8
     assert [model.joint(i).name for i in range(model.njnt)] == [*DECK_JOINTS, *ANTENNA_JOINTS]
     assert [model.actuator(i).name for i in range(model.nu)] == [*DECK_JOINTS, *ANTENNA_JOINTS]
-    chain = ["ship", "ship_yaw", "ship_pitch", "deck", "pedestal", "azimuth", "elevation",
-             "cross_elevation", "polarization", "reflector"]
+    chain = [
+        "ship",
+        "ship_yaw",
+        "ship_pitch",
+        "deck",
+        "pedestal",
+        "azimuth",
+        "elevation",
+        "cross_elevation",
+        "polarization",
+        "reflector",
+    ]
     for parent, child in itertools.pairwise(chain):
         assert model.body(int(model.body(child).parentid[0])).name == parent
     assert model.body("ship").parentid == 0
@@ -128,8 +141,9 @@ def test_world_from_deck_is_rz_rx_ry(model, seed):
     np.testing.assert_allclose(data.body("deck").xmat.reshape(3, 3), world_from_deck(*deck[1:]), atol=1e-12)
     np.testing.assert_allclose(data.body("deck").xpos, [0, 0, deck[0]], atol=1e-12)
     # The mast top (pedestal base) is MAST_TOP above the centre of rotation along the deck's up.
-    np.testing.assert_allclose(data.body("pedestal").xpos,
-                               [0, 0, deck[0]] + world_from_deck(*deck[1:]) @ [0, 0, MAST_TOP], atol=1e-12)
+    np.testing.assert_allclose(
+        data.body("pedestal").xpos, [0, 0, deck[0]] + world_from_deck(*deck[1:]) @ [0, 0, MAST_TOP], atol=1e-12
+    )
 
 
 @settings(max_examples=50, deadline=None)
@@ -140,7 +154,9 @@ def test_dish_orientation_in_the_deck_frame_equals_f(model, seed):
     r_dish = data.site("dish").xmat.reshape(3, 3)
     np.testing.assert_allclose(r_deck.T @ r_dish, f(theta), atol=1e-12)
     # The dish_quat sensor (world frame) is the same rotation.
-    np.testing.assert_allclose(quat_to_mat(data.sensor("dish_quat").data), world_from_deck(*deck[1:]) @ f(theta), atol=1e-9)
+    np.testing.assert_allclose(
+        quat_to_mat(data.sensor("dish_quat").data), world_from_deck(*deck[1:]) @ f(theta), atol=1e-9
+    )
     for name, value in zip(ANTENNA_JOINTS, theta, strict=True):
         assert data.sensor(f"{name}_pos").data[0] == pytest.approx(value, abs=1e-12)
 
@@ -305,11 +321,14 @@ def _hold(model, deck, theta, seconds):
     return data
 
 
-@pytest.mark.parametrize("deck, theta_deg", [
-    ((0.0, 0.7, 0.35, -0.5), (136.51, -60.0, 0.0, -28.8)),
-    ((0.0, -1.2, -0.2, 0.6), (30.0, -120.0, 40.0, 75.0)),
-    ((0.0, 0.0, 0.0, 0.0), (-60.0, -20.0, -70.0, 150.0)),
-])
+@pytest.mark.parametrize(
+    "deck, theta_deg",
+    [
+        ((0.0, 0.7, 0.35, -0.5), (136.51, -60.0, 0.0, -28.8)),
+        ((0.0, -1.2, -0.2, 0.6), (30.0, -120.0, 40.0, 75.0)),
+        ((0.0, 0.0, 0.0, 0.0), (-60.0, -20.0, -70.0, 150.0)),
+    ],
+)
 def test_static_holding_torques_equal_the_hand_imbalance_torque(model, deck, theta_deg):
     """At rest on a tilted deck each antenna drive holds the weight of the polarization
     assembly acting at its 3.6 mm offset: tau_j = -(r x m g) . a_j, r = R_wa (2, 0, 3) mm.
@@ -322,8 +341,7 @@ def test_static_holding_torques_equal_the_hand_imbalance_torque(model, deck, the
     weight = POL_MASS * np.array([0.0, 0.0, -G])
     # World joint axes from the chain (hand): z, -x of Rz(t1), z of Rz(t1) Rx(-t2), boresight.
     t1, t2 = theta[:2]
-    axes = r_wd @ np.column_stack([[0, 0, 1], rz(t1) @ [-1, 0, 0], rz(t1) @ rx(-t2) @ [0, 0, 1],
-                                   f(theta)[:, 2]])
+    axes = r_wd @ np.column_stack([[0, 0, 1], rz(t1) @ [-1, 0, 0], rz(t1) @ rx(-t2) @ [0, 0, 1], f(theta)[:, 2]])
     expected = -(np.cross(lever, weight) @ axes)
     measured = np.array([data.sensor(f"{name}_torque").data[0] for name in ANTENNA_JOINTS])
     scale = POL_MASS * G * np.linalg.norm(POL_COM)  # 1.17 N m, the largest possible
@@ -341,8 +359,9 @@ def test_imu_reads_the_deck_attitude_and_gravity_at_rest(model):
     r_wd = world_from_deck(*deck[1:])
     # framequat of the IMU = the deck's orientation (the IMU is fixed to the deck, unrotated).
     np.testing.assert_allclose(quat_to_mat(data.sensor("imu_quat").data), r_wd, atol=1e-6)
-    np.testing.assert_allclose(quat_to_mat(data.sensor("imu_quat").data),
-                               quat_to_mat(data.body("deck").xquat), atol=1e-12)
+    np.testing.assert_allclose(
+        quat_to_mat(data.sensor("imu_quat").data), quat_to_mat(data.body("deck").xquat), atol=1e-12
+    )
     # An accelerometer at rest reads the specific force: +g up, in its own frame.
     np.testing.assert_allclose(data.sensor("imu_accel").data, r_wd.T @ [0, 0, G], atol=1e-3)
     np.testing.assert_allclose(data.sensor("imu_gyro").data, 0, atol=1e-6)
@@ -368,9 +387,11 @@ def test_gyro_reads_the_body_frame_rate_of_a_driven_deck_axis(model, joint, rate
     assert w == pytest.approx(rate, rel=2e-4)
     others = np.delete(data.qvel[:4], model.joint(joint).id)
     assert np.abs(others).max() < 1e-4 * abs(rate)
-    expected = {"roll": np.array([0, w, 0]),
-                "pitch": ry(roll).T @ [w, 0, 0],
-                "yaw": (rx(pitch) @ ry(roll)).T @ [0, 0, w]}[joint]
+    expected = {
+        "roll": np.array([0, w, 0]),
+        "pitch": ry(roll).T @ [w, 0, 0],
+        "yaw": (rx(pitch) @ ry(roll)).T @ [0, 0, w],
+    }[joint]
     np.testing.assert_allclose(data.sensor("imu_gyro").data, expected, atol=1e-4 * abs(rate))
 
 
@@ -382,12 +403,30 @@ def test_deck_tracks_the_papers_ship_motion_with_feed_forward(model):
     turn = 1.0 * DEG  # 0.01 deg per 0.01 s sample
 
     def ship(t):
-        q = np.array([0.0, 40 * DEG * np.sin(w_yaw * t) + turn * t, 40 * DEG * np.sin(w_pitch * t),
-                      45 * DEG * np.sin(w_roll * t)])
-        qd = np.array([0.0, 40 * DEG * w_yaw * np.cos(w_yaw * t) + turn,
-                       40 * DEG * w_pitch * np.cos(w_pitch * t), 45 * DEG * w_roll * np.cos(w_roll * t)])
-        qdd = np.array([0.0, -40 * DEG * w_yaw**2 * np.sin(w_yaw * t),
-                        -40 * DEG * w_pitch**2 * np.sin(w_pitch * t), -45 * DEG * w_roll**2 * np.sin(w_roll * t)])
+        q = np.array(
+            [
+                0.0,
+                40 * DEG * np.sin(w_yaw * t) + turn * t,
+                40 * DEG * np.sin(w_pitch * t),
+                45 * DEG * np.sin(w_roll * t),
+            ]
+        )
+        qd = np.array(
+            [
+                0.0,
+                40 * DEG * w_yaw * np.cos(w_yaw * t) + turn,
+                40 * DEG * w_pitch * np.cos(w_pitch * t),
+                45 * DEG * w_roll * np.cos(w_roll * t),
+            ]
+        )
+        qdd = np.array(
+            [
+                0.0,
+                -40 * DEG * w_yaw**2 * np.sin(w_yaw * t),
+                -40 * DEG * w_pitch**2 * np.sin(w_pitch * t),
+                -45 * DEG * w_roll**2 * np.sin(w_roll * t),
+            ]
+        )
         return q, qd, qdd
 
     kp = model.actuator_gainprm[:4, 0]

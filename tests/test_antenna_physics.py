@@ -6,10 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from planbench.planners import antenna as ant
-from planbench.planners.errors import PlanningError
 from planbench import antenna, runner
 from planbench.antenna.ship_motion import PaperShipMotion
+from planbench.planners import antenna as ant
+from planbench.planners.errors import PlanningError
 
 
 def _run(params, duration, antenna_options=antenna.AntennaOptions(), **options):
@@ -65,9 +65,16 @@ def test_without_prediction_the_pointing_error_is_measurably_worse(paper_run):
 
 def test_a_twice_faster_ship_breaks_the_rate_and_torque_checks():
     """The checks can fail: the paper's motion at twice its speed (periods 4 s and 5 s)."""
-    setup = antenna.task._setup(PaperShipMotion(sample_time=0.005), *np.radians(ant.PAPER_SATELLITE_DEG),
-                           6.0, 0, antenna.POINTING_MAX_PAPER_DEG, None, {},
-                           antenna.AntennaOptions())
+    setup = antenna.task._setup(
+        PaperShipMotion(sample_time=0.005),
+        *np.radians(ant.PAPER_SATELLITE_DEG),
+        6.0,
+        0,
+        antenna.POINTING_MAX_PAPER_DEG,
+        None,
+        {},
+        antenna.AntennaOptions(),
+    )
     checks = _checks(runner.run("fast ship", setup))
     assert not checks["joint_torque"].passed
     assert checks["joint_torque"].value > 1.0
@@ -211,8 +218,15 @@ def test_a_half_turn_to_the_start_attitude_plans():
     from planbench import scenarios
 
     scenario = scenarios.get("antenna-paper-motion")
-    params = scenario.resolve(satellite_lon=None, satellite_look=(223.49, 60.0, -28.8), ship_heading=180.0,
-                              heading_amplitude=0.0, pitch_amplitude=0.0, roll_amplitude=0.0, duration=5.0)
+    params = scenario.resolve(
+        satellite_lon=None,
+        satellite_look=(223.49, 60.0, -28.8),
+        ship_heading=180.0,
+        heading_amplitude=0.0,
+        pitch_amplitude=0.0,
+        roll_amplitude=0.0,
+        duration=5.0,
+    )
     trajectory = scenario.plan(params)
     assert np.all(np.isfinite(trajectory.sample(np.array([0.0, 5.0])).position))
     # The start angles give the attitude the ship at heading 180 deg needs (eq. 1).

@@ -8,10 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from planbench.planners import antenna as ant
-from planbench.planners.errors import LimitError, PlanningError
-from planbench.planners.antenna.geostationary import look_angles
 from planbench.antenna.ship_motion import PaperShipMotion
+from planbench.planners import antenna as ant
+from planbench.planners.antenna.geostationary import look_angles
+from planbench.planners.errors import LimitError, PlanningError
 
 DEG = np.pi / 180
 angles = st.floats(-np.pi, np.pi, allow_nan=False)
@@ -125,8 +125,11 @@ def test_angular_velocity_eq6_is_first_order_and_the_log_is_exact(omega, theta):
 # ---------------------------------------------------------------------------- eq. (7)
 
 
-@given(joint_angles, st.lists(st.floats(0.1, 20.0), min_size=4, max_size=4).map(np.array),
-       st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array))
+@given(
+    joint_angles,
+    st.lists(st.floats(0.1, 20.0), min_size=4, max_size=4).map(np.array),
+    st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array),
+)
 def test_weighted_pseudo_inverse_is_the_weighted_minimum_norm_least_squares(theta, weights, omega):
     jac = ant.jacobian(theta)
     if ant.weighted_singular_value(jac, weights) < 1e-3:
@@ -178,8 +181,10 @@ def test_crr_increment_keeps_the_rk4_rotation_ratio():
     theta0 = np.radians(ant.PAPER_THETA0_DEG)
     new, info = ant.crr_step(theta0, attitudes[0], attitudes[1], ant.PAPER_DT)
     omega = ant.angular_velocity_eq6(attitudes[0], attitudes[1], ant.PAPER_DT)
+
     def rate(th):
         return ant.joint_rates(th, omega)[0]
+
     dt = ant.PAPER_DT
     k1 = rate(theta0)
     k2 = rate(theta0 + dt / 2 * k1)
@@ -287,8 +292,7 @@ def test_bad_input_is_named():
 # -------------------------------------------------------------------- geostationary
 
 
-SITES = [(40, -20, -15), (19.2, 0, -17.34), (-30, 10, 30), (45, 0, 0), (10, 100, 90),
-         (-60, -70, -100)]
+SITES = [(40, -20, -15), (19.2, 0, -17.34), (-30, 10, 30), (45, 0, 0), (10, 100, 90), (-60, -70, -100)]
 
 
 def _spherical_formulas(lat, lon, sat):
@@ -307,8 +311,8 @@ def test_look_angles_on_a_sphere_equal_the_spherical_formulas(lat, lon, sat, mon
     import erfa
 
     def sphere(n, lon_, lat_, h):
-        return 6378137.0 * np.array(
-            [np.cos(lat_) * np.cos(lon_), np.cos(lat_) * np.sin(lon_), np.sin(lat_)])
+        return 6378137.0 * np.array([np.cos(lat_) * np.cos(lon_), np.cos(lat_) * np.sin(lon_), np.sin(lat_)])
+
     monkeypatch.setattr(erfa, "gd2gc", sphere)
     az, el, pol = look_angles(sat * DEG, lat * DEG, lon * DEG)
     az_s, el_s, skew = _spherical_formulas(lat, lon, sat)
@@ -358,8 +362,7 @@ def test_satellite_below_the_horizon_is_a_limit_error():
 
 
 @settings(max_examples=60, deadline=None)
-@given(joint_angles, st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array),
-       st.floats(0.005, 0.05))
+@given(joint_angles, st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array), st.floats(0.005, 0.05))
 def test_crr_step_properties(theta, omega, dt):
     """One update from an exact attitude: CRR leaves a residual of higher order in the step
     (only a 1-D family of increments is searched), the full correction none; eq. (6) loses
@@ -383,8 +386,9 @@ def test_crr_step_properties(theta, omega, dt):
 # ------------------------------------------------------- the one-pose fast path (floats)
 
 rotvecs = st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array)
-limit_sets = st.one_of(st.none(), st.lists(st.floats(0.05, 2.0), min_size=4, max_size=4).map(
-    lambda r: ant.AntennaLimits(rate=np.array(r))))
+limit_sets = st.one_of(
+    st.none(), st.lists(st.floats(0.05, 2.0), min_size=4, max_size=4).map(lambda r: ant.AntennaLimits(rate=np.array(r)))
+)
 weight_sets = st.lists(st.floats(0.5, 20.0), min_size=4, max_size=4).map(np.array)
 
 
@@ -394,16 +398,18 @@ def test_scalar_kinematics_are_those_of_the_vectorized_functions(theta):
     np.testing.assert_array_equal(np.reshape(ant._fk_floats(*theta), (3, 3)), ant.forward_kinematics(theta))
     np.testing.assert_array_equal(np.array(ant._jacobian_rows(*theta[:3])), ant.jacobian(theta))
     a, b = ant.forward_kinematics(theta), ant.forward_kinematics(theta[::-1])
-    np.testing.assert_allclose(np.reshape(ant._relative_floats(a.ravel(), b.ravel()), (3, 3)), a @ b.T,
-                               rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        np.reshape(ant._relative_floats(a.ravel(), b.ravel()), (3, 3)), a @ b.T, rtol=0, atol=1e-15
+    )
 
 
 @given(st.one_of(rotvecs, rotvecs.map(lambda v: v * 1e-5), rotvecs.map(lambda v: v * 1.8)))
 def test_scalar_rotation_log_equals_rotation_log(rotvec):
     r = Rotation.from_rotvec(rotvec).as_matrix()
     expected = ant.rotation_log(r)
-    np.testing.assert_allclose(ant._log_floats(r.ravel().tolist()), expected, rtol=0,
-                               atol=1e-14 * np.linalg.norm(expected) + 1e-300)
+    np.testing.assert_allclose(
+        ant._log_floats(r.ravel().tolist()), expected, rtol=0, atol=1e-14 * np.linalg.norm(expected) + 1e-300
+    )
 
 
 def test_scalar_rotation_log_refuses_a_half_turn():
@@ -458,8 +464,7 @@ def test_scalar_joint_rates_equal_joint_rates(theta, omega, weights, limits):
 
 
 @settings(max_examples=150, deadline=None)
-@given(joint_angles, rotvecs, st.floats(0.005, 0.05), st.sampled_from(["eq6", "log"]), st.booleans(),
-       st.booleans())
+@given(joint_angles, rotvecs, st.floats(0.005, 0.05), st.sampled_from(["eq6", "log"]), st.booleans(), st.booleans())
 def test_scalar_crr_step_equals_crr_step(theta, omega, dt, omega_method, full_correction, limited):
     """One CRR update (eq. 6, 9, 11-14, 10, the cap and the full correction) in floats: the
     same angles to round-off, the same flags and residual."""
@@ -490,21 +495,30 @@ def test_scalar_crr_follows_the_paper_path(omega_method, limited):
     path = ant.solve_joint_path(attitudes, ant.PAPER_DT, theta0, "crr", limits=limits, omega_method=omega_method)
     iterations = []
     for i in range(t.size - 1):
-        new, info = ant.crr_step_scalar(path.theta[i], attitudes[i], attitudes[i + 1], ant.PAPER_DT, limits=limits,
-                                        omega_method=omega_method)
+        new, info = ant.crr_step_scalar(
+            path.theta[i], attitudes[i], attitudes[i + 1], ant.PAPER_DT, limits=limits, omega_method=omega_method
+        )
         np.testing.assert_allclose(new, path.theta[i + 1], rtol=0, atol=1e-14)
         iterations.append(info.iterations)
     # The Newton stop rule (a step under 1e-15 rad) sits at round-off: the two paths may stop
     # one iteration apart, never more (their angles agree to 1e-14 above).
     assert np.abs(np.array(iterations) - path.iterations[1:]).max() <= 1
     planner = ant.CrrPlanner(omega_method=omega_method)
-    problem = ant.AntennaProblem(attitudes[0], 0.0, 0.0, 0.0, theta0,
-                                 limits if limits is not None else ant.AntennaLimits(), update_dt=ant.PAPER_DT)
+    problem = ant.AntennaProblem(
+        attitudes[0],
+        0.0,
+        0.0,
+        0.0,
+        theta0,
+        limits if limits is not None else ant.AntennaLimits(),
+        update_dt=ant.PAPER_DT,
+    )
     planner.reset(problem)
     planner.attitude = attitudes[0]
     online = np.array([planner.step(ti, n) for ti, n in zip(t[1:], attitudes[1:], strict=True)])
-    reference = ant.solve_joint_path(attitudes, ant.PAPER_DT, theta0, "crr", limits=problem.limits,
-                                     omega_method=omega_method)
+    reference = ant.solve_joint_path(
+        attitudes, ant.PAPER_DT, theta0, "crr", limits=problem.limits, omega_method=omega_method
+    )
     np.testing.assert_allclose(online, reference.theta[1:], rtol=0, atol=1e-12)
 
 
@@ -535,6 +549,7 @@ def test_the_exact_singularity_with_no_damping_allowed_is_a_singularity_error(mo
             if not (args[3:] or kwargs.get("damping")):
                 raise np.linalg.LinAlgError("singular matrix")
             return solve(*args, **kwargs)
+
         return solve_or_raise
 
     monkeypatch.setattr(ant, "_solve_rates", singular(ant._solve_rates))

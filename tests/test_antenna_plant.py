@@ -11,12 +11,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-
-from planbench import models
 from model_diff import changed_fields
 from plant_model import assert_edits_only
+
+from planbench import antenna, api, models, runner, scenarios
 from planbench.antenna import params as antenna_params
-from planbench import antenna, api, runner, scenarios
 from planbench.antenna.ship_motion import world_from_ship
 from planbench.params import ParamError
 
@@ -26,9 +25,16 @@ SPEC = scenarios.get("antenna-sea-state")
 #: the noise, nor by the gears' backlash and friction (tests/test_antenna_drives.py).
 QUIET = dict(imu={"attitude_noise_deg": 0.0, "gyro_noise_deg_s": 0.0}, drives="ideal")
 #: Every field off nominal at once, inside its range.
-EVERYTHING = dict(mass_error=0.1, imbalance_offset=(4.0, -3.0, 2.0), joint_friction=1.0, torque_limit_scale=0.8,
-                  imu_bias=(0.05, -0.02, 0.1))
-JOINT_IDS = dict(zip(antenna.JOINTS, range(4, 8), strict=True))  # the antenna's dofs and actuators follow the deck's four
+EVERYTHING = dict(
+    mass_error=0.1,
+    imbalance_offset=(4.0, -3.0, 2.0),
+    joint_friction=1.0,
+    torque_limit_scale=0.8,
+    imu_bias=(0.05, -0.02, 0.1),
+)
+JOINT_IDS = dict(
+    zip(antenna.JOINTS, range(4, 8), strict=True)
+)  # the antenna's dofs and actuators follow the deck's four
 
 
 def plant_model(**fields) -> mujoco.MjModel:
@@ -58,14 +64,19 @@ def test_the_readme_documents_every_plant_field():
 
 def _mass(nominal, plant):
     ids = [nominal.body(b).id for b in antenna.MOVING_BODIES]
-    return {"body_mass": {i: 1.1 * nominal.body_mass[i] for i in ids},
-            "body_inertia": {i: 1.1 * nominal.body_inertia[i] for i in ids}}
+    return {
+        "body_mass": {i: 1.1 * nominal.body_mass[i] for i in ids},
+        "body_inertia": {i: 1.1 * nominal.body_inertia[i] for i in ids},
+    }
 
 
 def _imbalance(nominal, plant):
     offset = np.array([4e-3, -3e-3, 2e-3])  # m, in the polarization frame = the reflector's axes
-    return {"body_ipos": {nominal.body(b).id: nominal.body_ipos[nominal.body(b).id] + offset
-                          for b in ("polarization", "reflector")}}
+    return {
+        "body_ipos": {
+            nominal.body(b).id: nominal.body_ipos[nominal.body(b).id] + offset for b in ("polarization", "reflector")
+        }
+    }
 
 
 def _friction(nominal, plant):
@@ -77,12 +88,16 @@ def _torque(nominal, plant):
     return {"actuator_forcerange": {nominal.actuator(j).id: [-0.8 * r, 0.8 * r] for j, r in ratings.items()}}
 
 
-@pytest.mark.parametrize("fields, edits", [
-    (dict(mass_error=0.1), _mass),
-    (dict(imbalance_offset=(4.0, -3.0, 2.0)), _imbalance),
-    (dict(joint_friction=2.5), _friction),
-    (dict(torque_limit_scale=0.8), _torque),
-], ids=["mass_error", "imbalance_offset", "joint_friction", "torque_limit_scale"])
+@pytest.mark.parametrize(
+    "fields, edits",
+    [
+        (dict(mass_error=0.1), _mass),
+        (dict(imbalance_offset=(4.0, -3.0, 2.0)), _imbalance),
+        (dict(joint_friction=2.5), _friction),
+        (dict(torque_limit_scale=0.8), _torque),
+    ],
+    ids=["mass_error", "imbalance_offset", "joint_friction", "torque_limit_scale"],
+)
 def test_a_field_changes_its_part_of_the_model_and_nothing_else(fields, edits):
     nominal = models.load("antenna")
     plant = plant_model(**fields)
@@ -148,8 +163,9 @@ def test_without_an_imu_bias_the_plant_starts_where_the_nominal_one_does():
     perturbed, reference = build(0.1, fields), build(0.1)
     for name in ("qpos", "qvel", "act"):
         np.testing.assert_array_equal(getattr(perturbed.physics.data, name), getattr(reference.physics.data, name))
-        np.testing.assert_array_equal(getattr(perturbed.task.nominal_physics().data, name),
-                                      getattr(reference.physics.data, name))
+        np.testing.assert_array_equal(
+            getattr(perturbed.task.nominal_physics().data, name), getattr(reference.physics.data, name)
+        )
     np.testing.assert_array_equal(perturbed.task.problem.theta0, reference.task.problem.theta0)
 
 
@@ -237,9 +253,11 @@ def test_friction_holds_a_static_error_the_nominal_plant_has_not(nominal_run):
 
 
 def test_api_run_refuses_bad_plants_before_building():
-    for plant, words in [({"mass_error": 0.5}, "plant.mass_error = 0.5 fraction is outside [-0.2, 0.2]"),
-                         ({"imu_bias": [0.1, 0.1]}, "plant.imu_bias has 2 values, not 3"),
-                         ({"gyro_bias": [0, 0, 0]}, "unknown parameter 'plant.gyro_bias'")]:
+    for plant, words in [
+        ({"mass_error": 0.5}, "plant.mass_error = 0.5 fraction is outside [-0.2, 0.2]"),
+        ({"imu_bias": [0.1, 0.1]}, "plant.imu_bias has 2 values, not 3"),
+        ({"gyro_bias": [0, 0, 0]}, "unknown parameter 'plant.gyro_bias'"),
+    ]:
         with pytest.raises(ParamError) as refused:
             api.run("antenna-sea-state", plant=plant)
         assert words in str(refused.value), str(refused.value)

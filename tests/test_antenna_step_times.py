@@ -7,25 +7,29 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from planbench import scenarios
 from planbench.planners import antenna as ant
 from planbench.planners.errors import PlanningError
-from planbench import scenarios
 from planbench.task import RecordingPlanner, StepTimeError
 
 
 def _problem():
     satellite = ant.satellite_attitude(np.radians(223.49), np.radians(60.0), np.radians(-28.8))
     theta0 = np.array([0.3, 0.4, 0.1, -0.2])
-    return ant.AntennaProblem(satellite, 223.49, 60.0, -28.8, theta0, ant.AntennaLimits(rate=np.full(4, 1.0)),
-                              update_dt=0.02)
+    return ant.AntennaProblem(
+        satellite, 223.49, 60.0, -28.8, theta0, ant.AntennaLimits(rate=np.full(4, 1.0)), update_dt=0.02
+    )
 
 
-@pytest.mark.parametrize("times, bad", [
-    ((0.0,), 0),                 # at the reset time: the problem's start
-    ((-0.02,), 0),               # before it
-    ((0.02, 0.02), 1),           # twice at the same time
-    ((0.02, 0.04, 0.03), 2),     # back in time
-])
+@pytest.mark.parametrize(
+    "times, bad",
+    [
+        ((0.0,), 0),  # at the reset time: the problem's start
+        ((-0.02,), 0),  # before it
+        ((0.02, 0.02), 1),  # twice at the same time
+        ((0.02, 0.04, 0.03), 2),  # back in time
+    ],
+)
 @pytest.mark.parametrize("wrapped", [False, True], ids=["planner", "task's record"])
 def test_a_step_not_after_the_previous_one_names_both_times(times, bad, wrapped):
     problem = _problem()

@@ -13,14 +13,14 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import example, given, settings, strategies as st
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 from scipy.interpolate import CubicSpline
 
-from planbench.planners import antenna, fast, hexapod, loader
-from planbench.planners.fast import plan as fast_plan
-from planbench.planners import profiles
-from planbench.planners.loader.bspline import CubicBSplineTrajectory
+from planbench.planners import antenna, fast, hexapod, loader, profiles
 from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.fast import plan as fast_plan
+from planbench.planners.loader.bspline import CubicBSplineTrajectory
 from planbench.planners.trajectory import MAX_MAGNITUDE, sample_times
 
 NAN, INF = float("nan"), float("inf")
@@ -79,9 +79,12 @@ def test_bad_joint_limits_are_refused(kwargs, fragments):
 
 def test_limit_nan_names_the_joint_of_a_multi_joint_spline():
     keys = np.zeros((3, 3))
-    raises_named(lambda: spline(keys, labels=["a", "b", "c"], lower=[0, 0, 0],
-                                upper=[1, NAN, 1]),
-                 "upper limit of joint b", "= nan", LIMIT)
+    raises_named(
+        lambda: spline(keys, labels=["a", "b", "c"], lower=[0, 0, 0], upper=[1, NAN, 1]),
+        "upper limit of joint b",
+        "= nan",
+        LIMIT,
+    )
 
 
 HEXAPOD_LIMIT_CASES = [
@@ -98,16 +101,27 @@ HEXAPOD_LIMIT_CASES = [
 
 @pytest.mark.parametrize("field, value, fragments", HEXAPOD_LIMIT_CASES)
 def test_bad_hexapod_limits_are_refused(field, value, fragments):
-    args = dict(pose_lower=[-1] * 6, pose_upper=[1] * 6, stroke=1.0, strut_speed=1.0,
-                strut_accel=1.0, linear_speed=1.0, angular_speed=1.0)
+    args = dict(
+        pose_lower=[-1] * 6,
+        pose_upper=[1] * 6,
+        stroke=1.0,
+        strut_speed=1.0,
+        strut_accel=1.0,
+        linear_speed=1.0,
+        angular_speed=1.0,
+    )
     args[field] = value
     raises_named(lambda: hexapod.HexapodLimits(**args), *fragments)
 
 
 def test_nan_hexapod_limits_no_longer_plan_a_move():
     """A NaN pose limit used to compare False everywhere, so every pose passed."""
-    raises_named(lambda: hexapod.plan_moves(np.zeros(6), np.zeros(6), limits=hexapod.HexapodLimits(
-        [NAN] * 6, [1] * 6, 1, 1, 1, 1, 1)), "pose_lower x = nan")
+    raises_named(
+        lambda: hexapod.plan_moves(
+            np.zeros(6), np.zeros(6), limits=hexapod.HexapodLimits([NAN] * 6, [1] * 6, 1, 1, 1, 1, 1)
+        ),
+        "pose_lower x = nan",
+    )
 
 
 PROFILE_LIMIT_CASES = [
@@ -117,10 +131,8 @@ PROFILE_LIMIT_CASES = [
     (lambda: profiles.move_in_time(1.0, 1e308, 1.0, 1.0), ["duration = 1e+308 s", LIMIT]),
     (lambda: profiles.velocity_change(0.0, 1.0, -INF), ["a_max = -inf", LIMIT]),
     (lambda: profiles.cruise(1e308, 1.0), ["velocity = 1e+308 m/s", LIMIT]),
-    (lambda: profiles.Profile([1e308, 1e308], [0.0, 1.0, 0.0]),
-     ["profile durations[0] = 1e+308 s", LIMIT]),
-    (lambda: profiles.Profile([1e100, 1e100], [0.0, 1e100, 0.0]),
-     ["profile position at break 1", "e+299 m", LIMIT]),
+    (lambda: profiles.Profile([1e308, 1e308], [0.0, 1.0, 0.0]), ["profile durations[0] = 1e+308 s", LIMIT]),
+    (lambda: profiles.Profile([1e100, 1e100], [0.0, 1e100, 0.0]), ["profile position at break 1", "e+299 m", LIMIT]),
 ]
 
 
@@ -134,8 +146,7 @@ def test_bad_profile_numbers_are_refused(call, fragments):
 
 def _fast_plan():
     s = fast.source_direction(math.radians(10.0), math.radians(70.0))
-    return fast_plan.FastPlan([fast_plan.observation_segment(np.array([0.0, 10.0]),
-                                                              np.stack([s, s]), name="hold")])
+    return fast_plan.FastPlan([fast_plan.observation_segment(np.array([0.0, 10.0]), np.stack([s, s]), name="hold")])
 
 
 def _joint_path():
@@ -193,20 +204,15 @@ HUGE_CASES = [
     (lambda: spline([[0.0], [1e151]]), ["key point 1 of joint q1", "= 1e+151", LIMIT]),
     (lambda: spline([[0.0], [INF]]), ["key point 1 of joint q1", "= inf", "non-finite"]),
     (lambda: spline([[0.0], [NAN]]), ["key point 1 of joint q1", "= nan", "non-finite"]),
-    (lambda: spline([[0.0, 0.0], [0.0, -INF]], labels=["a", "b"]),
-     ["key point 1 of joint b", "= -inf"]),
+    (lambda: spline([[0.0, 0.0], [0.0, -INF]], labels=["a", "b"]), ["key point 1 of joint b", "= -inf"]),
     (lambda: spline(times=[0.0, 1e308]), ["key time t[1] = 1e+308 s", LIMIT]),
     (lambda: spline(times=[NAN, 1.0]), ["key time t[0] = nan s", "NaN"]),
-    (lambda: spline(times=[0.0, 1e-200]),
-     ["key step 1e-200 s is too short", "must be >= 4.9e-75 s"]),
-    (lambda: hexapod.plan_moves(np.zeros(6), [1e308, 0, 0, 0, 0, 0]),
-     ["target pose x = 1e+308 m", LIMIT]),
-    (lambda: hexapod.plan_moves([0, 0, 0, 0, 0, -1e308], np.zeros(6)),
-     ["start pose rz = -1e+308 rad", LIMIT]),
+    (lambda: spline(times=[0.0, 1e-200]), ["key step 1e-200 s is too short", "must be >= 4.9e-75 s"]),
+    (lambda: hexapod.plan_moves(np.zeros(6), [1e308, 0, 0, 0, 0, 0]), ["target pose x = 1e+308 m", LIMIT]),
+    (lambda: hexapod.plan_moves([0, 0, 0, 0, 0, -1e308], np.zeros(6)), ["start pose rz = -1e+308 rad", LIMIT]),
     (lambda: profiles.move_min_time(1e308, 1.0, 1.0), ["distance = 1e+308 m", LIMIT]),
     (lambda: profiles.move_min_time(-1e308, 1.0, 1.0), ["distance = -1e+308 m", LIMIT]),
-    (lambda: fast_plan.switch_times([1e308, 0.0, -100.0], [0.0, 0.0, -160.0]),
-     ["P0 x = 1e+308 m", LIMIT]),
+    (lambda: fast_plan.switch_times([1e308, 0.0, -100.0], [0.0, 0.0, -160.0]), ["P0 x = 1e+308 m", LIMIT]),
 ]
 
 
@@ -221,17 +227,25 @@ def test_largest_accepted_key_point_plans_finite_motion():
     out = s.sample(np.linspace(0.0, 20.0, 11))
     assert all(np.all(np.isfinite(x)) for x in (out.position, out.velocity, out.acceleration))
     # The overshoot check squares the coefficients: still finite, and still finds the bulge.
-    raises_named(lambda: spline([[MAX_MAGNITUDE], [-MAX_MAGNITUDE], [-MAX_MAGNITUDE],
-                                 [MAX_MAGNITUDE]], times=[0.0, 10.0, 20.0, 30.0],
-                                lower=[-MAX_MAGNITUDE]), "overshoots its lower limit",
-                 kind=LimitError)
-    raises_named(lambda: spline([[0.0], [1.0]], times=[0.0, 0.5]).sample([0.25, 2e150]),
-                 "t[1] = 2e+150 s")
+    raises_named(
+        lambda: spline(
+            [[MAX_MAGNITUDE], [-MAX_MAGNITUDE], [-MAX_MAGNITUDE], [MAX_MAGNITUDE]],
+            times=[0.0, 10.0, 20.0, 30.0],
+            lower=[-MAX_MAGNITUDE],
+        ),
+        "overshoots its lower limit",
+        kind=LimitError,
+    )
+    raises_named(lambda: spline([[0.0], [1.0]], times=[0.0, 0.5]).sample([0.25, 2e150]), "t[1] = 2e+150 s")
 
 
 def test_hexapod_limit_message_of_a_large_value_is_readable():
-    message = raises_named(lambda: hexapod.plan_moves(np.zeros(6), [1e140, 0, 0, 0, 0, 0]),
-                           "target x = 1e+146 um", "limit 11400.0 um", kind=LimitError)
+    message = raises_named(
+        lambda: hexapod.plan_moves(np.zeros(6), [1e140, 0, 0, 0, 0, 0]),
+        "target x = 1e+146 um",
+        "limit 11400.0 um",
+        kind=LimitError,
+    )
     assert len(message) < 120
 
 
@@ -245,35 +259,44 @@ def test_plan_moves_names_the_bad_row(row, axis, unit, value, text):
     target = np.zeros((5, 6))
     target[row, axis] = value
     name = hexapod.POSE_LABELS[axis]
-    raises_named(lambda: hexapod.plan_moves(np.zeros(6), target),
-                 f"target pose {name} of row {row} = {text} {unit}", LIMIT)
-    raises_named(lambda: hexapod.plan_moves(target, np.zeros((5, 6))),
-                 f"start pose {name} of row {row} = {text} {unit}", LIMIT)
+    raises_named(
+        lambda: hexapod.plan_moves(np.zeros(6), target), f"target pose {name} of row {row} = {text} {unit}", LIMIT
+    )
+    raises_named(
+        lambda: hexapod.plan_moves(target, np.zeros((5, 6))), f"start pose {name} of row {row} = {text} {unit}", LIMIT
+    )
 
 
 def test_plan_strut_moves_names_the_bad_row():
     target = np.zeros((3, 6))
     target[1, 4] = NAN
-    raises_named(lambda: hexapod.plan_strut_moves(np.zeros((3, 6)), target),
-                 "target strut5 position of row 1 = nan m", LIMIT)
+    raises_named(
+        lambda: hexapod.plan_strut_moves(np.zeros((3, 6)), target), "target strut5 position of row 1 = nan m", LIMIT
+    )
 
 
 OTHER_ENTRY_POINTS = [
-    (lambda: hexapod.plan_moves(np.zeros(6), [1e-3, 0, 0, 0, 0, 0], dt=1e-300),
-     ["tick 1e-300 s is too short", "1e+08"]),
+    (
+        lambda: hexapod.plan_moves(np.zeros(6), [1e-3, 0, 0, 0, 0, 0], dt=1e-300),
+        ["tick 1e-300 s is too short", "1e+08"],
+    ),
     (lambda: hexapod.strut_lengths([0, 0, NAN, 0, 0, 0]), ["pose z = nan m"]),
-    (lambda: hexapod.HexapodGeometry(np.full((6, 3), NAN), np.ones((6, 3)), np.zeros(3)),
-     ["base_pivots[0, 0] = nan m"]),
-    (lambda: loader.forward_kinematics([0, 0, 0, NAN, 0, 0]),
-     ["q of joint wrist_pitch = nan", LIMIT]),
+    (
+        lambda: hexapod.HexapodGeometry(np.full((6, 3), NAN), np.ones((6, 3)), np.zeros(3)),
+        ["base_pivots[0, 0] = nan m"],
+    ),
+    (lambda: loader.forward_kinematics([0, 0, 0, NAN, 0, 0]), ["q of joint wrist_pitch = nan", LIMIT]),
     (lambda: loader.forward_kinematics(np.zeros(5)), ["q has 5 joints, the chain has 6"]),
     (lambda: fast_plan.switch_times([NAN, 0.0, -100.0], [0.0, 0.0, -160.0]), ["P0 x = nan m"]),
-    (lambda: fast_plan.switch_times([0.0, 0.0, -160.0], [0.0, 0.0, -160.0], multifeed1=NAN),
-     ["multifeed1 = nan rad"]),
-    (lambda: fast_plan.transition_time(np.zeros(3) + 1, [0, INF, 0], np.ones(3), np.zeros(3)),
-     ["transition V0 y = inf m/s"]),
-    (lambda: fast_plan.observation_segment([0.0, NAN], np.tile([0.0, 0.0, 1.0], (2, 1))),
-     ["observation time t[1] = nan s"]),
+    (lambda: fast_plan.switch_times([0.0, 0.0, -160.0], [0.0, 0.0, -160.0], multifeed1=NAN), ["multifeed1 = nan rad"]),
+    (
+        lambda: fast_plan.transition_time(np.zeros(3) + 1, [0, INF, 0], np.ones(3), np.zeros(3)),
+        ["transition V0 y = inf m/s"],
+    ),
+    (
+        lambda: fast_plan.observation_segment([0.0, NAN], np.tile([0.0, 0.0, 1.0], (2, 1))),
+        ["observation time t[1] = nan s"],
+    ),
 ]
 
 
@@ -311,8 +334,7 @@ def check_within(traj, lower, upper):
     t = np.concatenate([np.linspace(-0.1, traj.duration + 0.1, 4001), traj.key_times])
     pos = traj.sample(t).position
     tol = traj.limit_tolerance
-    assert np.all(pos >= lower - tol) and np.all(pos <= upper + tol), (
-        (lower - pos).max(), (pos - upper).max(), tol)
+    assert np.all(pos >= lower - tol) and np.all(pos <= upper + tol), ((lower - pos).max(), (pos - upper).max(), tol)
 
 
 @settings(max_examples=300, deadline=None)
@@ -339,8 +361,7 @@ def test_the_tolerance_is_the_documented_one():
 
 
 @settings(max_examples=200, deadline=None)
-@given(on_limit_sequences(), st.integers(0, 11), st.booleans(),
-       st.sampled_from([1.5, 10.0, 1e6]), OFFSETS, SPANS)
+@given(on_limit_sequences(), st.integers(0, 11), st.booleans(), st.sampled_from([1.5, 10.0, 1e6]), OFFSETS, SPANS)
 def test_a_key_point_beyond_the_limit_is_refused(seq, where, high, factor, offset, span):
     keys = (offset + span * seq)[:, None]
     k = where % keys.shape[0]
@@ -351,16 +372,19 @@ def test_a_key_point_beyond_the_limit_is_refused(seq, where, high, factor, offse
     keys[k, 0] = upper + delta if high else lower - delta
     assert keys[k, 0] != (upper if high else lower)
     side = "upper" if high else "lower"
-    raises_named(lambda: spline(keys, lower=[lower], upper=[upper]),
-                 f"beyond its {side} limit", kind=LimitError)
+    raises_named(lambda: spline(keys, lower=[lower], upper=[upper]), f"beyond its {side} limit", kind=LimitError)
 
 
 def test_a_key_point_one_ulp_beyond_the_limit_is_refused():
     """Key points are the caller's numbers: they are checked exactly, without tolerance."""
-    raises_named(lambda: spline([[0.0], [np.nextafter(1.0, 2.0)]], lower=[0.0], upper=[1.0]),
-                 "q1 = 1.0000000000000002 is beyond its upper limit 1.0", kind=LimitError)
-    raises_named(lambda: spline([[-5e-324], [1.0]], lower=[0.0], upper=[1.0]),
-                 "beyond its lower limit 0", kind=LimitError)
+    raises_named(
+        lambda: spline([[0.0], [np.nextafter(1.0, 2.0)]], lower=[0.0], upper=[1.0]),
+        "q1 = 1.0000000000000002 is beyond its upper limit 1.0",
+        kind=LimitError,
+    )
+    raises_named(
+        lambda: spline([[-5e-324], [1.0]], lower=[0.0], upper=[1.0]), "beyond its lower limit 0", kind=LimitError
+    )
 
 
 def _true_extremes(times, keys):
@@ -389,8 +413,9 @@ def test_a_real_overshoot_beyond_the_tolerance_is_refused(b, high, factor, offse
         assert bottom < keys.min() - factor * tol
         bad, good = dict(lower=[bottom + factor * tol]), dict(lower=[bottom - factor * tol])
     side = "upper" if high else "lower"
-    raises_named(lambda: spline(keys[:, None], **bad), f"overshoots its {side} limit",
-                 "round-off tolerance", kind=LimitError)
+    raises_named(
+        lambda: spline(keys[:, None], **bad), f"overshoots its {side} limit", "round-off tolerance", kind=LimitError
+    )
     spline(keys[:, None], **good)
 
 
@@ -402,8 +427,7 @@ def test_a_dip_whose_cubic_term_is_round_off_is_found():
     keys = (360.0 * np.array([1.0, 1.0 - b, 1.0 - b, 1.0]))[:, None]
     top, bottom = _true_extremes(np.arange(4) * 0.5, keys[:, 0])
     assert bottom == pytest.approx(70.58175432, abs=1e-6)
-    raises_named(lambda: spline(keys, lower=[75.0]), "q1 = 70.5818 overshoots its lower limit 75",
-                 kind=LimitError)
+    raises_named(lambda: spline(keys, lower=[75.0]), "q1 = 70.5818 overshoots its lower limit 75", kind=LimitError)
     spline(keys, lower=[70.58])
 
 

@@ -44,7 +44,10 @@ CASES = [
     (["run", "loader-supply", "--out", "/sys/planbench/run"], ["/sys", "nothing can be created"]),
     (["run", "loader-supply", "--out", "/proc/self/planbench"], ["/proc/self", "nothing can be created"]),
     (["run", "loader-supply", "--out", "{tmp}/locked/run"], ["locked", "nothing can be created"]),
-    (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/locked/v.mp4"], ["locked", "nothing can be created"]),
+    (
+        ["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/locked/v.mp4"],
+        ["locked", "nothing can be created"],
+    ),
     (["plan", "loader-supply", "--out", "{tmp}/locked/p"], ["locked", "nothing can be created"]),
     (["run", "loader-supply", "--out", "{tmp}/" + LONG_NAME], ["300 bytes", "limit of 255"]),
     (["run", "loader-supply", "--out", "{tmp}/" + DEEP], ["bytes", "limit of 4095"]),
@@ -53,19 +56,28 @@ CASES = [
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/v.gif"], ["'.gif'", ".mkv"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/video"], ["(none)", ".mp4"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", ""], ["''", "empty"]),
-    (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/r/report.png/v.mp4"],
-     ["report.png", "would overwrite"]),
-    (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/r/summary.json/v.mp4"],
-     ["summary.json", "would overwrite"]),
-    (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/r/" + MANIFEST + "/v.mp4"],
-     [MANIFEST, "would overwrite"]),
+    (
+        ["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/r/report.png/v.mp4"],
+        ["report.png", "would overwrite"],
+    ),
+    (
+        ["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/r/summary.json/v.mp4"],
+        ["summary.json", "would overwrite"],
+    ),
+    (
+        ["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/r/" + MANIFEST + "/v.mp4"],
+        [MANIFEST, "would overwrite"],
+    ),
     (["run", "loader-supply", "--out", "{tmp}/r.mp4", "--video", "{tmp}/r.mp4"], ["r.mp4", "output directory itself"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/holiday.mp4"], ["holiday.mp4", "did not write it"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/clips.mp4"], ["clips.mp4", "is a directory"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/vlink.mp4"], ["vlink.mp4", "symbolic link"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", "/proc/v.mp4"], ["/proc", "nothing can be created"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/" + LONG_NAME + ".mp4"], ["304 bytes", "255"]),
-    (["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/notes.txt/v.mp4"], ["notes.txt", "not a directory"]),
+    (
+        ["run", "loader-supply", "--out", "{tmp}/r", "--video", "{tmp}/notes.txt/v.mp4"],
+        ["notes.txt", "not a directory"],
+    ),
     (["run", "loader-supply", "--out", "{tmp}/r", "--camera", ""], ["camera ''", "overview, closeup"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--camera", "top"], ["camera 'top'", "overview, closeup"]),
     # -- scenario and options -------------------------------------------------------------
@@ -88,24 +100,48 @@ CASES = [
     (["run", "antenna-sea-state", "--out", "{tmp}/r", "--tp", "-2"], ["tp = -2 s", "[1, 30] s"]),
     (["run", "antenna-paper-motion", "--out", "{tmp}/r", "--hs", "3"], ["unrecognized arguments", "--hs"]),
     (["run", "antenna-paper-motion", "--out", "{tmp}/r", "--set", "imu.rate_hz=30"], ["30", "200"]),
-    (["run", "antenna-paper-motion", "--out", "{tmp}/r", "--set", "imu.rate_hz=0"], ["imu.rate_hz = 0 Hz", "[1, 200] Hz"]),
+    (
+        ["run", "antenna-paper-motion", "--out", "{tmp}/r", "--set", "imu.rate_hz=0"],
+        ["imu.rate_hz = 0 Hz", "[1, 200] Hz"],
+    ),
     (["run", "antenna-paper-motion", "--out", "{tmp}/r", "--set", "imu.latency_s=0.0123"], ["0.0123", "5 ms"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--prediction", "off"], ["unrecognized arguments", "--prediction"]),
     (["run", "fast-tracking", "--out", "{tmp}/r", "--stewart", "maybe"], ["stewart = 'maybe'", "not true or false"]),
     (["run", "fast-tracking", "--out", "{tmp}/r", "--cable-segments", "1"], ["cable_segments = 1", "14"]),
     (["run", "fast-tracking", "--out", "{tmp}/r", "--cable-segments", "x"], ["cable_segments = 'x'", "not an integer"]),
     (["run", "hexapod-sync-move", "--out", "{tmp}/r", "--stewart", "on"], ["unrecognized arguments", "--stewart"]),
-    (["run", "loader-supply", "--out", "{tmp}/r", "--cable-segments", "4"], ["unrecognized arguments", "--cable-segments"]),
+    (
+        ["run", "loader-supply", "--out", "{tmp}/r", "--cable-segments", "4"],
+        ["unrecognized arguments", "--cable-segments"],
+    ),
     # valid numbers that are not a run
-    (["run", "fast-tracking", "--out", "{tmp}/r", "--duration", "1e-6"], ["duration = 1e-06 s", "one control tick (20 ms)"]),
-    (["run", "loader-supply", "--out", "{tmp}/r", "--duration", "0.004"], ["duration = 0.004 s", "one control tick (5 ms)"]),
-    (["run", "fast-tracking", "--out", "{tmp}/r", "--duration", "1e12"], ["duration 1e+12 s", "PiB of log", "limit of"]),
-    (["run", "hexapod-sync-move", "--out", "{tmp}/r", "--duration", "1e15"], ["duration 1e+15 s", "of log", "limit of"]),
+    (
+        ["run", "fast-tracking", "--out", "{tmp}/r", "--duration", "1e-6"],
+        ["duration = 1e-06 s", "one control tick (20 ms)"],
+    ),
+    (
+        ["run", "loader-supply", "--out", "{tmp}/r", "--duration", "0.004"],
+        ["duration = 0.004 s", "one control tick (5 ms)"],
+    ),
+    (
+        ["run", "fast-tracking", "--out", "{tmp}/r", "--duration", "1e12"],
+        ["duration 1e+12 s", "PiB of log", "limit of"],
+    ),
+    (
+        ["run", "hexapod-sync-move", "--out", "{tmp}/r", "--duration", "1e15"],
+        ["duration 1e+15 s", "of log", "limit of"],
+    ),
     (["run", "antenna-sea-state", "--out", "{tmp}/r", "--tp", "1e-3"], ["0.001 s", "[1, 30] s", "Munk"]),
     (["run", "antenna-sea-state", "--out", "{tmp}/r", "--tp", "1e4"], ["10000 s", "[1, 30] s", "Munk"]),
     (["run", "antenna-sea-state", "--out", "{tmp}/r", "--hs", "25"], ["hs = 25 m", "(0, 20] m"]),
-    (["run", "antenna-sea-state", "--out", "{tmp}/r", "--hs", "10", "--tp", "5"], ["hs = 10 m", "tp = 5 s", "DNV-RP-C205"]),
-    (["run", "antenna-sea-state", "--out", "{tmp}/r", "--wave-heading", "1e308"], ["wave_heading = 1e+308 deg", "[-360, 360]", "not wrapped"]),
+    (
+        ["run", "antenna-sea-state", "--out", "{tmp}/r", "--hs", "10", "--tp", "5"],
+        ["hs = 10 m", "tp = 5 s", "DNV-RP-C205"],
+    ),
+    (
+        ["run", "antenna-sea-state", "--out", "{tmp}/r", "--wave-heading", "1e308"],
+        ["wave_heading = 1e+308 deg", "[-360, 360]", "not wrapped"],
+    ),
     (["run", "fast-tracking", "--out", "{tmp}/r", "--wind-direction", "-1e308"], ["-1e+308 deg", "[-360, 360]"]),
     (["run", "fast-tracking", "--out", "{tmp}/r", "--cable-segments", "15"], ["cable_segments = 15", "[0, 14]"]),
     (["run", "fast-tracking", "--out", "{tmp}/r", "--cable-segments", "50"], ["cable_segments = 50", "[0, 14]"]),
@@ -166,8 +202,9 @@ def _lay_out(tmp_path):
     added = tmp_path / "added"
     added.mkdir()
     (added / "summary.json").write_text("{}")
-    (added / MANIFEST).write_text(json.dumps({"written_by": "planbench", "target": "added",
-                                              "files": ["summary.json", MANIFEST]}))
+    (added / MANIFEST).write_text(
+        json.dumps({"written_by": "planbench", "target": "added", "files": ["summary.json", MANIFEST]})
+    )
     (added / "mine.txt").write_text("mine")
     (tmp_path / "holiday.mp4").write_bytes(b"\x00\x00\x00\x18ftypmp42 someone's video")
     (tmp_path / "clips.mp4").mkdir()
@@ -200,18 +237,26 @@ def test_bad_invocation(argv, expected, scene, capsys):
     assert snapshot(scene) == before
 
 
-@pytest.mark.parametrize("argv", [
-    ["run", "loader-supply", "--out", "{tmp}/mydata"],
-    ["run", "loader-supply", "--out", "{tmp}/r", "--duration", "nan"],
-    ["demo", "--out", "{tmp}/results"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", "loader-supply", "--out", "{tmp}/mydata"],
+        ["run", "loader-supply", "--out", "{tmp}/r", "--duration", "nan"],
+        ["demo", "--out", "{tmp}/results"],
+    ],
+)
 def test_bad_invocation_as_a_process(argv, scene):
     """The same contract seen from the shell: no traceback reaches the terminal."""
     argv = [a.replace("{tmp}", str(scene)) for a in argv]
     before = snapshot(scene)
     root = Path(__file__).resolve().parents[1]
-    proc = subprocess.run([sys.executable, "-m", "planbench.cli", *argv], capture_output=True, text=True,
-                          cwd=scene, env={**os.environ, "PYTHONPATH": str(root)})
+    proc = subprocess.run(
+        [sys.executable, "-m", "planbench.cli", *argv],
+        capture_output=True,
+        text=True,
+        cwd=scene,
+        env={**os.environ, "PYTHONPATH": str(root)},
+    )
     assert proc.returncode == 2 and len(proc.stderr.splitlines()) == 1, proc.stderr
     assert "Traceback" not in proc.stderr and proc.stdout == ""
     assert snapshot(scene) == before

@@ -30,8 +30,11 @@ def test_the_planner_only_campaign_counts_its_runs():
 
 
 def test_the_memory_table_names_its_runs_and_the_6_h_log():
-    rows = [{"duration_s": 300.0, "peak_mb": 240.0}, {"duration_s": 1330.0, "peak_mb": 300.0},
-            {"duration_s": bench.SIX_HOURS_S, "peak_mb": None, "log_mb": 2911.0}]
+    rows = [
+        {"duration_s": 300.0, "peak_mb": 240.0},
+        {"duration_s": 1330.0, "peak_mb": 300.0},
+        {"duration_s": bench.SIX_HOURS_S, "peak_mb": None, "log_mb": 2911.0},
+    ]
     text = bench.format_memory(rows)
     assert "1330 s over 300 s: 1.25 x" in text and "2911" in text and "not run" in text
     assert "--six-hours" in text
@@ -41,11 +44,26 @@ def test_the_campaign_table_compares_engines_in_the_same_state():
     # Made-up rows: each row's ratios are against the local pools in its own state (a pool
     # started with the campaign, or held from an earlier one), never across states.
     def row(engine, workers, state, runs_per_s):
-        return {"engine": engine, "workers": workers, "state": state, "campaigns": 2, "runs": 8,
-                "wall_s": 8 / runs_per_s, "runs_per_s": runs_per_s, "campaign_s": 9.0, "same_table": True}
+        return {
+            "engine": engine,
+            "workers": workers,
+            "state": state,
+            "campaigns": 2,
+            "runs": 8,
+            "wall_s": 8 / runs_per_s,
+            "runs_per_s": runs_per_s,
+            "campaign_s": 9.0,
+            "same_table": True,
+        }
 
-    rows = [row("local", 1, "started", 0.5), row("local", 2, "started", 0.8), row("local", 1, "held", 0.6),
-            row("local", 2, "held", 1.2), row("ray", 2, "started", 0.4), row("ray", 2, "held", 1.0)]
+    rows = [
+        row("local", 1, "started", 0.5),
+        row("local", 2, "started", 0.8),
+        row("local", 1, "held", 0.6),
+        row("local", 2, "held", 1.2),
+        row("ray", 2, "started", 0.4),
+        row("ray", 2, "held", 1.0),
+    ]
     lines = bench.format_campaign(rows).splitlines()
     ratios = {line[:44].strip(): line.split()[-3:-1] for line in lines[1:7]}
     assert ratios["local x2, pool started with it (best of 2)"] == ["1.60", "1.00"]

@@ -2,22 +2,25 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 from scipy.interpolate import CubicSpline
 
-from planbench.planners.loader.bspline import CubicBSplineTrajectory, solve_control_points
 from planbench.planners.errors import LimitError, PlanningError
 from planbench.planners.loader import TABLE1, TABLE1_TIMES, direct_plan, supply_plan, table1_to_si
+from planbench.planners.loader.bspline import CubicBSplineTrajectory, solve_control_points
 
 # Eq. (11) of the paper: theta2(t) piecewise, rows a3, a2, a1, a0 per segment (deg, s).
-EQ11 = np.array([
-    [193.2552, -146.2284, 0.0, 55.8],
-    [-163.7664, 143.6556, -1.287, 43.4],
-    [46.6104, -101.9944, 19.5444, 58.2],
-    [130.1240, -32.0784, -47.4918, 48.3],
-    [-241.5080, 163.1080, 18.0230, 32.8],
-])
+EQ11 = np.array(
+    [
+        [193.2552, -146.2284, 0.0, 55.8],
+        [-163.7664, 143.6556, -1.287, 43.4],
+        [46.6104, -101.9944, 19.5444, 58.2],
+        [130.1240, -32.0784, -47.4918, 48.3],
+        [-241.5080, 163.1080, 18.0230, 32.8],
+    ]
+)
 # The control points the paper prints for theta2 (its "P_1" row).
 PAPER_THETA2_CONTROL = [31.4287, 67.9856, 31.4287, 66.6995, 50.9732, 19.2077, 68.9962, 19.2077]
 
@@ -73,9 +76,11 @@ def check_spline_properties(times, keys):
     inner = times[1:-1]
     left, right = spline.sample(inner - eps), spline.sample(inner + eps)
     h = times[1] - times[0]
-    for a, b, tol in ((left.position, right.position, 1e-6),
-                      (left.velocity, right.velocity, 1e-6 / h),
-                      (left.acceleration, right.acceleration, 1e-5 / h**2)):
+    for a, b, tol in (
+        (left.position, right.position, 1e-6),
+        (left.velocity, right.velocity, 1e-6 / h),
+        (left.acceleration, right.acceleration, 1e-5 / h**2),
+    ):
         np.testing.assert_allclose(a, b, atol=tol * scale)
     # Outside the key times the trajectory holds still.
     out = spline.sample([times[0] - 1.0, times[-1] + 1.0])

@@ -10,8 +10,8 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import re
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -21,10 +21,12 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from planbench import cli
-from planbench.campaign import report, spec as spec_module
+from planbench.campaign import report
+from planbench.campaign import spec as spec_module
 from planbench.campaign.store import CampaignDir
 from planbench.params import ParamError
 
@@ -150,8 +152,12 @@ def test_ray_engine_gives_the_same_table(local_campaign, tmp_path):
 def test_sigkill_then_resume_loses_and_duplicates_nothing(local_campaign, tmp_path):
     spec, _, table = local_campaign
     out = tmp_path / "killed"
-    process = subprocess.Popen([*PLANBENCH, "sweep", str(spec), "--out", str(out), "--workers", "2", "--quiet"],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    process = subprocess.Popen(
+        [*PLANBENCH, "sweep", str(spec), "--out", str(out), "--workers", "2", "--quiet"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 120
     try:
         while time.monotonic() < deadline:
@@ -178,7 +184,9 @@ def test_sigkill_then_resume_loses_and_duplicates_nothing(local_campaign, tmp_pa
 
 
 def test_a_run_that_raises_is_a_row_not_a_crash(tmp_path, capsys):
-    _write(tmp_path / "bad_planner.py", """
+    _write(
+        tmp_path / "bad_planner.py",
+        """
 from planbench.planners.hexapod import PaperMovePlanner
 
 class Picky(PaperMovePlanner):
@@ -189,15 +197,19 @@ class Picky(PaperMovePlanner):
 
 def make():
     return Picky()
-""")
-    spec = _write(tmp_path / "spec.toml", """
+""",
+    )
+    spec = _write(
+        tmp_path / "spec.toml",
+        """
 scenario = "hexapod-sync-move"
 planner = "bad_planner.py:make"
 [parameters]
 duration = 1.0
 [grid]
 "moves[0].target[0]" = [1.0, 2.0]
-""")
+""",
+    )
     code = cli.main(["sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"])
     assert code == cli.EXIT_CHECK_FAILED
     table = pq.read_table(tmp_path / "out" / "results.parquet")
@@ -208,7 +220,9 @@ duration = 1.0
 
 
 def test_a_worker_that_dies_costs_only_its_run(tmp_path):
-    planner = _write(tmp_path / "fatal_planner.py", """
+    planner = _write(
+        tmp_path / "fatal_planner.py",
+        """
 import os
 from planbench.planners.hexapod import PaperMovePlanner
 
@@ -220,15 +234,19 @@ class Fatal(PaperMovePlanner):
 
 def make():
     return Fatal()
-""")
-    spec = _write(tmp_path / "spec.toml", f"""
+""",
+    )
+    spec = _write(
+        tmp_path / "spec.toml",
+        f"""
 scenario = "hexapod-sync-move"
 planner = "{planner.name}:make"
 [parameters]
 duration = 0.5
 [grid]
 "moves[0].target[0]" = [1.0, 2.0, 1.2]
-""")
+""",
+    )
     code = cli.main(["sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"])
     assert code == cli.EXIT_CHECK_FAILED
     table = pq.read_table(tmp_path / "out" / "results.parquet")
@@ -246,6 +264,7 @@ class _PoolThatBreaksOnSubmit:
 
     def __init__(self, max_workers, mp_context, initializer, initargs):
         import concurrent.futures as cf
+
         self._cf, self._submits = cf, 0
         self._breaks = _PoolThatBreaksOnSubmit.pools == 0
         _PoolThatBreaksOnSubmit.pools += 1
@@ -265,13 +284,17 @@ class _PoolThatBreaksOnSubmit:
 
 def test_a_pool_that_breaks_between_submits_loses_no_run(tmp_path, monkeypatch):
     from planbench.campaign import engines
+
     monkeypatch.setattr(engines.cf, "ProcessPoolExecutor", _PoolThatBreaksOnSubmit)
     _PoolThatBreaksOnSubmit.pools = 0
-    spec = _write(tmp_path / "spec.toml", """
+    spec = _write(
+        tmp_path / "spec.toml",
+        """
 scenario = "hexapod-sync-move"
 [grid]
 "moves[0].target[0]" = [1.0, 1.1, 1.2, 1.3]
-""")
+""",
+    )
     tables = {}
     for name, pools_before in (("broken", 0), ("whole", 1)):  # the second never breaks
         _PoolThatBreaksOnSubmit.pools = pools_before
@@ -289,11 +312,15 @@ BAD_SPECS = {
     "unknown parameter": ('scenario = "hexapod-sync-move"\n[grid]\nwindd = [1.0]\n', "unknown parameter 'windd'"),
     "empty axis": ('scenario = "hexapod-sync-move"\n[grid]\nwind = []\n', "grid.wind is empty"),
     "distribution outside the range": (
-        'scenario = "hexapod-sync-move"\nsamples = 4\n[random]\nwind = { distribution = "uniform", low = 10.0, high = 60.0 }\n',
-        "outside wind's range [0, 50] m/s"),
+        'scenario = "hexapod-sync-move"\nsamples = 4\n[random]\n'
+        'wind = { distribution = "uniform", low = 10.0, high = 60.0 }\n',
+        "outside wind's range [0, 50] m/s",
+    ),
     "untruncated normal on a bounded parameter": (
-        'scenario = "hexapod-sync-move"\nsamples = 4\n[random]\nwind = { distribution = "normal", mean = 4.0, std = 1.0 }\n',
-        "truncate it"),
+        'scenario = "hexapod-sync-move"\nsamples = 4\n[random]\n'
+        'wind = { distribution = "normal", mean = 4.0, std = 1.0 }\n',
+        "truncate it",
+    ),
     "grid value out of range": ('scenario = "hexapod-sync-move"\n[grid]\nelevation = [20.0, 95.0]\n', "elevation = 95"),
     "unknown key": ('scenario = "hexapod-sync-move"\nsed = 3\n', "unknown key 'sed'"),
     "unknown scenario": ('scenario = "no-such"\n', "no-such"),
@@ -319,8 +346,9 @@ def test_bad_spec_exits_2_with_one_line_before_any_run(case, tmp_path, capsys):
 
 def test_bad_spec_from_the_shell_has_no_traceback(tmp_path):
     spec = _write(tmp_path / "spec.toml", BAD_SPECS["empty axis"][0])
-    result = subprocess.run([*PLANBENCH, "sweep", str(spec), "--out", str(tmp_path / "out")],
-                            capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [*PLANBENCH, "sweep", str(spec), "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=120
+    )
     assert result.returncode == 2 and result.stderr.count("\n") == 1 and "grid.wind is empty" in result.stderr
     assert not (tmp_path / "out").exists()
 
@@ -339,14 +367,20 @@ def test_a_foreign_directory_is_refused(tmp_path):
 def test_an_invalid_combination_is_refused_or_skipped(tmp_path):
     # Each axis value is valid on the base; together, run 1's target equals its start: a move
     # of zero length, a limit between parameters.
-    text = ('scenario = "hexapod-sync-move"\n[parameters]\nmoves = [{ target = [3, 0, 0, 0, 0, 0] }]\n'
-            'start_pose = [2, 0, 0, 0, 0, 0]\n[grid]\n"start_pose[0]" = [1.0]\n"moves[0].target[0]" = [4.0, 1.0]\n')
+    text = (
+        'scenario = "hexapod-sync-move"\n[parameters]\nmoves = [{ target = [3, 0, 0, 0, 0, 0] }]\n'
+        'start_pose = [2, 0, 0, 0, 0, 0]\n[grid]\n"start_pose[0]" = [1.0]\n"moves[0].target[0]" = [4.0, 1.0]\n'
+    )
     spec = spec_module.load(_write(tmp_path / "refuse.toml", text))
     spec.resolve(spec.runs()[0])
     with pytest.raises(ParamError, match=r"run 1 \(start_pose\[0\] = 1, moves\[0\]\.target\[0\] = 1, .*zero length"):
         spec.resolve(spec.runs()[1])
-    result = subprocess.run([*PLANBENCH, "sweep", str(tmp_path / "refuse.toml"), "--out", str(tmp_path / "out"),
-                             "--quiet"], capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [*PLANBENCH, "sweep", str(tmp_path / "refuse.toml"), "--out", str(tmp_path / "out"), "--quiet"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 2 and "run 1" in result.stderr and not (tmp_path / "out").exists()
     spec = spec_module.load(_write(tmp_path / "skip.toml", 'invalid = "skip"\n' + text))
     from planbench.campaign import context_of, tasks_of, worker
@@ -357,14 +391,21 @@ def test_an_invalid_combination_is_refused_or_skipped(tmp_path):
 
 # ------------------------------------------------------------------------------ determinism
 
+
 @settings(max_examples=30)
-@given(seed=st.integers(0, 2**63 - 1), samples=st.integers(1, 5), seeds=st.integers(1, 4),
-       winds=st.lists(st.floats(0.0, 50.0), min_size=1, max_size=3, unique=True))
+@given(
+    seed=st.integers(0, 2**63 - 1),
+    samples=st.integers(1, 5),
+    seeds=st.integers(1, 4),
+    winds=st.lists(st.floats(0.0, 50.0), min_size=1, max_size=3, unique=True),
+)
 def test_the_same_spec_gives_the_same_runs(tmp_path_factory, seed, samples, seeds, winds):
     folder = tmp_path_factory.mktemp("spec")
-    text = (f'scenario = "hexapod-sync-move"\nseed = {seed}\nseeds = {seeds}\nsamples = {samples}\n'
-            f'[grid]\nwind = {[float(w) for w in winds]}\n'
-            '[random]\nelevation = { distribution = "uniform", low = 20.0, high = 90.0 }\n')
+    text = (
+        f'scenario = "hexapod-sync-move"\nseed = {seed}\nseeds = {seeds}\nsamples = {samples}\n'
+        f"[grid]\nwind = {[float(w) for w in winds]}\n"
+        '[random]\nelevation = { distribution = "uniform", low = 20.0, high = 90.0 }\n'
+    )
     a = spec_module.load(_write(folder / "a.toml", text))
     b = spec_module.load(_write(folder / "b.toml", text))
     runs_a, runs_b = a.runs(), b.runs()
@@ -383,10 +424,12 @@ def test_the_same_spec_gives_the_same_runs(tmp_path_factory, seed, samples, seed
 
 
 def test_distributions_draw_what_they_name(tmp_path):
-    text = ('scenario = "hexapod-sync-move"\nseed = 3\nsamples = 20000\n[random]\n'
-            'wind = { distribution = "normal", mean = 5.0, std = 1.0, low = 3.0, high = 9.0 }\n'
-            'elevation = { distribution = "log-uniform", low = 20.0, high = 80.0 }\n'
-            '"start_pose[0]" = { distribution = "uniform", low = -1.0, high = 1.0 }\n')
+    text = (
+        'scenario = "hexapod-sync-move"\nseed = 3\nsamples = 20000\n[random]\n'
+        'wind = { distribution = "normal", mean = 5.0, std = 1.0, low = 3.0, high = 9.0 }\n'
+        'elevation = { distribution = "log-uniform", low = 20.0, high = 80.0 }\n'
+        '"start_pose[0]" = { distribution = "uniform", low = -1.0, high = 1.0 }\n'
+    )
     spec = spec_module.load(_write(tmp_path / "s.toml", text))
     wind, elevation, x = spec.draws()
     assert wind.min() >= 3.0 and wind.max() <= 9.0
@@ -398,14 +441,17 @@ def test_distributions_draw_what_they_name(tmp_path):
 
 
 def test_rerun_worst_replays_the_worst_run_with_a_video(tmp_path, capsys):
-    spec = _write(tmp_path / "spec.toml", """
+    spec = _write(
+        tmp_path / "spec.toml",
+        """
 scenario = "hexapod-sync-move"
 seed = 5
 [parameters]
 duration = 1.5
 [grid]
 wind = [0.0, 8.0]
-""")
+""",
+    )
     out = tmp_path / "out"
     code = cli.main(["sweep", str(spec), "--out", str(out), "--workers", "1", "--quiet", "--rerun-worst", "1"])
     assert code in (cli.EXIT_OK, cli.EXIT_CHECK_FAILED)
@@ -426,9 +472,16 @@ wind = [0.0, 8.0]
 def test_worst_runs_rank_by_the_ratio_to_the_limit():
     import pyarrow as pa
 
-    table = pa.table({"run": [0, 1, 2, 3], "status": ["passed", "failed", "error", "passed"],
-                      "check.a": [0.5, 1.2, None, 0.9], "limit.a": [1.0, 1.0, None, 1.0],
-                      "check.b": [10.0, 10.0, None, 2.0], "limit.b": [5.0, 5.0, None, 5.0]})
+    table = pa.table(
+        {
+            "run": [0, 1, 2, 3],
+            "status": ["passed", "failed", "error", "passed"],
+            "check.a": [0.5, 1.2, None, 0.9],
+            "limit.a": [1.0, 1.0, None, 1.0],
+            "check.b": [10.0, 10.0, None, 2.0],
+            "limit.b": [5.0, 5.0, None, 5.0],
+        }
+    )
     meta = {"a": {"comparison": "<="}, "b": {"comparison": ">="}}
     # run 3: b is 2 where it must be >= 5 (ratio 2.5); run 1: a is 1.2 of its limit; run 0: 0.5.
     assert report.worst_runs(table, 4, meta) == [3, 1, 0]
@@ -450,8 +503,19 @@ def test_example_campaign_specs_are_valid(example):
 
 def test_a_perturbed_run_repeats_from_its_summary(tmp_path, capsys):
     first, again = tmp_path / "first", tmp_path / "again"
-    assert cli.main(["run", "hexapod-sync-move", "--set", "plant.camera_mass_error=0.1", "--duration", "1.0",
-                     "--out", str(first), "--quiet"]) in (cli.EXIT_OK, cli.EXIT_CHECK_FAILED)
+    assert cli.main(
+        [
+            "run",
+            "hexapod-sync-move",
+            "--set",
+            "plant.camera_mass_error=0.1",
+            "--duration",
+            "1.0",
+            "--out",
+            str(first),
+            "--quiet",
+        ]
+    ) in (cli.EXIT_OK, cli.EXIT_CHECK_FAILED)
     summary = json.loads((first / "summary.json").read_text())
     assert summary["plant"]["camera_mass_error"] == 0.1
     cli.main(["run", str(first / "summary.json"), "--out", str(again), "--quiet"])
@@ -468,7 +532,7 @@ def test_a_perturbed_run_repeats_from_its_summary(tmp_path, capsys):
 def test_saved_outputs_only_when_asked(tmp_path):
     from planbench.campaign import context_of, tasks_of, worker
 
-    text = ('scenario = "loader-supply"\n{save}[parameters]\nduration = 0.2\n[grid]\npayload_mass = [40.0]\n')
+    text = 'scenario = "loader-supply"\n{save}[parameters]\nduration = 0.2\n[grid]\npayload_mass = [40.0]\n'
     saved = spec_module.load(_write(tmp_path / "saved.toml", text.format(save='save = ["timeseries"]\n')))
     files = worker.run_chunk(context_of(saved), tasks_of(saved, saved.runs()))["files"][0]
     assert set(files) == {"summary.json", "timeseries.npz", "report.png"}
@@ -478,7 +542,9 @@ def test_saved_outputs_only_when_asked(tmp_path):
 
 
 def test_a_planner_only_campaign_judges_the_plans_without_physics(tmp_path):
-    spec = _write(tmp_path / "spec.toml", """
+    spec = _write(
+        tmp_path / "spec.toml",
+        """
 scenario = "hexapod-sync-move"
 mode = "plan"
 seed = 4
@@ -489,7 +555,8 @@ invalid = "skip"
 [random]
 "moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
 "moves[0].target[5]" = { distribution = "uniform", low = -0.05, high = 0.05 }
-""")
+""",
+    )
     out = tmp_path / "out"
     assert cli.main(["sweep", str(spec), "--out", str(out), "--workers", "1", "--quiet"]) == cli.EXIT_OK
     table = pq.read_table(out / "results.parquet")
@@ -511,14 +578,17 @@ def test_a_pool_held_across_campaigns_serves_each_and_ends_with_its_block(tmp_pa
     from planbench import campaign
     from planbench.campaign.engines import LocalEngine
 
-    spec = _write(tmp_path / "spec.toml", """
+    spec = _write(
+        tmp_path / "spec.toml",
+        """
 scenario = "hexapod-sync-move"
 mode = "plan"
 samples = 40
 invalid = "skip"
 [random]
 "moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
-""")
+""",
+    )
     from planbench.campaign import context_of, worker
 
     loaded = spec_module.load(spec)  # the rows computed here, in one chunk, for reference

@@ -8,10 +8,12 @@ import time
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from planbench import campaign, cli
-from planbench.campaign import spec as spec_module, worker
+from planbench.campaign import spec as spec_module
+from planbench.campaign import worker
 from planbench.campaign.spec import run_seeds
 from planbench.hexapod.params import _POSE_HIGH, _POSE_LOW
 from planbench.params import ParamError
@@ -52,8 +54,16 @@ def test_run_seeds_are_numpys_seed_sequence():
 
 
 def _spec(tmp_path, seed, samples, seeds, axes, grid_sync, grid_axis, extra=""):
-    lines = [f'scenario = "hexapod-sync-move"', 'mode = "plan"', f"seed = {seed}", f"samples = {samples}",
-             f"seeds = {seeds}", 'invalid = "skip"', extra, "[grid]"]
+    lines = [
+        'scenario = "hexapod-sync-move"',
+        'mode = "plan"',
+        f"seed = {seed}",
+        f"samples = {samples}",
+        f"seeds = {seeds}",
+        'invalid = "skip"',
+        extra,
+        "[grid]",
+    ]
     if grid_sync:
         lines.append(f'"moves[0].synchronous" = [{", ".join(grid_sync)}]')
     if grid_axis is not None:
@@ -88,8 +98,14 @@ def specs(draw):
         key = draw(st.sampled_from(free))
         low, high = _bounds(key)
         grid_axis = (key, draw(st.lists(st.floats(low, high), min_size=1, max_size=2)))
-    return (draw(st.integers(0, 2**63 - 1)), draw(st.integers(2, 40)), draw(st.integers(1, 2)), axes, grid_sync,
-            grid_axis)
+    return (
+        draw(st.integers(0, 2**63 - 1)),
+        draw(st.integers(2, 40)),
+        draw(st.integers(1, 2)),
+        axes,
+        grid_sync,
+        grid_axis,
+    )
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -106,16 +122,28 @@ def test_columns_give_the_rows_of_the_per_run_path(tmp_path, case, data):
 
 
 def test_columns_are_iter_runs(tmp_path):
-    spec = _spec(tmp_path, 7, 9, 3, [("start_pose[1]", -3.0, 3.0), ("moves[0].target[4]", -0.2, 0.2)],
-                 ("true", "false"), ("moves[0].target[2]", [1.0, -2.5]))
+    spec = _spec(
+        tmp_path,
+        7,
+        9,
+        3,
+        [("start_pose[1]", -3.0, 3.0), ("moves[0].target[4]", -0.2, 0.2)],
+        ("true", "false"),
+        ("moves[0].target[2]", [1.0, -2.5]),
+    )
     columns = spec.columns(np.arange(spec.size))
     for run in spec.iter_runs():
-        assert (columns["run"][run.index], columns["point"][run.index], columns["sample"][run.index],
-                columns["replicate"][run.index], columns["seed"][run.index]) == \
-            (run.index, run.point, run.sample, run.replicate, run.seed)
+        assert (
+            columns["run"][run.index],
+            columns["point"][run.index],
+            columns["sample"][run.index],
+            columns["replicate"][run.index],
+            columns["seed"][run.index],
+        ) == (run.index, run.point, run.sample, run.replicate, run.seed)
         for axis, value in zip(spec.axes, run.values, strict=True):
-            assert columns[axis.column][run.index] == value and type(columns[axis.column][run.index].item()) \
-                is type(value)
+            assert columns[axis.column][run.index] == value and type(columns[axis.column][run.index].item()) is type(
+                value
+            )
 
 
 def test_invalid_rows_carry_each_ones_message(tmp_path):
@@ -135,9 +163,17 @@ def test_invalid_rows_carry_each_ones_message(tmp_path):
 def test_rare_findings_are_validated_run_by_run(tmp_path):
     # A target equal to the pose before it (a move of zero length) is not decided on arrays:
     # the run goes through from_mapping, with its message.
-    spec = _spec(tmp_path, 1, 1, 2, [], (), ("moves[0].target[0]", [0.0, 1.0, 0.0]),
-                 extra='[parameters]\nstart_pose = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n'
-                       'moves = [{ target = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0] }]')
+    spec = _spec(
+        tmp_path,
+        1,
+        1,
+        2,
+        [],
+        (),
+        ("moves[0].target[0]", [0.0, 1.0, 0.0]),
+        extra="[parameters]\nstart_pose = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n"
+        "moves = [{ target = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0] }]",
+    )
     assert campaign.columnar(spec)
     from planbench.hexapod import plan_columns
 
@@ -152,10 +188,17 @@ def test_rare_findings_are_validated_run_by_run(tmp_path):
 
 
 def test_several_moves_per_run(tmp_path):
-    spec = _spec(tmp_path, 9, 30, 1, [("moves[0].target[0]", -3.0, 3.0), ("moves[0].target[3]", -0.2, 0.2)],
-                 ("true", "false"), None,
-                 extra='[parameters]\nmoves = [{ target = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0] }, '
-                       '{ target = [0.0, 2.0, 0.0, 0.0, 0.0, 0.1], synchronous = false }]')
+    spec = _spec(
+        tmp_path,
+        9,
+        30,
+        1,
+        [("moves[0].target[0]", -3.0, 3.0), ("moves[0].target[3]", -0.2, 0.2)],
+        ("true", "false"),
+        None,
+        extra="[parameters]\nmoves = [{ target = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0] }, "
+        "{ target = [0.0, 2.0, 0.0, 0.0, 0.0, 0.1], synchronous = false }]",
+    )
     assert campaign.columnar(spec)
     table, _ = _columns(spec, np.arange(spec.size))
     reference, _ = _per_run(spec, np.arange(spec.size))
@@ -231,8 +274,10 @@ def test_refuse_names_the_first_invalid_run_as_the_per_run_check(tmp_path):
 
 def test_a_part_keeps_every_rows_keys():
     # The first row an invalid run's (no checks): the valid row after it keeps its check values.
-    rows = [{"run": 0, "status": "invalid", "error": "ParamError: x", "wall_s": 0.0},
-            {"run": 1, "check.a": 1.5, "limit.a": 2.0, "pass.a": True, "status": "passed", "error": None, "wall_s": 0.1}]
+    rows = [
+        {"run": 0, "status": "invalid", "error": "ParamError: x", "wall_s": 0.0},
+        {"run": 1, "check.a": 1.5, "limit.a": 2.0, "pass.a": True, "status": "passed", "error": None, "wall_s": 0.1},
+    ]
     table = worker.rows_table(rows)
     assert table.column_names == ["run", "status", "error", "wall_s", "check.a", "limit.a", "pass.a"]
     assert table.column("check.a").to_pylist() == [None, 1.5] and table.column("pass.a").to_pylist() == [None, True]

@@ -42,16 +42,16 @@ import mujoco
 import numpy as np
 import pytest
 
-from planbench.planners import antenna as ant
-from planbench.planners.fast import plan as fp
-from planbench.planners.fast import sky as sky
-from planbench.planners import hexapod as hexapod_planner
-from planbench.planners.antenna.geostationary import look_angles
 from planbench import antenna as antenna_sim
 from planbench import fast as fast_sim
-from planbench.fast import physics as fast_physics
 from planbench import hexapod as sim_hexapod
 from planbench import outputs, runner, scenarios
+from planbench.fast import physics as fast_physics
+from planbench.planners import antenna as ant
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.antenna.geostationary import look_angles
+from planbench.planners.fast import plan as fp
+from planbench.planners.fast import sky as sky
 
 EXACT = 1e-9
 KIN = 1e-7
@@ -59,28 +59,81 @@ LAW = 1e-6
 
 #: The checks of every scenario, as summary.json lists them (from actual runs).
 CHECKS = {
-    "loader-supply": ["keypoint_error", "tracking_error", "obstacle_contacts", "min_clearance",
-                      "joint_torque", "simulation_warnings",
-                      "controller_errors"],
-    "loader-direct": ["keypoint_error", "tracking_error", "obstacle_contacts", "min_clearance",
-                      "joint_torque", "simulation_warnings",
-                      "controller_errors"],
-    "hexapod-sync-move": ["arrival_spread", "strut_velocity", "strut_accel", "hexapod_speed", "following_error",
-                          "pose_error_final", "strut_force", "stroke", "simulation_warnings",
-                      "controller_errors"],
-    "hexapod-async-move": ["arrival_vs_own_time", "strut_velocity", "strut_accel", "hexapod_speed", "following_error",
-                           "pose_error_final", "strut_force", "stroke", "simulation_warnings",
-                      "controller_errors"],
-    "antenna-paper-motion": ["pointing_error_max", "polarization_error_max", "attitude_error_fro_max",
-                             "joint_rate", "joint_torque", "simulation_warnings",
-                      "controller_errors"],
-    "antenna-sea-state": ["pointing_error_max", "pointing_error_rms", "polarization_error_max",
-                          "attitude_error_fro_max", "joint_rate", "joint_torque", "simulation_warnings",
-                      "controller_errors"],
-    **{name: ["feed_error_rms", "feed_error_max", "cabin_error_rms", "cable_tension_min",
-              "cable_tension_max", "stewart_stroke", "stewart_force", "simulation_warnings",
-                      "controller_errors"]
-       for name in ("fast-tracking", "fast-ra-scan", "fast-source-switch")},
+    "loader-supply": [
+        "keypoint_error",
+        "tracking_error",
+        "obstacle_contacts",
+        "min_clearance",
+        "joint_torque",
+        "simulation_warnings",
+        "controller_errors",
+    ],
+    "loader-direct": [
+        "keypoint_error",
+        "tracking_error",
+        "obstacle_contacts",
+        "min_clearance",
+        "joint_torque",
+        "simulation_warnings",
+        "controller_errors",
+    ],
+    "hexapod-sync-move": [
+        "arrival_spread",
+        "strut_velocity",
+        "strut_accel",
+        "hexapod_speed",
+        "following_error",
+        "pose_error_final",
+        "strut_force",
+        "stroke",
+        "simulation_warnings",
+        "controller_errors",
+    ],
+    "hexapod-async-move": [
+        "arrival_vs_own_time",
+        "strut_velocity",
+        "strut_accel",
+        "hexapod_speed",
+        "following_error",
+        "pose_error_final",
+        "strut_force",
+        "stroke",
+        "simulation_warnings",
+        "controller_errors",
+    ],
+    "antenna-paper-motion": [
+        "pointing_error_max",
+        "polarization_error_max",
+        "attitude_error_fro_max",
+        "joint_rate",
+        "joint_torque",
+        "simulation_warnings",
+        "controller_errors",
+    ],
+    "antenna-sea-state": [
+        "pointing_error_max",
+        "pointing_error_rms",
+        "polarization_error_max",
+        "attitude_error_fro_max",
+        "joint_rate",
+        "joint_torque",
+        "simulation_warnings",
+        "controller_errors",
+    ],
+    **{
+        name: [
+            "feed_error_rms",
+            "feed_error_max",
+            "cabin_error_rms",
+            "cable_tension_min",
+            "cable_tension_max",
+            "stewart_stroke",
+            "stewart_force",
+            "simulation_warnings",
+            "controller_errors",
+        ]
+        for name in ("fast-tracking", "fast-ra-scan", "fast-source-switch")
+    },
 }
 
 #: Simulated time per scenario (None: the scenario's default). The loader and hexapod runs are
@@ -91,10 +144,15 @@ CHECKS = {
 #: observing windows are tested on the short plans of ``fast_observation`` and ``fast_scan``.
 #: All stay under FAST's 120 s, beyond which timeseries.npz keeps only every 10th tick.
 DURATIONS = {
-    "loader-supply": None, "loader-direct": None,
-    "hexapod-sync-move": None, "hexapod-async-move": None,
-    "antenna-paper-motion": 12.0, "antenna-sea-state": 20.0,
-    "fast-tracking": 3.0, "fast-ra-scan": 3.0, "fast-source-switch": 3.0,
+    "loader-supply": None,
+    "loader-direct": None,
+    "hexapod-sync-move": None,
+    "hexapod-async-move": None,
+    "antenna-paper-motion": 12.0,
+    "antenna-sea-state": 20.0,
+    "fast-tracking": 3.0,
+    "fast-ra-scan": 3.0,
+    "fast-source-switch": 3.0,
 }
 
 
@@ -135,7 +193,7 @@ class Written:
 
     def sensor(self, name: str) -> np.ndarray:
         s = self.model.sensor(name)
-        return self.ts["sensordata"][:, s.adr[0]:s.adr[0] + s.dim[0]]
+        return self.ts["sensordata"][:, s.adr[0] : s.adr[0] + s.dim[0]]
 
 
 def write(tmp_path_factory, name: str, setup, duration: float, plan, model=None) -> Written:
@@ -229,7 +287,8 @@ def rms(x) -> float:
 def assert_value(w: Written, name: str, recomputed: float, rtol: float, atol: float = 0.0):
     reported = w.check(name)
     assert reported == pytest.approx(recomputed, rel=rtol, abs=atol), (
-        f"{w.summary['scenario']} {name}: summary.json says {reported!r}, recomputed {recomputed!r}")
+        f"{w.summary['scenario']} {name}: summary.json says {reported!r}, recomputed {recomputed!r}"
+    )
 
 
 # ============================================================================ loader
@@ -298,7 +357,7 @@ def test_loader_obstacle_contacts(loader):
         data.qpos[:] = row
         mujoco.mj_kinematics(model, data)
         mujoco.mj_collision(model, data)
-        for c in data.contact[:data.ncon]:
+        for c in data.contact[: data.ncon]:
             g1, g2 = int(c.geom1), int(c.geom2)
             if g1 in obstacles and g2 in robot:
                 g1, g2 = g2, g1
@@ -489,8 +548,11 @@ def _satellite_angles(name: str):
     section 5.1 values, or the look angles of the geostationary slot from the ship."""
     if name == "antenna-paper-motion":
         return np.radians(ant.PAPER_SATELLITE_DEG)
-    return look_angles(np.radians(antenna_sim.SATELLITE_LON_DEG), np.radians(antenna_sim.SHIP_LAT_DEG),
-                       np.radians(antenna_sim.SHIP_LON_DEG))
+    return look_angles(
+        np.radians(antenna_sim.SATELLITE_LON_DEG),
+        np.radians(antenna_sim.SHIP_LAT_DEG),
+        np.radians(antenna_sim.SHIP_LON_DEG),
+    )
 
 
 def _antenna_errors(w: Written):
@@ -595,8 +657,7 @@ def _short_scan_plan() -> fp.FastPlan:
     jd1, jd2 = sky.meridian_transit(ra, dec, fast_sim.OBSERVING_NIGHT)
 
     def make(t2):
-        return sky.MotionScan(ra, dec, "dec", np.radians(0.02), 2, np.radians(0.05),
-                              15.0 * sky.DEG_PER_HOUR, t2)
+        return sky.MotionScan(ra, dec, "dec", np.radians(0.02), 2, np.radians(0.05), 15.0 * sky.DEG_PER_HOUR, t2)
 
     t2 = fp.minimum_t2(make, (jd1, jd2))
     segments, _, _ = fp.scan_segments(make(t2), (jd1, jd2))
@@ -609,8 +670,14 @@ def fast_observation(tmp_path_factory):
     termination, 4 m/s wind, Stewart on; its observing window is the middle 10 s."""
     plan = fast_sim.observation_plan(10.0)
     setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0))
-    return write(tmp_path_factory, "fast-observation", setup, setup.task.duration, plan,
-                 fast_physics._compiled(setup.provenance.params.cable_segments))
+    return write(
+        tmp_path_factory,
+        "fast-observation",
+        setup,
+        setup.task.duration,
+        plan,
+        fast_physics._compiled(setup.provenance.params.cable_segments),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -618,8 +685,14 @@ def fast_scan(tmp_path_factory):
     """A short motion scan: its observing window is the legs and the transition between."""
     plan = _short_scan_plan()
     setup = fast_sim.build(plan, fast_sim.FastParams(wind=4.0, seed=1))
-    return write(tmp_path_factory, "fast-scan", setup, setup.task.duration, plan,
-                 fast_physics._compiled(setup.provenance.params.cable_segments))
+    return write(
+        tmp_path_factory,
+        "fast-scan",
+        setup,
+        setup.task.duration,
+        plan,
+        fast_physics._compiled(setup.provenance.params.cable_segments),
+    )
 
 
 FAST_RUNS = ["fast-tracking", "fast-ra-scan", "fast-source-switch", "fast-observation", "fast-scan"]
@@ -653,8 +726,7 @@ def test_fast_observing_window(fast_run):
     (their switch from park), the observation or the scan's legs and transition otherwise."""
     w = fast_run
     window, observing = _observing_window(w)
-    names = {seg.name for seg in w.plan.segments
-             if seg.t0 <= w.t[-1] and seg.name.startswith(OBSERVING)}
+    names = {seg.name for seg in w.plan.segments if seg.t0 <= w.t[-1] and seg.name.startswith(OBSERVING)}
     assert observing == (w.summary["scenario"] not in CHECKS)
     if w.summary["scenario"] == "fast-scan":
         assert {"leg 1", "leg 2", "transition 1"} <= names
@@ -700,8 +772,10 @@ def _catenary_tension(chord, l0, span):
     (Irvine; models/fast/README.md), by bisection then Newton to convergence."""
     ea, weight = fast_physics.CABLE_EA, fast_physics.CABLE_WEIGHT
     a = (weight * span) ** 2 * l0 / 24.0
+
     def f(t):
         return l0 * (1.0 + t / ea) - a / t**2 - chord
+
     lo, hi = np.full_like(chord, 1e3), np.full_like(chord, 1e7)
     assert (f(lo) < 0).all() and (f(hi) > 0).all()
     for _ in range(60):
@@ -728,8 +802,9 @@ def test_fast_cable_tension_max(fast_run):
         # The chains: the winch's segment, a spring EA / (L0 / n) of rest length L0 / n
         # (ChainCableLoads), at its length in the logged pose.
         first = [model.tendon(f"{c}_seg1").id for c in CABLES]
-        length = kinematics_rows(model, w.ts["qpos"][:-1], lambda d: (mujoco.mj_fwdPosition(model, d),
-                                                                      d.ten_length[first])[1])
+        length = kinematics_rows(
+            model, w.ts["qpos"][:-1], lambda d: (mujoco.mj_fwdPosition(model, d), d.ten_length[first])[1]
+        )
         rest = l0[:-1] / segments
         tension = np.maximum(fast_physics.CABLE_EA / rest * (length - rest), 0.0)
         assert_value(w, "cable_tension_max", float(tension.max()) / 1e3, LAW)
@@ -772,7 +847,13 @@ def diverging_loader(tmp_path_factory):
     ``faulty_loader``.)"""
     setup = scenarios.get("loader-supply").build(scenarios.get("loader-supply").resolve(duration=0.5))
     setup.physics.model.ptr.opt.gravity[:] = [0.0, 0.0, -1e12]
-    return write(tmp_path_factory, "loader-diverging", setup, setup.task.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
+    return write(
+        tmp_path_factory,
+        "loader-diverging",
+        setup,
+        setup.task.duration,
+        scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params),
+    )
 
 
 FAULT_TICK = 40
@@ -794,7 +875,13 @@ def faulty_loader(tmp_path_factory):
             inner(tick, observation)
 
     setup.components.controller = RaisingController()
-    return write(tmp_path_factory, "loader-faulty", setup, setup.task.duration, scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params))
+    return write(
+        tmp_path_factory,
+        "loader-faulty",
+        setup,
+        setup.task.duration,
+        scenarios.get("loader-supply").plan(scenarios.get("loader-supply").params),
+    )
 
 
 def _replayed_warnings(w: Written) -> int:
@@ -846,11 +933,16 @@ def test_check_names(any_run):
 
 
 _FIXTURE = {
-    "loader-supply": "loader_supply", "loader-direct": "loader_direct",
-    "hexapod-sync-move": "hexapod_sync", "hexapod-async-move": "hexapod_async",
-    "antenna-paper-motion": "antenna_paper", "antenna-sea-state": "antenna_sea",
-    "fast-tracking": "fast_tracking", "fast-ra-scan": "fast_ra_scan",
-    "fast-source-switch": "fast_source_switch", "fast-observation": "fast_observation",
+    "loader-supply": "loader_supply",
+    "loader-direct": "loader_direct",
+    "hexapod-sync-move": "hexapod_sync",
+    "hexapod-async-move": "hexapod_async",
+    "antenna-paper-motion": "antenna_paper",
+    "antenna-sea-state": "antenna_sea",
+    "fast-tracking": "fast_tracking",
+    "fast-ra-scan": "fast_ra_scan",
+    "fast-source-switch": "fast_source_switch",
+    "fast-observation": "fast_observation",
     "fast-scan": "fast_scan",
 }
 
@@ -907,13 +999,17 @@ def test_planner_and_controller_solve_with_the_paper_weights():
     permuted = _least_norm_rates(ant.jacobian(theta0), omega, np.array([10.0, 5.0, 1.0, 2.0]))
     assert np.abs(permuted - hand).max() > 0.05 * np.abs(hand).max()  # the test can tell
     np.testing.assert_allclose(ant.joint_rates(theta0, omega)[0], hand, rtol=1e-10, atol=1e-14)
-    problem = scenarios.get("antenna-paper-motion").build(scenarios.get("antenna-paper-motion").resolve(duration=0.1)).task.problem  # what the controller gets
-    np.testing.assert_allclose(ant.joint_rates(theta0, omega, problem.weights)[0], hand,
-                               rtol=1e-10, atol=1e-14)
+    problem = (
+        scenarios.get("antenna-paper-motion")
+        .build(scenarios.get("antenna-paper-motion").resolve(duration=0.1))
+        .task.problem
+    )  # what the controller gets
+    np.testing.assert_allclose(ant.joint_rates(theta0, omega, problem.weights)[0], hand, rtol=1e-10, atol=1e-14)
 
     def rk4_direction(weights):
         def rate(th):
             return _least_norm_rates(ant.jacobian(th), omega, weights)
+
         k1 = rate(theta0)
         k2 = rate(theta0 + dt / 2 * k1)
         k3 = rate(theta0 + dt / 2 * k2)
@@ -947,14 +1043,16 @@ def test_paper_theta0_holds_the_papers_satellite():
 
 #: Loader paper, Table 1 as printed: P2, M1 ... M4, P3 at T = 0, 0.5, ... 2.5 s; theta1 in mm,
 #: theta2 ... theta6 in degrees.
-PAPER_TABLE1 = np.array([
-    [50, 55.8, -70.6, 20, 0, 0],
-    [50, 43.4, -49.6, 15, 20, 10],
-    [50, 58.2, -37.8, 34.3, 30, 10],
-    [50, 48.3, -27.2, 42.9, 30, 10],
-    [50, 32.8, -18.5, 15.4, 20, 0],
-    [50, 52.4, -20.5, 29.6, 0, 0],
-])
+PAPER_TABLE1 = np.array(
+    [
+        [50, 55.8, -70.6, 20, 0, 0],
+        [50, 43.4, -49.6, 15, 20, 10],
+        [50, 58.2, -37.8, 34.3, 30, 10],
+        [50, 48.3, -27.2, 42.9, 30, 10],
+        [50, 32.8, -18.5, 15.4, 20, 0],
+        [50, 52.4, -20.5, 29.6, 0, 0],
+    ]
+)
 
 
 def test_loader_plans_pass_the_papers_key_points():
@@ -965,8 +1063,7 @@ def test_loader_plans_pass_the_papers_key_points():
     times = np.arange(6) * 0.5
     keys = np.column_stack([PAPER_TABLE1[:, 0] / 1000.0, PAPER_TABLE1[:, 1:] * (np.pi / 180.0)])
     np.testing.assert_allclose(loader_planner.supply_plan().sample(times).position, keys, atol=1e-12)
-    np.testing.assert_allclose(loader_planner.direct_plan().sample(times[[0, -1]]).position,
-                               keys[[0, -1]], atol=1e-12)
+    np.testing.assert_allclose(loader_planner.direct_plan().sample(times[[0, -1]]).position, keys[[0, -1]], atol=1e-12)
 
 
 def _peaks(plan, name_prefix: str):

@@ -7,12 +7,13 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from planbench.planners.trajectory import ChunkedSample, TrajectorySample
 from planbench import runner
 from planbench.fast import FastTrackingParams, build_scenario
 from planbench.fast import controller as fast_controller
+from planbench.planners.trajectory import ChunkedSample, TrajectorySample
 
 
 def _spline_sample(t: np.ndarray) -> TrajectorySample:
@@ -24,16 +25,21 @@ def _spline_sample(t: np.ndarray) -> TrajectorySample:
 
 
 @settings(max_examples=40, deadline=None)
-@given(n=st.integers(0, 60), chunk=st.integers(1, 17),
-       reads=st.lists(st.tuples(st.integers(0, 60), st.integers(0, 25)), max_size=8))
+@given(
+    n=st.integers(0, 60),
+    chunk=st.integers(1, 17),
+    reads=st.lists(st.tuples(st.integers(0, 60), st.integers(0, 25)), max_size=8),
+)
 def test_chunked_sample_rows_are_the_whole_sample_rows(n, chunk, reads):
     t = np.linspace(0.0, 3.0, n)
     whole = _spline_sample(t)
     saved = runner.CHUNK_TICKS
     runner.CHUNK_TICKS = chunk
     try:  # sampled as it is read, and sampled once in chunks of a temporary log (the runner's)
-        samples = [ChunkedSample(_spline_sample, t, chunk),
-                   runner.stored_reference(SimpleNamespace(sample=_spline_sample), t)]
+        samples = [
+            ChunkedSample(_spline_sample, t, chunk),
+            runner.stored_reference(SimpleNamespace(sample=_spline_sample), t),
+        ]
     finally:
         runner.CHUNK_TICKS = saved
     for lazy in samples:
@@ -46,7 +52,7 @@ def test_chunked_sample_rows_are_the_whole_sample_rows(n, chunk, reads):
         head = lazy.head(n // 2)
         for name in ("position", "velocity", "acceleration"):
             np.testing.assert_array_equal(getattr(lazy, name), getattr(whole, name))
-        np.testing.assert_array_equal(head.position, whole.position[:n // 2])
+        np.testing.assert_array_equal(head.position, whole.position[: n // 2])
 
 
 def _log(sensors: dict) -> dict:
@@ -68,8 +74,7 @@ def test_fast_controller_in_small_plan_blocks_runs_the_same(monkeypatch, system)
 
 
 @settings(max_examples=30, deadline=None)
-@given(n=st.integers(1, 40), block=st.integers(1, 9), seed=st.integers(0, 2**32 - 1),
-       stride=st.integers(1, 3))
+@given(n=st.integers(1, 40), block=st.integers(1, 9), seed=st.integers(0, 2**32 - 1), stride=st.integers(1, 3))
 def test_imu_errors_in_blocks_are_the_whole_run_s_draws(n, block, seed, stride):
     """ImuErrors, read every ``stride``-th tick in blocks of ``block`` ticks: the numbers of the
     whole arrays drawn at once, and the generator left where those draws leave it."""
@@ -77,8 +82,11 @@ def test_imu_errors_in_blocks_are_the_whole_run_s_draws(n, block, seed, stride):
 
     white, bias, walk = 1e-3, 1e-2, 1e-4
     rng = np.random.default_rng(seed)
-    whole = (rng.normal(0.0, white, (n, 2, 3)) + rng.normal(0.0, bias, (1, 2, 3))
-             + np.cumsum(rng.normal(0.0, walk, (n, 2, 3)), axis=0))
+    whole = (
+        rng.normal(0.0, white, (n, 2, 3))
+        + rng.normal(0.0, bias, (1, 2, 3))
+        + np.cumsum(rng.normal(0.0, walk, (n, 2, 3)), axis=0)
+    )
     after = rng.normal(size=4)
     saved = measurement.IMU_BLOCK_TICKS
     measurement.IMU_BLOCK_TICKS = block

@@ -30,8 +30,13 @@ SUFFIXES = (".py", ".md", ".toml", ".xml", ".cfg", ".txt")
 
 def project_files() -> list[Path]:
     """The repository's tracked text files (and new ones not ignored)."""
-    out = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard"], cwd=ROOT,
-                         capture_output=True, text=True, check=True).stdout.split()
+    out = subprocess.run(
+        ["git", "ls-files", "--cached", "--others", "--exclude-standard"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
     return [ROOT / f for f in out if f.endswith(SUFFIXES) and (ROOT / f).is_file()]
 
 
@@ -86,24 +91,30 @@ def test_every_citation_is_in_the_project():
     assert not found, found
 
 
-@pytest.mark.parametrize("text, missing", [
-    ("see ARCHITECTURE.md, Conventions", "ARCHITECTURE.md"),
-    ("the paper (shared/papers/fast-feed-support-motion-planning.txt)", "shared/papers/"),
-    ('limits: REFERENCE.md, "Rubin hexapods and rotators"', "no such section"),
-    ("models/robot/README.md lists the gains", "models/robot/README.md"),
-    ("examples/*/nothing.toml", "examples/*/nothing.toml"),
-])
+@pytest.mark.parametrize(
+    "text, missing",
+    [
+        ("see ARCHITECTURE.md, Conventions", "ARCHITECTURE.md"),
+        ("the paper (shared/papers/fast-feed-support-motion-planning.txt)", "shared/papers/"),
+        ('limits: REFERENCE.md, "Rubin hexapods and rotators"', "no such section"),
+        ("models/robot/README.md lists the gains", "models/robot/README.md"),
+        ("examples/*/nothing.toml", "examples/*/nothing.toml"),
+    ],
+)
 def test_a_citation_of_a_missing_file_or_section_is_found(text, missing):
     bad = bad_citations(text, ROOT / "sims" / "cli.py")
     assert any(missing in b for b in bad), bad
 
 
-@pytest.mark.parametrize("text", [
-    'REFERENCE.md, "Rubin hexapod"',
-    "models/hexapod/README.md and sims/hexapod/plan_checks.py",
-    "models/*/README.md",
-    'README.md, "How the hexapod is judged"',
-    "ts_mthexapod's constants.py (another project's file)",
-])
+@pytest.mark.parametrize(
+    "text",
+    [
+        'REFERENCE.md, "Rubin hexapod"',
+        "models/hexapod/README.md and sims/hexapod/plan_checks.py",
+        "models/*/README.md",
+        'README.md, "How the hexapod is judged"',
+        "ts_mthexapod's constants.py (another project's file)",
+    ],
+)
 def test_citations_in_the_project_pass(text):
     assert bad_citations(text, ROOT / "sims" / "cli.py") == []

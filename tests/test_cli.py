@@ -10,8 +10,9 @@ import pytest
 
 
 def planbench(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "planbench.cli", *map(str, args)],
-                          capture_output=True, text=True, cwd=cwd, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "planbench.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=300
+    )
 
 
 def assert_one_line_error(proc, *words):
@@ -28,17 +29,31 @@ def test_list_names_every_scenario():
     assert proc.returncode == 0
     names = [line.split()[0] for line in proc.stdout.splitlines()]
     # The mechanisms in their folders' name order, each's scenarios in the order it declares them.
-    assert names == ["antenna-paper-motion", "antenna-sea-state", "fast-tracking", "fast-ra-scan",
-                     "fast-source-switch", "hexapod-sync-move", "hexapod-async-move", "loader-supply",
-                     "loader-direct"]
+    assert names == [
+        "antenna-paper-motion",
+        "antenna-sea-state",
+        "fast-tracking",
+        "fast-ra-scan",
+        "fast-source-switch",
+        "hexapod-sync-move",
+        "hexapod-async-move",
+        "loader-supply",
+        "loader-direct",
+    ]
 
 
 def test_run_writes_summary_timeseries_report_and_video(tmp_path):
     out = tmp_path / "run"
     proc = planbench("run", "loader-supply", "--out", out, "--video", out / "loader.mp4", "--quiet")
     assert proc.returncode == 0, proc.stderr
-    assert {p.name for p in out.iterdir()} == {"summary.json", "timeseries.npz", "report.png", "loader.mp4",
-                                            "log.arrow", "planbench-manifest.json"}
+    assert {p.name for p in out.iterdir()} == {
+        "summary.json",
+        "timeseries.npz",
+        "report.png",
+        "loader.mp4",
+        "log.arrow",
+        "planbench-manifest.json",
+    }
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"] == "loader-supply" and summary["passed"] is True
     assert summary["sim_time_s"] == pytest.approx(3.0) and summary["realtime_factor"] > 0
@@ -57,8 +72,19 @@ def test_run_writes_summary_timeseries_report_and_video(tmp_path):
 
 def test_video_outside_the_output_dir(tmp_path):
     video = tmp_path / "videos" / "short.mp4"
-    proc = planbench("run", "loader-supply", "--out", tmp_path / "r", "--video", video,
-                     "--duration", "0.5", "--camera", "closeup", "--quiet")
+    proc = planbench(
+        "run",
+        "loader-supply",
+        "--out",
+        tmp_path / "r",
+        "--video",
+        video,
+        "--duration",
+        "0.5",
+        "--camera",
+        "closeup",
+        "--quiet",
+    )
     assert proc.returncode == 0, proc.stderr
     assert imageio_ffmpeg.count_frames_and_secs(str(video))[0] == 16  # 0.5 s at 30 fps
     assert json.loads((tmp_path / "r" / "summary.json").read_text())["video"]["camera"] == "closeup"
@@ -73,23 +99,24 @@ def test_failing_check_exits_1(tmp_path):
 
 
 def test_unknown_scenario_exits_2(tmp_path):
-    assert_one_line_error(planbench("run", "loader-teleport", "--out", tmp_path / "x"),
-                          "loader-teleport", "loader-supply")
+    assert_one_line_error(
+        planbench("run", "loader-teleport", "--out", tmp_path / "x"), "loader-teleport", "loader-supply"
+    )
     assert not (tmp_path / "x").exists()
 
 
 @pytest.mark.parametrize("duration", ["-1", "0", "nan", "abc"])
 def test_bad_duration_exits_2(tmp_path, duration):
-    assert_one_line_error(planbench("run", "loader-supply", "--out", tmp_path / "x",
-                                    f"--duration={duration}"), "duration")
+    assert_one_line_error(
+        planbench("run", "loader-supply", "--out", tmp_path / "x", f"--duration={duration}"), "duration"
+    )
     assert not (tmp_path / "x").exists()
 
 
 def test_unwritable_output_dir_exits_2(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a directory")
-    assert_one_line_error(planbench("run", "loader-supply", "--out", blocker / "out"),
-                          str(blocker), "not a directory")
+    assert_one_line_error(planbench("run", "loader-supply", "--out", blocker / "out"), str(blocker), "not a directory")
     assert_one_line_error(planbench("run", "loader-supply", "--out", blocker), "not a directory")
     assert blocker.read_text() == "not a directory"
 
@@ -97,8 +124,7 @@ def test_unwritable_output_dir_exits_2(tmp_path):
 def test_other_bad_options_exit_2(tmp_path):
     assert_one_line_error(planbench("run", "loader-supply", "--wind", "4"), "unrecognized arguments: --wind 4")
     assert_one_line_error(planbench("run", "loader-supply", "--seed", "-3"), "seed")
-    assert_one_line_error(planbench("run", "loader-supply", "--camera", "top",
-                                    "--out", tmp_path / "c"), "camera")
+    assert_one_line_error(planbench("run", "loader-supply", "--camera", "top", "--out", tmp_path / "c"), "camera")
     assert_one_line_error(planbench("frobnicate"), "invalid choice")
 
 
@@ -116,8 +142,21 @@ def test_plan_writes_npz_and_plot(tmp_path):
 
 def test_hexapod_run_with_elevation_and_wind(tmp_path):
     out = tmp_path / "hx"
-    proc = planbench("run", "hexapod-async-move", "--elevation", "20", "--wind", "8", "--out", out,
-                     "--video", out / "hexapod.mp4", "--camera", "closeup", "--quiet")
+    proc = planbench(
+        "run",
+        "hexapod-async-move",
+        "--elevation",
+        "20",
+        "--wind",
+        "8",
+        "--out",
+        out,
+        "--video",
+        out / "hexapod.mp4",
+        "--camera",
+        "closeup",
+        "--quiet",
+    )
     assert proc.returncode == 0, proc.stdout + proc.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["metrics"]["elevation_deg"] == 20.0 and summary["metrics"]["wind_mean_m_s"] == 8.0
@@ -131,8 +170,11 @@ def test_hexapod_run_with_elevation_and_wind(tmp_path):
 
 
 def test_hexapod_bad_elevation_exits_2(tmp_path):
-    assert_one_line_error(planbench("run", "hexapod-sync-move", "--elevation", "10", "--out",
-                                    tmp_path / "x"), "elevation = 10 deg", "[15, 90]")
+    assert_one_line_error(
+        planbench("run", "hexapod-sync-move", "--elevation", "10", "--out", tmp_path / "x"),
+        "elevation = 10 deg",
+        "[15, 90]",
+    )
     assert_one_line_error(planbench("run", "loader-supply", "--elevation", "45"), "unrecognized arguments: --elevation")
     assert not (tmp_path / "x").exists()
 
@@ -147,15 +189,35 @@ def test_hexapod_plan(tmp_path):
 
 def test_antenna_sea_state_run_with_sea_options(tmp_path):
     out = tmp_path / "sea"
-    proc = planbench("run", "antenna-sea-state", "--hs", "3", "--tp", "8", "--wave-heading", "90",
-                     "--duration", "4", "--out", out, "--video", out / "sea.mp4", "--quiet")
+    proc = planbench(
+        "run",
+        "antenna-sea-state",
+        "--hs",
+        "3",
+        "--tp",
+        "8",
+        "--wave-heading",
+        "90",
+        "--duration",
+        "4",
+        "--out",
+        out,
+        "--video",
+        out / "sea.mp4",
+        "--quiet",
+    )
     assert proc.returncode == 0, proc.stdout + proc.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert "Hs 3 m, Tp 8 s" in summary["metrics"]["ship_motion"]
     assert "90 deg off the bow" in summary["metrics"]["ship_motion"]
     assert {c["name"] for c in summary["checks"]} >= {
-        "pointing_error_max", "pointing_error_rms", "polarization_error_max",
-        "attitude_error_fro_max", "joint_rate", "joint_torque"}
+        "pointing_error_max",
+        "pointing_error_rms",
+        "polarization_error_max",
+        "attitude_error_fro_max",
+        "joint_rate",
+        "joint_torque",
+    }
     ts = np.load(out / "timeseries.npz")
     n = ts["t"].size
     assert ts["theta_actual"].shape == ts["theta_planned"].shape == (n, 4)
@@ -163,16 +225,19 @@ def test_antenna_sea_state_run_with_sea_options(tmp_path):
     assert imageio_ffmpeg.count_frames_and_secs(str(out / "sea.mp4"))[0] == 4 * 30 + 1
 
 
-@pytest.mark.parametrize("args, words", [
-    (("antenna-sea-state", "--hs", "-2"), ("hs = -2 m", "(0, 20] m")),
-    (("antenna-sea-state", "--tp", "nan"), ("tp = nan", "not finite")),
-    (("antenna-paper-motion", "--hs", "4"), ("unrecognized arguments", "--hs")),
-    (("hexapod-sync-move", "--wave-heading", "90"), ("unrecognized arguments", "--wave-heading")),
-    (("antenna-sea-state", "--wind", "5"), ("unrecognized arguments", "--wind")),
-    (("antenna-sea-state", "--set", "imu.rate_hz=30"), ("IMU rate 30 Hz", "whole number")),
-    (("antenna-paper-motion", "--set", "imu.latency_s=0.012"), ("IMU latency 0.012 s", "5 ms")),
-    (("loader-supply", "--prediction", "off"), ("unrecognized arguments", "--prediction")),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (("antenna-sea-state", "--hs", "-2"), ("hs = -2 m", "(0, 20] m")),
+        (("antenna-sea-state", "--tp", "nan"), ("tp = nan", "not finite")),
+        (("antenna-paper-motion", "--hs", "4"), ("unrecognized arguments", "--hs")),
+        (("hexapod-sync-move", "--wave-heading", "90"), ("unrecognized arguments", "--wave-heading")),
+        (("antenna-sea-state", "--wind", "5"), ("unrecognized arguments", "--wind")),
+        (("antenna-sea-state", "--set", "imu.rate_hz=30"), ("IMU rate 30 Hz", "whole number")),
+        (("antenna-paper-motion", "--set", "imu.latency_s=0.012"), ("IMU latency 0.012 s", "5 ms")),
+        (("loader-supply", "--prediction", "off"), ("unrecognized arguments", "--prediction")),
+    ],
+)
 def test_antenna_bad_options_exit_2(tmp_path, args, words):
     assert_one_line_error(planbench("run", *args, "--out", tmp_path / "x"), *words)
     assert not (tmp_path / "x").exists()
@@ -193,8 +258,21 @@ def test_antenna_plan(tmp_path):
 
 def test_antenna_without_prediction_fails_the_paper_motion(tmp_path):
     """--prediction off: the 20 ms IMU latency and the 20 ms update interval become lag."""
-    proc = planbench("run", "antenna-paper-motion", "--prediction", "off", "--set", "imu.rate_hz=25",
-                     "--set", "imu.latency_s=0.04", "--duration", "3", "--out", tmp_path / "np", "--quiet")
+    proc = planbench(
+        "run",
+        "antenna-paper-motion",
+        "--prediction",
+        "off",
+        "--set",
+        "imu.rate_hz=25",
+        "--set",
+        "imu.latency_s=0.04",
+        "--duration",
+        "3",
+        "--out",
+        tmp_path / "np",
+        "--quiet",
+    )
     assert proc.returncode == 1, proc.stdout + proc.stderr
     summary = json.loads((tmp_path / "np" / "summary.json").read_text())
     metrics = summary["metrics"]
@@ -209,8 +287,13 @@ def test_fast_plans(tmp_path, name):
     out = tmp_path / name
     proc = planbench("plan", name, "--out", out)
     assert proc.returncode == 0, proc.stderr
-    assert {p.name for p in out.iterdir()} == {"plan.npz", "plan.png", "figures.png", "segments.json",
-                                            "planbench-manifest.json"}
+    assert {p.name for p in out.iterdir()} == {
+        "plan.npz",
+        "plan.png",
+        "figures.png",
+        "segments.json",
+        "planbench-manifest.json",
+    }
     plan = np.load(out / "plan.npz")
     assert list(plan["labels"][:3]) == ["feed_x", "feed_y", "feed_z"] and plan["position"].shape[1] == 13
     assert np.linalg.norm(plan["velocity"][:, :3], axis=1).max() <= 0.4 + 1e-12
@@ -224,16 +307,39 @@ def test_fast_dec_scan_is_a_plan_only(tmp_path):
 
 def test_fast_run_outputs_and_stewart_option(tmp_path):
     out = tmp_path / "fast"
-    proc = planbench("run", "fast-tracking", "--duration", "3", "--stewart", "off", "--wind", "6",
-                     "--wind-direction", "90",
-                     "--out", out, "--video", out / "closeup.mp4", "--camera", "closeup", "--quiet")
+    proc = planbench(
+        "run",
+        "fast-tracking",
+        "--duration",
+        "3",
+        "--stewart",
+        "off",
+        "--wind",
+        "6",
+        "--wind-direction",
+        "90",
+        "--out",
+        out,
+        "--video",
+        out / "closeup.mp4",
+        "--camera",
+        "closeup",
+        "--quiet",
+    )
     assert proc.returncode in (0, 1), proc.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["metrics"]["stewart"] == "off" and summary["metrics"]["wind_mean_m_s"] == 6.0
     assert summary["metrics"]["wind_toward_deg"] == pytest.approx(90.0)
     names = {c["name"] for c in summary["checks"]}
-    assert {"feed_error_rms", "feed_error_max", "cabin_error_rms", "cable_tension_min", "cable_tension_max",
-            "stewart_stroke", "stewart_force"} <= names
+    assert {
+        "feed_error_rms",
+        "feed_error_max",
+        "cabin_error_rms",
+        "cable_tension_min",
+        "cable_tension_max",
+        "stewart_stroke",
+        "stewart_force",
+    } <= names
     # 3 s lie in the switch: no observing segment, so the feed checks cover the whole run.
     assert "no observing segment" in next(c for c in summary["checks"] if c["name"] == "feed_error_rms")["note"]
     ts = np.load(out / "timeseries.npz")
@@ -250,19 +356,35 @@ def test_fast_run_outputs_and_stewart_option(tmp_path):
 
 
 def test_fast_bad_stewart_option(tmp_path):
-    assert_one_line_error(planbench("run", "fast-tracking", "--stewart", "maybe", "--out", tmp_path / "x"),
-                          "stewart = 'maybe' is not true or false")
-    assert_one_line_error(planbench("run", "loader-supply", "--stewart", "on", "--out", tmp_path / "x"),
-                          "unrecognized arguments: --stewart on")
+    assert_one_line_error(
+        planbench("run", "fast-tracking", "--stewart", "maybe", "--out", tmp_path / "x"),
+        "stewart = 'maybe' is not true or false",
+    )
+    assert_one_line_error(
+        planbench("run", "loader-supply", "--stewart", "on", "--out", tmp_path / "x"),
+        "unrecognized arguments: --stewart on",
+    )
     assert_one_line_error(planbench("run", "fast-ra-scan", "--wind", "-1", "--out", tmp_path / "x"), "wind")
-    assert_one_line_error(planbench("run", "fast-ra-scan", "--wind-direction", "inf", "--out", tmp_path / "x"),
-                          "wind_direction = inf is not finite")
-    assert_one_line_error(planbench("run", "hexapod-sync-move", "--wind-direction", "30", "--out", tmp_path / "x"),
-                          "unrecognized arguments: --wind-direction 30")
-    assert_one_line_error(planbench("run", "fast-tracking", "--cable-segments", "1", "--out", tmp_path / "x"),
-                          "cable_segments = 1 is not a chain", "2 ... 14")
-    assert_one_line_error(planbench("run", "fast-tracking", "--cable-segments", "20", "--out", tmp_path / "x"),
-                          "cable_segments = 20 is outside [0, 14]", "omega dt <= 0.7")
-    assert_one_line_error(planbench("run", "loader-supply", "--cable-segments", "4", "--out", tmp_path / "x"),
-                          "unrecognized arguments: --cable-segments 4")
+    assert_one_line_error(
+        planbench("run", "fast-ra-scan", "--wind-direction", "inf", "--out", tmp_path / "x"),
+        "wind_direction = inf is not finite",
+    )
+    assert_one_line_error(
+        planbench("run", "hexapod-sync-move", "--wind-direction", "30", "--out", tmp_path / "x"),
+        "unrecognized arguments: --wind-direction 30",
+    )
+    assert_one_line_error(
+        planbench("run", "fast-tracking", "--cable-segments", "1", "--out", tmp_path / "x"),
+        "cable_segments = 1 is not a chain",
+        "2 ... 14",
+    )
+    assert_one_line_error(
+        planbench("run", "fast-tracking", "--cable-segments", "20", "--out", tmp_path / "x"),
+        "cable_segments = 20 is outside [0, 14]",
+        "omega dt <= 0.7",
+    )
+    assert_one_line_error(
+        planbench("run", "loader-supply", "--cable-segments", "4", "--out", tmp_path / "x"),
+        "unrecognized arguments: --cable-segments 4",
+    )
     assert not (tmp_path / "x").exists()

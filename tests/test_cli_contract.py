@@ -21,15 +21,21 @@ from tests.test_bad_invocations import scene  # noqa: F401  (the fixture)
 from tests.test_outputs import snapshot
 
 ROOT = Path(__file__).resolve().parents[1]
-PLAN_SPEC = ('scenario = "loader-supply"\nmode = "plan"\nseed = 1\nsamples = 3\n[random]\n'
-             '"key_points[1][0]" = { distribution = "uniform", low = 30, high = 70 }\n')
+PLAN_SPEC = (
+    'scenario = "loader-supply"\nmode = "plan"\nseed = 1\nsamples = 3\n[random]\n'
+    '"key_points[1][0]" = { distribution = "uniform", low = 30, high = 70 }\n'
+)
 
 
 def _summary(**changes) -> str:
     from planbench import scenarios
 
-    data = {"scenario": "loader-supply", "seed": 0, "parameters": scenarios.get("loader-supply").params.to_dict(),
-            "plugins": {}}
+    data = {
+        "scenario": "loader-supply",
+        "seed": 0,
+        "parameters": scenarios.get("loader-supply").params.to_dict(),
+        "plugins": {},
+    }
     data.update(changes)
     return json.dumps(data)
 
@@ -42,23 +48,40 @@ CASES = [
     (["demo", "--out", "~"], {}, ["home directory"]),
     (["demo", "--out", "{tmp}/mydata"], {}, ["mydata", "thesis.tex", "did not write"]),
     (["demo", "--out", "{tmp}/link"], {}, ["symbolic link"]),
-    (["run", "deep.toml", "--out", "{tmp}/r"], {"deep.toml": 'scenario = "loader-supply"\n[parameters]\nx = '
-                                                + "[" * 5000 + "]" * 5000 + "\n"}, ["deep.toml", "nested too deep"]),
-    (["run", "deep.json", "--out", "{tmp}/r"], {"deep.json": '{"parameters": ' + "[" * 100000 + "]" * 100000 + "}"},
-     ["deep.json", "nested too deep"]),
-    (["sweep", "deep_spec.toml", "--out", "{tmp}/c"], {"deep_spec.toml": "x = " + "[" * 5000 + "]" * 5000 + "\n"},
-     ["deep_spec.toml", "nested too deep"]),
+    (
+        ["run", "deep.toml", "--out", "{tmp}/r"],
+        {"deep.toml": 'scenario = "loader-supply"\n[parameters]\nx = ' + "[" * 5000 + "]" * 5000 + "\n"},
+        ["deep.toml", "nested too deep"],
+    ),
+    (
+        ["run", "deep.json", "--out", "{tmp}/r"],
+        {"deep.json": '{"parameters": ' + "[" * 100000 + "]" * 100000 + "}"},
+        ["deep.json", "nested too deep"],
+    ),
+    (
+        ["sweep", "deep_spec.toml", "--out", "{tmp}/c"],
+        {"deep_spec.toml": "x = " + "[" * 5000 + "]" * 5000 + "\n"},
+        ["deep_spec.toml", "nested too deep"],
+    ),
     (["run", "list_plugins.json", "--out", "{tmp}/r"], {"list_plugins.json": "LIST_PLUGINS"}, ['"plugins"', "table"]),
     (["run", "seed.json", "--out", "{tmp}/r"], {"seed.json": "SEED"}, ['"seed" = 7', "parameters.seed = 0"]),
     (["sweep", "s.toml", "--out", "{tmp}/" + "n" * 256], {"s.toml": PLAN_SPEC}, ["256 bytes", "255"]),
     (["sweep", "s.toml", "--out", ""], {"s.toml": PLAN_SPEC}, ["''", "empty"]),
-    (["sweep", "both.toml", "--out", "{tmp}/c"],
-     {"both.toml": PLAN_SPEC + '[grid]\n"key_points[1][0]" = [40, 50]\n'}, ["in both [grid] and [random]"]),
-    (["sweep", "overlap.toml", "--out", "{tmp}/c"],
-     {"overlap.toml": PLAN_SPEC.replace("[random]", '[grid]\nkey_points = [[[0, 0, 0, 0, 0, 0]]]\n[random]')},
-     ["'key_points'", "same value"]),
-    (["sweep", "s.toml", "--out", "{tmp}/c", "--engine", "ray", "--address", "127.0.0.1:1"], {"s.toml": PLAN_SPEC},
-     ["127.0.0.1:1", "nothing listens"]),
+    (
+        ["sweep", "both.toml", "--out", "{tmp}/c"],
+        {"both.toml": PLAN_SPEC + '[grid]\n"key_points[1][0]" = [40, 50]\n'},
+        ["in both [grid] and [random]"],
+    ),
+    (
+        ["sweep", "overlap.toml", "--out", "{tmp}/c"],
+        {"overlap.toml": PLAN_SPEC.replace("[random]", "[grid]\nkey_points = [[[0, 0, 0, 0, 0, 0]]]\n[random]")},
+        ["'key_points'", "same value"],
+    ),
+    (
+        ["sweep", "s.toml", "--out", "{tmp}/c", "--engine", "ray", "--address", "127.0.0.1:1"],
+        {"s.toml": PLAN_SPEC},
+        ["127.0.0.1:1", "nothing listens"],
+    ),
     (["run", "loader-supply", "--out", "{tmp}/r", "--duration="], {}, ["--duration is empty"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--set", "duration="], {}, ["--set duration is empty"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--set", "seed=  "], {}, ["--set seed is empty"]),
@@ -66,12 +89,16 @@ CASES = [
     (["run", "loader-supply", "--out", "{tmp}/r", "--duration", "5\nseed=3"], {}, ["--duration", "line break"]),
     (["run", "loader-supply", "--out", "{tmp}/r", "--set", "duration=" + "[" * 5000], {}, ["nested too deep"]),
     # TOML has no none: a file that writes the flags' "none" is told to leave the key out.
-    (["run", "radec.toml", "--out", "{tmp}/r"],
-     {"radec.toml": 'scenario = "fast-tracking"\n[parameters]\nsource = "none"\nsource_radec = [202.78, 30.51]\n'},
-     ["source = 'none'", "omit it from the file", "give source_radec"]),
-    (["run", "both.toml", "--out", "{tmp}/r"],
-     {"both.toml": 'scenario = "fast-tracking"\n[parameters]\nsource = "3C 286"\nsource_radec = [202.78, 30.51]\n'},
-     ["both given", "leave source out"]),
+    (
+        ["run", "radec.toml", "--out", "{tmp}/r"],
+        {"radec.toml": 'scenario = "fast-tracking"\n[parameters]\nsource = "none"\nsource_radec = [202.78, 30.51]\n'},
+        ["source = 'none'", "omit it from the file", "give source_radec"],
+    ),
+    (
+        ["run", "both.toml", "--out", "{tmp}/r"],
+        {"both.toml": 'scenario = "fast-tracking"\n[parameters]\nsource = "3C 286"\nsource_radec = [202.78, 30.51]\n'},
+        ["both given", "leave source out"],
+    ),
 ]
 
 
@@ -94,10 +121,9 @@ def test_bad_input_is_one_line(argv, files, expected, scene, capsys):  # noqa: F
 
 
 def test_a_multi_line_toml_value_is_still_one_value():
-    from planbench.params import parse_value, field_types
-    from planbench.hexapod import HexapodParams  # noqa: F401
-
     from planbench import scenarios
+    from planbench.hexapod import HexapodParams  # noqa: F401
+    from planbench.params import field_types, parse_value
 
     cls = type(scenarios.get("hexapod-sync-move").params)
     moves = parse_value(field_types(cls)["moves"], "[\n{target=[0,0,0.01,0,0,0]}\n]", "--set moves")
@@ -158,9 +184,15 @@ SIM_SPEC = 'scenario = "loader-supply"\nseeds = 8\n'
 
 def _sweep(tmp_path, **kw):
     (tmp_path / "sim.toml").write_text(SIM_SPEC)
-    return subprocess.Popen([sys.executable, "-m", "planbench.cli", "sweep", "sim.toml", "--out", "c", "--quiet",
-                             "--workers", "2"], cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)},
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+    return subprocess.Popen(
+        [sys.executable, "-m", "planbench.cli", "sweep", "sim.toml", "--out", "c", "--quiet", "--workers", "2"],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        **kw,
+    )
 
 
 def _workers_of(pid: int) -> list[int]:
@@ -185,8 +217,9 @@ def test_interrupted_sweep_prints_one_line(tmp_path, signum, code):
     os.killpg(proc.pid, signum)
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == code, err
-    assert err.splitlines() == [f"planbench: interrupted by {signal.Signals(signum).name}; nothing "
-                                "half-written was left"], err
+    assert err.splitlines() == [
+        f"planbench: interrupted by {signal.Signals(signum).name}; nothing half-written was left"
+    ], err
 
 
 def test_workers_end_with_a_killed_driver(tmp_path):
@@ -199,6 +232,7 @@ def test_workers_end_with_a_killed_driver(tmp_path):
     deadline = time.monotonic() + 60
     while any(Path(f"/proc/{p}").exists() for p in children) and time.monotonic() < deadline:
         time.sleep(0.2)
-    alive = [p for p in children if Path(f"/proc/{p}").exists()
-             and "Z" not in Path(f"/proc/{p}/stat").read_text().split()[2]]
+    alive = [
+        p for p in children if Path(f"/proc/{p}").exists() and "Z" not in Path(f"/proc/{p}/stat").read_text().split()[2]
+    ]
     assert alive == []

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planbench.planners.antenna import JOINT_LABELS
 from planbench import runner, scenarios
 from planbench.antenna import AntennaController
+from planbench.planners.antenna import JOINT_LABELS
 from planbench.plugins import PluginError
 
 DECK = ("heave", "yaw", "pitch", "roll")
@@ -84,17 +84,26 @@ def test_other_controllers_drive_every_actuator(name):
 def test_the_servo_controller_finds_its_drives_by_name():
     """ServoFeedforwardController on a command that is not the model's first actuators (the
     antenna's four joints, actuators 4 ... 7) reads those drives' gains, not the deck's."""
-    from planbench.planners.trajectory import TrajectorySample
     from planbench.controllers import ServoFeedforwardController
+    from planbench.planners.trajectory import TrajectorySample
     from planbench.task import ControlContext
 
     setup = build("antenna-paper-motion", None)
     model = setup.physics.model.ptr
     n = 3
     reference = TrajectorySample(np.arange(n) * 0.005, np.zeros((n, 4)), np.zeros((n, 4)), np.zeros((n, 4)))
-    context = ControlContext(model=model, nominal_physics=lambda: setup.physics, problem=None, trajectory=None,
-                             reference=reference, control_dt=0.005, command=np.zeros(4), setpoint=np.zeros(4),
-                             actuators=tuple(JOINT_LABELS), observation={})
+    context = ControlContext(
+        model=model,
+        nominal_physics=lambda: setup.physics,
+        problem=None,
+        trajectory=None,
+        reference=reference,
+        control_dt=0.005,
+        command=np.zeros(4),
+        setpoint=np.zeros(4),
+        actuators=tuple(JOINT_LABELS),
+        observation={},
+    )
     servo = ServoFeedforwardController(feedforward=False, integral_time=0.1)
     servo.reset(context)
     ids = [model.actuator(name).id for name in JOINT_LABELS]
@@ -109,17 +118,25 @@ def test_the_servo_controller_refuses_a_reference_that_is_not_its_command(channe
     trajectory is refused by name in reset, not driven onto the wrong joints."""
     from types import SimpleNamespace
 
-    from planbench.planners.trajectory import TrajectorySample
     from planbench.controllers import ServoFeedforwardController
+    from planbench.planners.trajectory import TrajectorySample
     from planbench.task import ControlContext
 
     setup = build("antenna-paper-motion", None)
     n = 3
     reference = TrajectorySample(np.arange(n) * 0.005, *(np.zeros((n, channels)),) * 3)
     labels = tuple(reversed(JOINT_LABELS))[:channels]
-    context = ControlContext(model=setup.physics.model.ptr, nominal_physics=lambda: setup.physics, problem=None,
-                             trajectory=SimpleNamespace(labels=labels), reference=reference, control_dt=0.005,
-                             command=np.zeros(4), setpoint=np.zeros(4), actuators=tuple(JOINT_LABELS),
-                             observation={})
+    context = ControlContext(
+        model=setup.physics.model.ptr,
+        nominal_physics=lambda: setup.physics,
+        problem=None,
+        trajectory=SimpleNamespace(labels=labels),
+        reference=reference,
+        control_dt=0.005,
+        command=np.zeros(4),
+        setpoint=np.zeros(4),
+        actuators=tuple(JOINT_LABELS),
+        observation={},
+    )
     with pytest.raises(ValueError, match="are not the commanded actuators"):
         ServoFeedforwardController(feedforward=False).reset(context)

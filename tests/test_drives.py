@@ -9,7 +9,8 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import example, given, settings, strategies as st
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from planbench import drives
 from planbench.task import JointEncoders
@@ -35,9 +36,18 @@ AXIS = """
 
 
 def drive(**changes) -> drives.DriveTrain:
-    base = dict(ratio=2 * math.pi / 0.01, rotor_inertia=1e-4, torque_constant=0.5, peak_current=20.0,
-                continuous_current=8.0, max_motor_speed=300.0, kp=2e6, kv=2e4, efficiency=0.9,
-                stiffness=5e7)
+    base = dict(
+        ratio=2 * math.pi / 0.01,
+        rotor_inertia=1e-4,
+        torque_constant=0.5,
+        peak_current=20.0,
+        continuous_current=8.0,
+        max_motor_speed=300.0,
+        kp=2e6,
+        kv=2e4,
+        efficiency=0.9,
+        stiffness=5e7,
+    )
     base.update(changes)
     return drives.DriveTrain(**base)
 
@@ -165,8 +175,15 @@ def test_counted_encoders_read_straight_from_the_buffer_as_from_a_copy(positions
     physics = type("P", (), {"data": type("Ptr", (), {"ptr": data})()})()
     resolutions = [resolution, 2 * resolution, 3 * resolution]
     run = JointEncoders([1, 2, 3], [1, 2, 3], [1, 2, 3], "axes", "rad", 0.005, resolution=resolutions)
-    scattered = JointEncoders([3, 1, 2], [3, 1, 2], [3, 1, 2], "axes", "rad", 0.005,
-                              resolution=[resolutions[2], resolutions[0], resolutions[1]])
+    scattered = JointEncoders(
+        [3, 1, 2],
+        [3, 1, 2],
+        [3, 1, 2],
+        "axes",
+        "rad",
+        0.005,
+        resolution=[resolutions[2], resolutions[0], resolutions[1]],
+    )
     a, b = run.reset(physics, np.zeros(3), 0), scattered.reset(physics, np.zeros(3), 0)
     assert run._counted_run is not None and scattered._counted_run is None
     for tick, shift in enumerate([0.0, 1e-7, -0.3]):
@@ -181,21 +198,32 @@ def test_counted_encoders_read_straight_from_the_buffer_as_from_a_copy(positions
 def test_the_servo_feedforward_through_a_drive_train_is_the_load_s_plus_the_rotor_s():
     """Inverse dynamics on a model with a drive train as built: the motor moves with its load,
     so the feed-forward is (M + J N^2) a, not a force stretching the transmission."""
-    from planbench.planners.trajectory import TrajectorySample
     from planbench.controllers import ServoFeedforwardController
+    from planbench.planners.trajectory import TrajectorySample
     from planbench.task import ControlContext
 
     train = drive()
     model = axis_model(train)
-    physics = type("P", (), {"model": type("M", (), {"ptr": model})(), "data": type("D", (), {"ptr": mujoco.MjData(model)})()})()
+    physics = type(
+        "P", (), {"model": type("M", (), {"ptr": model})(), "data": type("D", (), {"ptr": mujoco.MjData(model)})()}
+    )()
     physics.data.qpos = physics.data.ptr.qpos
     n = 5
     t = np.arange(n) * 0.005
     a = np.full((n, 1), 2.0)  # m/s^2
     reference = TrajectorySample(t, 0.5 * a * t[:, None] ** 2, a * t[:, None], a)
-    context = ControlContext(model=model, nominal_physics=lambda: physics, problem=None, trajectory=None,
-                             reference=reference, control_dt=0.005, command=np.zeros(1), setpoint=np.zeros(1),
-                             actuators=("axis",), observation={})
+    context = ControlContext(
+        model=model,
+        nominal_physics=lambda: physics,
+        problem=None,
+        trajectory=None,
+        reference=reference,
+        control_dt=0.005,
+        command=np.zeros(1),
+        setpoint=np.zeros(1),
+        actuators=("axis",),
+        observation={},
+    )
     servo = ServoFeedforwardController()
     servo.reset(context)
     mass = LOAD_MASS + train.reflected_inertia + drives.ROTOR_BODY_MASS  # the rotor body moves too
@@ -224,17 +252,23 @@ def test_a_motor_stands_off_its_load_by_the_deflection_and_half_the_backlash():
 
 
 def test_the_keyframe_puts_each_motor_at_its_load():
-    spec = mujoco.MjSpec.from_string(AXIS.format(dt=DT, mass=LOAD_MASS).replace(
-        "</worldbody>", "</worldbody><keyframe><key name='home' qpos='0.25' act='0.25'/></keyframe>"))
+    spec = mujoco.MjSpec.from_string(
+        AXIS.format(dt=DT, mass=LOAD_MASS).replace(
+            "</worldbody>", "</worldbody><keyframe><key name='home' qpos='0.25' act='0.25'/></keyframe>"
+        )
+    )
     nominal = spec.compile()
     drives.add_drive_train(spec, "axis", "axis", drive())
     drives.keyframe_with_motors(spec, nominal)
     model = spec.compile()
-    np.testing.assert_array_equal(model.key_qpos[0][[model.joint("axis").qposadr[0],
-                                                     model.joint("axis_motor").qposadr[0]]], [0.25, 0.25])
+    np.testing.assert_array_equal(
+        model.key_qpos[0][[model.joint("axis").qposadr[0], model.joint("axis_motor").qposadr[0]]], [0.25, 0.25]
+    )
     np.testing.assert_array_equal(model.key_act[0], [0.25])
     qpos, dofs = drives.drive_coordinates(model, ["axis"])
-    assert qpos.tolist() == [model.joint("axis_motor").qposadr[0]] and dofs.tolist() == [model.joint("axis_motor").dofadr[0]]
+    assert qpos.tolist() == [model.joint("axis_motor").qposadr[0]] and dofs.tolist() == [
+        model.joint("axis_motor").dofadr[0]
+    ]
 
 
 def test_an_unknown_drive_option_is_refused():

@@ -1,7 +1,7 @@
 """dm_env's own conformance suite (``dm_env.test_utils.EnvironmentTestMixin``) for the
-dm_control Environment of every registered scenario (``planbench.envs.make``), with an action sequence that holds the actuators where
-the episode starts and runs to the end of the episode, so the contract around LAST and the
-next FIRST is checked too."""
+dm_control Environment of every registered scenario (``planbench.envs.make``), with an
+action sequence that holds the actuators where the episode starts and runs to the end of
+the episode, so the contract around LAST and the next FIRST is checked too."""
 
 from __future__ import annotations
 
@@ -95,13 +95,13 @@ def test_an_episode_starts_as_a_run_starts(name):
         for key, value in run_start.items():
             assert np.asarray(value, dtype=float).tobytes() == observation[key].tobytes(), key
         for _ in range(3):
-            env.step(np.clip(np.zeros(env.action_spec().shape), env.action_spec().minimum,
-                             env.action_spec().maximum))
+            env.step(np.clip(np.zeros(env.action_spec().shape), env.action_spec().minimum, env.action_spec().maximum))
     assert len(set(seeds)) == len(seeds), seeds
 
 
 def test_episodes_are_reproducible_from_the_random_state():
     """Two environments with the same ``random`` draw the same episode seeds; another draws others."""
+
     def seeds(random):
         env = envs.make("loader-supply", random=random, duration=EPISODE_S)
         out = []
@@ -139,8 +139,10 @@ def test_each_sea_state_episode_has_its_own_sea():
         assert np.degrees(pointing[0]) < 1e-6, pointing
         # The set-points are the start with the servo's velocity lead: no force step at reset.
         kp, kv = physics.drive_gains()
-        np.testing.assert_allclose(physics.data.act[physics.antenna_actuators],
-                                   physics.data.qpos[physics.antenna_qpos] + kv / kp * physics.data.qvel[physics.antenna_dofs])
+        np.testing.assert_allclose(
+            physics.data.act[physics.antenna_actuators],
+            physics.data.qpos[physics.antenna_qpos] + kv / kp * physics.data.qvel[physics.antenna_dofs],
+        )
     assert len({s.tobytes() for s in starts}) == 3
     assert np.abs(np.diff(starts, axis=0)).max() > np.radians(0.1)
     # The built seed: the built sea and the built start.

@@ -45,7 +45,7 @@ def test_ab_angles_round_trip_through_r_ab(phi_ab, theta_ab, alpha):
     # The printed eq. (8) sign (cos a cos phi sin t - sin a sin phi sin t) is wrong unless
     # alpha or phi vanish: check it disagrees somewhere.
     if abs(math.sin(alpha) * math.sin(phi_ab) * s) > 1e-3:
-        printed = (math.cos(alpha) * math.cos(phi_ab) * s - math.sin(alpha) * math.sin(phi_ab) * s)
+        printed = math.cos(alpha) * math.cos(phi_ab) * s - math.sin(alpha) * math.sin(phi_ab) * s
         assert abs(printed - math.sin(theta_a) * math.cos(theta_b)) > 1e-6
 
 
@@ -112,14 +112,16 @@ def test_tensions_balance_the_wrench(azimuth, elevation):
     pose = split.pose
     a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, pose.origin, pose.rotation)
     r_ab = fast.ab_rotation(pose.theta_a, pose.theta_b)
-    wrench = fast.gravity_wrench(pose.origin, pose.rotation, fast.cable_lengths(pose.origin, pose.rotation),
-                                 ab_rotation=r_ab)
+    wrench = fast.gravity_wrench(
+        pose.origin, pose.rotation, fast.cable_lengths(pose.origin, pose.rotation), ab_rotation=r_ab
+    )
     np.testing.assert_allclose(a @ split.tensions + wrench, 0, atol=1e-6)
     # The A-B tilt moves the centre of mass by (m_AB / m)(R_AB - I) r_AB-com in the cabin frame.
     com = fast.cabin_com_at(r_ab)
     g = fast.FAST
-    np.testing.assert_allclose(g.cabin_mass * com, g.cabin_mass * g.cabin_com + g.ab_mass * (r_ab @ g.ab_com - g.ab_com),
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        g.cabin_mass * com, g.cabin_mass * g.cabin_com + g.ab_mass * (r_ab @ g.ab_com - g.ab_com), atol=1e-9
+    )
     assert split.tensions.min() >= fast.FAST_LIMITS.tension_min
     assert split.tensions.max() <= fast.FAST_LIMITS.tension_max
 

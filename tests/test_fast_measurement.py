@@ -10,8 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from planbench import runner
-from planbench.fast import FastTrackingParams, build_scenario
-from planbench.fast import measurement
+from planbench.fast import FastTrackingParams, build_scenario, measurement
 from planbench.fast.measurement import SensorOptions, error_model, steady_state_gain
 from planbench.params import ParamError
 
@@ -20,22 +19,43 @@ CABIN_MM, CABIN_DEG = 14.56, 0.095
 PLATFORM_MM, PLATFORM_DEG = 2.99, 0.093
 
 #: No sensor errors at all: every noise, bias and drift of the fused system zero.
-PERFECT = SensorOptions(imu_gyro_noise=0.0, imu_gyro_bias=0.0, imu_gyro_bias_walk=0.0, imu_accel_noise=0.0,
-                        imu_accel_bias=0.0, imu_accel_bias_walk=0.0, ts_noise_m=0.0, ts_common_m=0.0,
-                        ts_point_m=0.0, rtk_noise_m=0.0, rtk_common_m=0.0, rtk_point_m=0.0)
+PERFECT = SensorOptions(
+    imu_gyro_noise=0.0,
+    imu_gyro_bias=0.0,
+    imu_gyro_bias_walk=0.0,
+    imu_accel_noise=0.0,
+    imu_accel_bias=0.0,
+    imu_accel_bias_walk=0.0,
+    ts_noise_m=0.0,
+    ts_common_m=0.0,
+    ts_point_m=0.0,
+    rtk_noise_m=0.0,
+    rtk_common_m=0.0,
+    rtk_point_m=0.0,
+)
 
 
 @functools.cache
-def tracking(duration: float = 60.0, wind: float = 4.0, stewart: bool = True, sensors: SensorOptions = SensorOptions(),
-             cable_segments: int | None = None, seed: int = 0, control_rate_hz: float | None = None,
-             drives: str = "as-built"):
+def tracking(
+    duration: float = 60.0,
+    wind: float = 4.0,
+    stewart: bool = True,
+    sensors: SensorOptions = SensorOptions(),
+    cable_segments: int | None = None,
+    seed: int = 0,
+    control_rate_hz: float | None = None,
+    drives: str = "as-built",
+):
     """(result, setup) of fast-tracking's first ``duration`` s (the switch from park: the
     cabin descends at up to 0.4 m/s, the hardest part for the filters)."""
     kw = {} if cable_segments is None else {"cable_segments": cable_segments}
     if control_rate_hz is not None:
         kw["control_rate_hz"] = control_rate_hz
-    setup = build_scenario(FastTrackingParams(duration=duration, wind=wind, stewart=stewart, sensors=sensors,
-                                              seed=seed, drives=drives, **kw))
+    setup = build_scenario(
+        FastTrackingParams(
+            duration=duration, wind=wind, stewart=stewart, sensors=sensors, seed=seed, drives=drives, **kw
+        )
+    )
     return runner.run("fast-tracking", setup), setup
 
 
@@ -49,11 +69,12 @@ def estimate_errors(result, setup, skip_s: float = 2.0):
     out = {}
     for k, (body, name) in enumerate((("cabin", "cabin"), ("platform", "feed_platform"))):
         adr = model.jnt_qposadr[model.body_jntadr[model.body(name).id]]
-        position, quat = log.qpos[start:n, adr:adr + 3], log.qpos[start:n, adr + 3:adr + 7]
+        position, quat = log.qpos[start:n, adr : adr + 3], log.qpos[start:n, adr + 3 : adr + 7]
         estimate = setup.task.sensors.estimate_log(n).span("estimate", start, n)[:, k]
         position_error = np.linalg.norm(estimate[:, :3] - position, axis=1)
-        attitude_error = (Rotation.from_matrix(estimate[:, 3:].reshape(-1, 3, 3))
-                          * Rotation.from_quat(quat[:, [1, 2, 3, 0]]).inv()).magnitude()
+        attitude_error = (
+            Rotation.from_matrix(estimate[:, 3:].reshape(-1, 3, 3)) * Rotation.from_quat(quat[:, [1, 2, 3, 0]]).inv()
+        ).magnitude()
         out[body] = (1e3 * math.sqrt(np.mean(position_error**2)), math.degrees(math.sqrt(np.mean(attitude_error**2))))
     return out
 
@@ -122,7 +143,9 @@ def test_with_the_real_sensors_the_stabilizer_beats_no_stabilizer(wind):
     the feed error RMS is lower with it, at the observing wind and the stress wind."""
     on, _ = tracking(30.0, wind, True)
     off, _ = tracking(30.0, wind, False)
-    rms = {name: next(c.value for c in r.checks if c.name == "feed_error_rms") for name, r in (("on", on), ("off", off))}
+    rms = {
+        name: next(c.value for c in r.checks if c.name == "feed_error_rms") for name, r in (("on", on), ("off", off))
+    }
     assert rms["on"] < rms["off"]
     assert rms["on"] < 10.0  # FAST's 10 mm RMS
 
@@ -130,10 +153,15 @@ def test_with_the_real_sensors_the_stabilizer_beats_no_stabilizer(wind):
 #: fast-tracking, first 30 s, 4 m/s, seed 0, stabilizer on: its check values at 6978090, the
 #: commit before the fused measurement system and the chains (lumped cables, the idealized
 #: cabin-pose measurements).
-BEFORE = {"feed_error_rms": 0.5704301260969762, "feed_error_max": 1.5910340540282037,
-          "cabin_error_rms": 5.522352723530739, "cable_tension_min": 169.9803280526772,
-          "cable_tension_max": 177.9414580806105, "stewart_stroke": 8.878764883591508,
-          "stewart_force": 11.706771087518952}
+BEFORE = {
+    "feed_error_rms": 0.5704301260969762,
+    "feed_error_max": 1.5910340540282037,
+    "cabin_error_rms": 5.522352723530739,
+    "cable_tension_min": 169.9803280526772,
+    "cable_tension_max": 177.9414580806105,
+    "stewart_stroke": 8.878764883591508,
+    "stewart_force": 11.706771087518952,
+}
 
 
 def test_the_ideal_option_gives_the_figures_of_before():
@@ -143,21 +171,25 @@ def test_the_ideal_option_gives_the_figures_of_before():
     values within 4e-11 of them: the libraries' last bits differ by CPU (not numpy's SIMD
     kernels alone: they were switched off, tried), and 30 s of simulation carry them that far.
     A change of behaviour moves these values by 1e-3 or more."""
-    result, _ = tracking(30.0, sensors=SensorOptions(system="ideal"), cable_segments=0, control_rate_hz=100.0,
-                         drives="ideal")
+    result, _ = tracking(
+        30.0, sensors=SensorOptions(system="ideal"), cable_segments=0, control_rate_hz=100.0, drives="ideal"
+    )
     values = {c.name: c.value for c in result.checks if c.name in BEFORE}
     assert values.keys() == BEFORE.keys()
     for name, value in BEFORE.items():
         assert values[name] == pytest.approx(value, rel=1e-9, abs=0.0), name
 
 
-@pytest.mark.parametrize("field, value, words", [
-    ("system", "perfect", "system = 'perfect' is not one of"),
-    ("ts_latency_s", 1.5, r"ts_latency_s = 1.5 s is outside \[0, 1\] s"),
-    ("rtk_rate_hz", 0.0, r"rtk_rate_hz = 0 Hz is outside"),
-    ("imu_gyro_noise", -1e-6, "imu_gyro_noise = -1e-06"),
-    ("ts_drift_time_s", float("nan"), "ts_drift_time_s = nan is not finite"),
-])
+@pytest.mark.parametrize(
+    "field, value, words",
+    [
+        ("system", "perfect", "system = 'perfect' is not one of"),
+        ("ts_latency_s", 1.5, r"ts_latency_s = 1.5 s is outside \[0, 1\] s"),
+        ("rtk_rate_hz", 0.0, r"rtk_rate_hz = 0 Hz is outside"),
+        ("imu_gyro_noise", -1e-6, "imu_gyro_noise = -1e-06"),
+        ("ts_drift_time_s", float("nan"), "ts_drift_time_s = nan is not finite"),
+    ],
+)
 def test_bad_sensor_options_are_named(field, value, words):
     with pytest.raises(ParamError, match=words):
         SensorOptions(**{field: value})
@@ -182,10 +214,13 @@ def test_sensor_options_reach_the_run_from_the_scenario_parameters():
     # 50 Hz (never sooner than the datasheet), one 10 ms tick at 100; GPS/RTK's 50 ms to 60 ms.
     assert {s.name: s for s in ideal.task.sensors.specs}["cabin_pose"].latency_s == pytest.approx(0.02)
     assert spec["cabin_rtk"].latency_s == pytest.approx(0.06)
-    ideal_100 = build_scenario(FastTrackingParams(duration=0.5, sensors=SensorOptions(system="ideal"),
-                                                  control_rate_hz=100.0))
+    ideal_100 = build_scenario(
+        FastTrackingParams(duration=0.5, sensors=SensorOptions(system="ideal"), control_rate_hz=100.0)
+    )
     specs = {s.name: s for s in ideal_100.task.sensors.specs}
-    assert specs["cabin_pose"].latency_s == pytest.approx(0.01) and specs["cabin_pose_ts"].latency_s == pytest.approx(0.15)
+    assert specs["cabin_pose"].latency_s == pytest.approx(0.01) and specs["cabin_pose_ts"].latency_s == pytest.approx(
+        0.15
+    )
     assert specs["cabin_pose_ts"].rate_hz == pytest.approx(10.0)
 
 

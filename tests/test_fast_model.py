@@ -11,9 +11,9 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from planbench import models
-from planbench.planners import fast
 from planbench.fast import physics as fp
 from planbench.fast.physics import FastPhysics
+from planbench.planners import fast
 
 G = fast.FAST
 
@@ -62,13 +62,14 @@ def test_stewart_joint_sites_equal_the_planner_geometry(physics):
     base = [model.site(f"base_joint{i}").id for i in range(1, 7)]
     plat = [model.site(f"platform_joint{i}").id for i in range(1, 7)]
     physics.set_configuration([0, 0, -155.65], np.eye(3), 0.0, 0.0)
-    np.testing.assert_allclose(np.linalg.norm(data.site_xpos[plat] - data.site_xpos[base], axis=1),
-                               fast.stewart_leg_lengths(), atol=1e-9)
+    np.testing.assert_allclose(
+        np.linalg.norm(data.site_xpos[plat] - data.site_xpos[base], axis=1), fast.stewart_leg_lengths(), atol=1e-9
+    )
     # Move the free platform by an offset and rotation in the AB frame (= world at this pose).
     offset, turn = np.array([0.05, -0.03, 0.02]), Rotation.from_rotvec([0.01, -0.02, 0.03])
     adr = model.joint("feed_platform").qposadr[0]
-    data.qpos[adr:adr + 3] += offset
-    data.qpos[adr + 3:adr + 7] = np.roll(turn.as_quat(), 1)
+    data.qpos[adr : adr + 3] += offset
+    data.qpos[adr + 3 : adr + 7] = np.roll(turn.as_quat(), 1)
     mujoco.mj_kinematics(model, data)
     lengths = np.linalg.norm(data.site_xpos[plat] - data.site_xpos[base], axis=1)
     np.testing.assert_allclose(lengths, fast.stewart_leg_lengths(offset, turn.as_matrix()), atol=1e-9)
@@ -79,8 +80,9 @@ def test_stewart_joint_sites_equal_the_planner_geometry(physics):
 
 def test_masses_and_centre_of_mass_equal_the_planner(physics):
     physics.set_configuration([0, 0, -155.65], np.eye(3), 0.0, 0.0)
-    cabin = ["cabin", "ab_a", "ab_b", "feed_platform", "receiver"] + \
-        [f"leg{i}_{part}" for i in range(1, 7) for part in ("housing", "rod")]
+    cabin = ["cabin", "ab_a", "ab_b", "feed_platform", "receiver"] + [
+        f"leg{i}_{part}" for i in range(1, 7) for part in ("housing", "rod")
+    ]
     mass, com = physics.subtree_mass(cabin)
     assert mass == pytest.approx(G.cabin_mass, abs=1e-6)  # CASPR's 30 091.8 kg
     np.testing.assert_allclose(com - [0, 0, -155.65], G.cabin_com, atol=1e-5)
@@ -127,9 +129,13 @@ def test_home_keyframe_is_the_zenith_equilibrium(physics):
 
 
 def test_reflector_mesh_is_the_300_m_cap_with_a_500_m_aperture():
-    vertices = np.array([[float(v) for v in line.split()[1:]]
-                         for line in (models.model_dir("fast") / "assets" / "reflector.obj").read_text().splitlines()
-                         if line.startswith("v ")])
+    vertices = np.array(
+        [
+            [float(v) for v in line.split()[1:]]
+            for line in (models.model_dir("fast") / "assets" / "reflector.obj").read_text().splitlines()
+            if line.startswith("v ")
+        ]
+    )
     np.testing.assert_allclose(np.linalg.norm(vertices, axis=1), fast.REFLECTOR_RADIUS, rtol=1e-6)
     assert np.hypot(vertices[:, 0], vertices[:, 1]).max() == pytest.approx(250.0, rel=1e-6)
     assert vertices[:, 2].min() == pytest.approx(-fast.REFLECTOR_RADIUS)

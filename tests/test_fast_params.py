@@ -19,11 +19,16 @@ def test_start_utc_outside_1972_2099_is_refused(cls, start):
         cls.from_mapping({"start_utc": start})
 
 
-@pytest.mark.parametrize("mapping, words", [
-    ({"source": "3C 286", "source_radec": RADEC},
-     r"^source = '3C 286' and source_radec = \[202.78, 30.51\] are both given: give one"),
-    ({"source": None}, r"^source and source_radec are both none: give one"),
-])
+@pytest.mark.parametrize(
+    "mapping, words",
+    [
+        (
+            {"source": "3C 286", "source_radec": RADEC},
+            r"^source = '3C 286' and source_radec = \[202.78, 30.51\] are both given: give one",
+        ),
+        ({"source": None}, r"^source and source_radec are both none: give one"),
+    ],
+)
 def test_source_and_radec_one_of_them(mapping, words):
     with pytest.raises(ParamError, match=words):
         fast.FastTrackingParams.from_mapping(mapping)
@@ -34,16 +39,20 @@ def test_radec_alone_clears_the_catalogue_source():
     assert p.source is None and p.source_radec == tuple(RADEC)
 
 
-@pytest.mark.parametrize("direction, ok", [(1e9, False), (-360.5, False), (361.0, False),
-                                           (360.0, True), (-360.0, True), (45.0, True)])
+@pytest.mark.parametrize(
+    "direction, ok", [(1e9, False), (-360.5, False), (361.0, False), (360.0, True), (-360.0, True), (45.0, True)]
+)
 def test_wind_file_direction_beyond_one_turn_is_refused(tmp_path, direction, ok):
     path = tmp_path / "wind.csv"
     path.write_text(f"t,speed,direction\n0,4,10\n1,4,{direction!r}\n2,4,10\n")
     if ok:
         assert MeasuredWind(path).direction[1] == direction
         return
-    with pytest.raises(WindFileError, match=rf"line 3: direction {re.escape(f'{direction:g}')} deg is outside "
-                                            rf"\[-{MAX_DIRECTION_DEG:g}, {MAX_DIRECTION_DEG:g}\] deg"):
+    with pytest.raises(
+        WindFileError,
+        match=rf"line 3: direction {re.escape(f'{direction:g}')} deg is outside "
+        rf"\[-{MAX_DIRECTION_DEG:g}, {MAX_DIRECTION_DEG:g}\] deg",
+    ):
         MeasuredWind(path)
 
 

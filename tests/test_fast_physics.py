@@ -7,16 +7,16 @@ import mujoco
 import numpy as np
 import pytest
 
-from planbench.planners import fast
-from planbench.planners.fast import plan as fplan
 from planbench import fast as fast_sim
 from planbench import runner
-from planbench.fast import physics as fast_physics
-from planbench.fast.measurement import SensorOptions
 from planbench.fast import loads as fast_loads
+from planbench.fast import physics as fast_physics
 from planbench.fast.controller import ControllerOptions, FastController, winch_feedforward
 from planbench.fast.loads import CableLoads
+from planbench.fast.measurement import SensorOptions
 from planbench.fast.physics import FastPhysics, tangent_stiffness
+from planbench.planners import fast
+from planbench.planners.fast import plan as fplan
 
 #: The idealized cabin-pose measurements (the earlier sensors: tests of the statics and of the
 #: chains that want the feed still to a millimetre).
@@ -29,8 +29,9 @@ MEASURED_LOWEST_MODE_HZ = (0.12, 0.2)
 def hold_plan(azimuth_deg: float, elevation_deg: float, duration: float) -> fplan.FastPlan:
     """A feed held still at the focal point of one direction (a one-segment plan)."""
     s = fast.source_direction(math.radians(azimuth_deg), math.radians(elevation_deg))
-    return fplan.FastPlan([fplan.observation_segment(np.array([0.0, duration]), np.stack([s, s]),
-                                                     name="observation (held)")])
+    return fplan.FastPlan(
+        [fplan.observation_segment(np.array([0.0, duration]), np.stack([s, s]), name="observation (held)")]
+    )
 
 
 @functools.cache
@@ -50,8 +51,7 @@ def test_static_tensions_equal_the_planner(elevation_deg):
     cable tensions equal the planner's static distribution within 1 % (the lumped cables, with
     the idealized sensors at 100 Hz, where the feed holds within 2 mm; at 50 Hz it is 2.02)."""
     plan = hold_plan(30.0, elevation_deg, 10.0)
-    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0, cable_segments=0, sensors=IDEAL,
-                                                     control_rate_hz=100.0))
+    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0, cable_segments=0, sensors=IDEAL, control_rate_hz=100.0))
     result = runner.run("hold", setup)
     planned = setup.components.controller.state.tension[-1]
     measured = -result.log.actuator_force[-1, setup.physics.cable_ids]
@@ -94,7 +94,7 @@ def test_lowest_cabin_modes():
     assert 0.25 < freq[0] < 0.35 and freq[-1] < 0.8
     assert zeta.min() >= 0.004
     # The lowest is the heave: its shape is the cabin's z (qpos index 2).
-    heave = np.abs(shapes[:model.nv, 0])
+    heave = np.abs(shapes[: model.nv, 0])
     assert np.argmax(heave[:6]) == 2
     # Hand value.
     origin, rotation = physics.cabin_pose()
@@ -128,8 +128,10 @@ def test_stabilizer_holds_10_mm_rms_at_4_m_s():
     assert feed_on.value < check(on, "cabin_error_rms").value
     assert on.passed
     # At 8 m/s (the stress case) the stabilizer still removes most of the error.
-    assert check(observation_run(8.0, True)[0], "feed_error_rms").value < \
-        0.6 * check(observation_run(8.0, False)[0], "feed_error_rms").value
+    assert (
+        check(observation_run(8.0, True)[0], "feed_error_rms").value
+        < 0.6 * check(observation_run(8.0, False)[0], "feed_error_rms").value
+    )
 
 
 def test_wind_load_matches_the_drag_formula():
@@ -158,7 +160,9 @@ class PayOutCable(FastController):
 
 def test_a_slack_cable_fails_and_no_cable_ever_pushes():
     plan = fast_sim.observation_plan(30.0)
-    setup = fast_sim.build(plan, fast_sim.FastParams(wind=0.0), controller=PayOutCable(ControllerOptions(stewart=False)))
+    setup = fast_sim.build(
+        plan, fast_sim.FastParams(wind=0.0), controller=PayOutCable(ControllerOptions(stewart=False))
+    )
     result = runner.run("slack", setup)
     low = check(result, "cable_tension_min")
     assert not low.passed and low.value < fast.FAST_LIMITS.tension_min / 1e3
@@ -210,8 +214,15 @@ def test_dm_control_environment_with_the_winch_feedforward():
 
     def run(extra_length: float):
         step = env.reset()
-        assert {"cabin_estimate_position", "platform_estimate_position", "cabin_imu_gyro", "platform_ts_points",
-                "ab_angles", "leg_positions", "reference_positions"} <= set(step.observation)
+        assert {
+            "cabin_estimate_position",
+            "platform_estimate_position",
+            "cabin_imu_gyro",
+            "platform_ts_points",
+            "ab_angles",
+            "leg_positions",
+            "reference_positions",
+        } <= set(step.observation)
         rewards = []
         action = env.physics.data.ctrl.copy()  # the parked commands
         while not step.last():
@@ -224,21 +235,26 @@ def test_dm_control_environment_with_the_winch_feedforward():
         return np.array(rewards)
 
     held = run(0.0)
-    assert abs(held.size - env.task.setup.components.trajectory.duration / env.task.setup.task.control_dt) <= 1  # a step a tick
+    assert (
+        abs(held.size - env.task.setup.components.trajectory.duration / env.task.setup.task.control_dt) <= 1
+    )  # a step a tick
     assert held.min() > math.exp(-1.0)  # feed error below 10 mm throughout
     assert run(1.0).min() < 0.05  # 1 m of cable paid out: the feed drops by metres
 
 
-@pytest.mark.parametrize("options, option, value, words", [
-    (SensorOptions, "pose_rate_hz", 0.0, r"pose_rate_hz = 0 Hz is outside \[0.1, 500\] Hz"),
-    (SensorOptions, "pose_rate_hz", 600.0, r"outside \[0.1, 500\] Hz: .* at most one per control tick"),
-    (SensorOptions, "pose_latency_s", -0.1, r"pose_latency_s = -0.1 s is outside \[0, 10\] s"),
-    (SensorOptions, "stewart_noise_m", float("nan"), "stewart_noise_m = nan is not finite"),
-    (ControllerOptions, "stewart_bandwidth_hz", 260.0, r"outside \(0, 250\) Hz"),
-    (ControllerOptions, "stewart_bandwidth_hz", 250.0, r"outside \(0, 250\) Hz"),
-    (ControllerOptions, "leg_integral_s", 0.0, r"leg_integral_s = 0 s is outside \(0, \.\.\.\] s"),
-    (ControllerOptions, "ki", -1.0, r"ki = -1 1/s is outside \[0, \.\.\.\] 1/s"),
-])
+@pytest.mark.parametrize(
+    "options, option, value, words",
+    [
+        (SensorOptions, "pose_rate_hz", 0.0, r"pose_rate_hz = 0 Hz is outside \[0.1, 500\] Hz"),
+        (SensorOptions, "pose_rate_hz", 600.0, r"outside \[0.1, 500\] Hz: .* at most one per control tick"),
+        (SensorOptions, "pose_latency_s", -0.1, r"pose_latency_s = -0.1 s is outside \[0, 10\] s"),
+        (SensorOptions, "stewart_noise_m", float("nan"), "stewart_noise_m = nan is not finite"),
+        (ControllerOptions, "stewart_bandwidth_hz", 260.0, r"outside \(0, 250\) Hz"),
+        (ControllerOptions, "stewart_bandwidth_hz", 250.0, r"outside \(0, 250\) Hz"),
+        (ControllerOptions, "leg_integral_s", 0.0, r"leg_integral_s = 0 s is outside \(0, \.\.\.\] s"),
+        (ControllerOptions, "ki", -1.0, r"ki = -1 1/s is outside \[0, \.\.\.\] 1/s"),
+    ],
+)
 def test_bad_controller_and_sensor_options_are_named(options, option, value, words):
     with pytest.raises(ValueError, match=words):
         options(**{option: value})
@@ -267,14 +283,22 @@ def test_collision_detection_is_off_only_because_no_geom_collides():
         assert physics.data.ptr.ncon == 0
 
 
-@pytest.mark.parametrize("overrides, words", [
-    ({"control_rate_hz": 60.0}, r"control_rate_hz = 60 Hz is not the 2 ms physics step divided by a whole number"),
-    ({"control_rate_hz": 5.0}, r"control_rate_hz = 5 Hz is outside \[10, 500\] Hz"),
-    ({"sensors": SensorOptions(ts_rate_hz=60.0)}, r"sensors.ts_rate_hz = 60 Hz is above the control rate "
-                                                  r"control_rate_hz = 50 Hz"),
-    ({"sensors": SensorOptions(system="ideal", pose_rate_hz=120.0), "control_rate_hz": 100.0},
-     r"sensors.pose_rate_hz = 120 Hz is above the control rate control_rate_hz = 100 Hz"),
-])
+@pytest.mark.parametrize(
+    "overrides, words",
+    [
+        ({"control_rate_hz": 60.0}, r"control_rate_hz = 60 Hz is not the 2 ms physics step divided by a whole number"),
+        ({"control_rate_hz": 5.0}, r"control_rate_hz = 5 Hz is outside \[10, 500\] Hz"),
+        (
+            {"sensors": SensorOptions(ts_rate_hz=60.0)},
+            r"sensors.ts_rate_hz = 60 Hz is above the control rate "
+            r"control_rate_hz = 50 Hz",
+        ),
+        (
+            {"sensors": SensorOptions(system="ideal", pose_rate_hz=120.0), "control_rate_hz": 100.0},
+            r"sensors.pose_rate_hz = 120 Hz is above the control rate control_rate_hz = 100 Hz",
+        ),
+    ],
+)
 def test_a_bad_control_rate_is_named(overrides, words):
     with pytest.raises(ValueError, match=words):
         fast_sim.FastTrackingParams(duration=1.0, **overrides).check()
@@ -286,8 +310,9 @@ def test_a_controller_bandwidth_beyond_the_control_rate_is_refused_before_the_ru
     from planbench.fast import FastTrackingParams, build_scenario
     from planbench.task import PluginError
 
-    setup = build_scenario(FastTrackingParams(duration=1.0),
-                           controller=FastController(ControllerOptions(platform_bandwidth_hz=30.0)))
+    setup = build_scenario(
+        FastTrackingParams(duration=1.0), controller=FastController(ControllerOptions(platform_bandwidth_hz=30.0))
+    )
     with pytest.raises(PluginError, match=r"platform_bandwidth_hz = 30 Hz is not below half the control rate, 25 Hz"):
         runner.run("bandwidth", setup)
     assert setup.physics.data.time == 0.0
@@ -387,8 +412,12 @@ def test_chains_carry_the_rope_the_winches_pay_out():
     rest = setup.task.disturbance._rest
     np.testing.assert_allclose(rest * segments, setup.physics.data.ptr.ctrl[physics.cable_ids])
     nodes = model.body_mass[physics.node_bodies]
-    np.testing.assert_allclose(nodes, np.broadcast_to((fast_physics.node_mass_factor(segments) *
-                                                       fast.FAST.cable_mass_per_length * rest)[:, None], nodes.shape))
+    np.testing.assert_allclose(
+        nodes,
+        np.broadcast_to(
+            (fast_physics.node_mass_factor(segments) * fast.FAST.cable_mass_per_length * rest)[:, None], nodes.shape
+        ),
+    )
     origin, _ = physics.cabin_pose()
     assert np.linalg.norm(origin - state.cabin_origin[0]) < 0.007
 
@@ -425,7 +454,7 @@ def cabin_modes(setup):
     zeta = np.divide(-s.real, np.abs(s), out=np.full(s.shape, np.nan), where=np.abs(s) > 0)
     mass = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, mass)
-    velocity = vec[model.nv:2 * model.nv]
+    velocity = vec[model.nv : 2 * model.nv]
     energy = np.einsum("ik,ij,jk->k", velocity.conj(), mass, velocity).real
     # The feed support's dofs: every dof before the first cable node's (the nodes come last).
     cabin = np.arange(model.body_dofadr[physics.node_bodies.min()])
@@ -453,7 +482,9 @@ def test_chains_bring_the_lowest_cabin_mode_into_the_measured_band(segments, ele
 
 def test_discretized_cables_run_with_the_stabilizer():
     plan = fast_sim.observation_plan(30.0)
-    on = runner.run("chain", fast_sim.build(plan, fast_sim.FastParams(wind=4.0, cable_segments=SEGMENTS, sensors=IDEAL)))
+    on = runner.run(
+        "chain", fast_sim.build(plan, fast_sim.FastParams(wind=4.0, cable_segments=SEGMENTS, sensors=IDEAL))
+    )
     assert on.passed and check(on, "feed_error_rms").value < 2.0
     assert on.metrics["cables"] == f"{SEGMENTS} segments each"
 

@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
+from planbench import fast as fast_sims
 from planbench.planners import fast
-from planbench.planners.fast import plan as fp
 from planbench.planners import profiles as prof
 from planbench.planners.errors import LimitError
-from planbench import fast as fast_sims
+from planbench.planners.fast import plan as fp
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +49,8 @@ def test_segment_times_follow_eq_10():
     assert times.t_p_line == pytest.approx(prof.min_move_time(2.0, fast.V_S_MAX, fast.A_S_MAX))
     _, arc = fp._arc_between(ph, p1)
     assert times.t_focal == pytest.approx(
-        prof.min_move_time(arc, fast.V_S_MAX, fp.tangential_limit(fast.A_S_MAX, fast.V_S_MAX)))
+        prof.min_move_time(arc, fast.V_S_MAX, fp.tangential_limit(fast.A_S_MAX, fast.V_S_MAX))
+    )
     # A slow A-B rotator makes the rotator, not the feed, set T_line: the line is stretched.
     slow = fp.MechanismLimits(ab_rate=math.radians(0.05), ab_accel=math.radians(0.005))
     slow_times = fp.switch_times(p0, p1, mechanisms=slow)
@@ -193,6 +194,7 @@ def test_eq10_includes_the_multifeed_rotation():
     p0 = np.array([0.0, 0.0, -fast.FOCAL_SURFACE_RADIUS + 2.0])
     p1 = _on_sphere(90.0, 80.0)
     times = fp.switch_times(p0, p1, multifeed0=0.0, multifeed1=math.radians(170.0))
-    assert times.t_multifeed == pytest.approx(prof.min_move_time(
-        math.radians(170.0), fp.MECHANISM_LIMITS.multifeed_rate, fp.MECHANISM_LIMITS.multifeed_accel))
+    assert times.t_multifeed == pytest.approx(
+        prof.min_move_time(math.radians(170.0), fp.MECHANISM_LIMITS.multifeed_rate, fp.MECHANISM_LIMITS.multifeed_accel)
+    )
     assert times.t_line == pytest.approx(times.t_multifeed - times.t_focal)  # the rotator is the slowest

@@ -13,24 +13,32 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-
 from model_diff import changed_fields
 from plant_model import assert_edits_only
-from planbench.planners import fast
-from planbench import api, fast as fast_sim, runner, scenarios
+
+from planbench import api, runner, scenarios
+from planbench import fast as fast_sim
 from planbench.fast import physics as fast_physics
 from planbench.fast.params import CABIN_BODIES, FastPlant
 from planbench.fast.physics import CABLE_EA, CABLE_WEIGHT, FastPhysics
 from planbench.params import ParamError
+from planbench.planners import fast
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("fast-tracking")
 GRAVITY = fast.GRAVITY
 CABIN_MASS = 30_091.8  # kg, CASPR (REFERENCE.md)
 #: Every field off nominal at once, inside its range.
-EVERYTHING = dict(cable_ea_error=-0.05, cable_mass_error=0.1, anchor_radial_error=20.0, anchor_height_error=-10.0,
-                  anchor_errors=((5.0, 0.0, 0.0), (0.0, -8.0, 3.0)) + ((0.0, 0.0, 0.0),) * 4, cabin_mass_error=0.03,
-                  cabin_com_offset=(0.05, -0.02, 0.1), stewart_force_scale=0.9)
+EVERYTHING = dict(
+    cable_ea_error=-0.05,
+    cable_mass_error=0.1,
+    anchor_radial_error=20.0,
+    anchor_height_error=-10.0,
+    anchor_errors=((5.0, 0.0, 0.0), (0.0, -8.0, 3.0)) + ((0.0, 0.0, 0.0),) * 4,
+    cabin_mass_error=0.03,
+    cabin_com_offset=(0.05, -0.02, 0.1),
+    stewart_force_scale=0.9,
+)
 
 
 def plant_model(**fields) -> mujoco.MjModel:
@@ -51,8 +59,9 @@ def hold(plant: FastPlant | None = None, duration: float = 2.0, stewart: bool = 
 def started(plant: FastPlant | None = None):
     """The setup of ``hold`` at its start (the runner's start_episode: the controller's first
     commands, the plant's cable law written), before any step."""
-    setup = fast_sim.build(fast_sim.observation_plan(2.0), fast_sim.FastParams(wind=0.0, stewart=False,
-                                                                               cable_segments=0), plant=plant)
+    setup = fast_sim.build(
+        fast_sim.observation_plan(2.0), fast_sim.FastParams(wind=0.0, stewart=False, cable_segments=0), plant=plant
+    )
     runner.start_episode(setup)
     return setup
 
@@ -78,6 +87,7 @@ def test_the_readme_documents_every_plant_field():
 def _towers(errors_mm):
     """Tower tops moved by (6, 3) mm, and the cable tendons' spring lengths (they have no
     stiffness) that default to their lengths at qpos0."""
+
     def edits(nominal, plant):
         out = {"site_pos": {}}
         for i in range(6):
@@ -85,6 +95,7 @@ def _towers(errors_mm):
             out["site_pos"][site] = nominal.site_pos[site] + 1e-3 * np.asarray(errors_mm[i])
         out["tendon_lengthspring"] = {k: [plant.tendon_length0[k]] * 2 for k in range(6)}
         return out
+
     return edits
 
 
@@ -96,8 +107,10 @@ def _outward(dr_mm):
 
 def _cabin_mass(nominal, plant):
     ids = [nominal.body(b).id for b in CABIN_BODIES]
-    return {"body_mass": {i: 1.05 * nominal.body_mass[i] for i in ids},
-            "body_inertia": {i: 1.05 * nominal.body_inertia[i] for i in ids}}
+    return {
+        "body_mass": {i: 1.05 * nominal.body_mass[i] for i in ids},
+        "body_inertia": {i: 1.05 * nominal.body_inertia[i] for i in ids},
+    }
 
 
 def _cabin_com(nominal, plant):
@@ -115,19 +128,35 @@ def _stewart_force(nominal, plant):
     return {"actuator_forcerange": {nominal.actuator(f"leg{i}").id: [-24_000.0, 24_000.0] for i in range(1, 7)}}
 
 
-@pytest.mark.parametrize("fields, edits", [
-    (dict(anchor_radial_error=50.0), _towers(_outward(50.0))),
-    (dict(anchor_height_error=-30.0), _towers(np.tile([0.0, 0.0, -30.0], (6, 1)))),
-    (dict(anchor_errors=((10.0, -20.0, 5.0),) + ((0.0, 0.0, 0.0),) * 4 + ((0.0, 7.0, 0.0),)),
-     _towers([[10.0, -20.0, 5.0]] + [[0.0, 0.0, 0.0]] * 4 + [[0.0, 7.0, 0.0]])),
-    (dict(anchor_radial_error=-40.0, anchor_height_error=25.0, anchor_errors=((0.0, 0.0, 5.0),) * 6),
-     _towers(_outward(-40.0) + [0.0, 0.0, 30.0])),
-    (dict(cabin_mass_error=0.05), _cabin_mass),
-    (dict(cabin_com_offset=(0.1, -0.2, 0.05)), _cabin_com),
-    (dict(cable_mass_error=0.1), _cable_mass),
-    (dict(stewart_force_scale=0.8), _stewart_force),
-], ids=["anchor_radial_error", "anchor_height_error", "anchor_errors", "anchors_together", "cabin_mass_error",
-        "cabin_com_offset", "cable_mass_error", "stewart_force_scale"])
+@pytest.mark.parametrize(
+    "fields, edits",
+    [
+        (dict(anchor_radial_error=50.0), _towers(_outward(50.0))),
+        (dict(anchor_height_error=-30.0), _towers(np.tile([0.0, 0.0, -30.0], (6, 1)))),
+        (
+            dict(anchor_errors=((10.0, -20.0, 5.0),) + ((0.0, 0.0, 0.0),) * 4 + ((0.0, 7.0, 0.0),)),
+            _towers([[10.0, -20.0, 5.0]] + [[0.0, 0.0, 0.0]] * 4 + [[0.0, 7.0, 0.0]]),
+        ),
+        (
+            dict(anchor_radial_error=-40.0, anchor_height_error=25.0, anchor_errors=((0.0, 0.0, 5.0),) * 6),
+            _towers(_outward(-40.0) + [0.0, 0.0, 30.0]),
+        ),
+        (dict(cabin_mass_error=0.05), _cabin_mass),
+        (dict(cabin_com_offset=(0.1, -0.2, 0.05)), _cabin_com),
+        (dict(cable_mass_error=0.1), _cable_mass),
+        (dict(stewart_force_scale=0.8), _stewart_force),
+    ],
+    ids=[
+        "anchor_radial_error",
+        "anchor_height_error",
+        "anchor_errors",
+        "anchors_together",
+        "cabin_mass_error",
+        "cabin_com_offset",
+        "cable_mass_error",
+        "stewart_force_scale",
+    ],
+)
 def test_a_field_changes_its_part_of_the_model_and_nothing_else(fields, edits):
     nominal = fast_physics._compiled(0)
     plant = plant_model(**fields)
@@ -171,10 +200,14 @@ def test_the_discretized_cables_take_the_plant_s_ea_and_mass():
     runner.start_episode(setup)  # the chain's reset writes its node masses and springs
     model, physics = setup.physics.model.ptr, setup.physics
     rest = setup.physics.data.ctrl[physics.cable_ids] / 3
-    np.testing.assert_allclose(model.body_mass[physics.node_bodies],
-                               (fast_physics.node_mass_factor(3) * 11.0 * rest)[:, None] * np.ones((6, 2)), rtol=1e-15)
-    np.testing.assert_allclose(model.tendon_stiffness[physics.segment_tendons[:, 1:]],
-                               (1.35e8 / rest)[:, None] * np.ones((6, 2)), rtol=1e-15)
+    np.testing.assert_allclose(
+        model.body_mass[physics.node_bodies],
+        (fast_physics.node_mass_factor(3) * 11.0 * rest)[:, None] * np.ones((6, 2)),
+        rtol=1e-15,
+    )
+    np.testing.assert_allclose(
+        model.tendon_stiffness[physics.segment_tendons[:, 1:]], (1.35e8 / rest)[:, None] * np.ones((6, 2)), rtol=1e-15
+    )
     nominal = setup.task.nominal_physics().model.ptr
     assert changed_fields(fast_physics._compiled(3), nominal) == {}
 
@@ -202,7 +235,9 @@ def test_the_controller_gets_the_nominal_model_and_its_feedforward_stays_nominal
     # Feed-forward: the winches' stretch and sag at the nominal EA and weight, the nominal
     # tower tops; the A-B rotator's gravity torque of the nominal masses.
     for name in ("l0_ff", "ab_setpoint", "p_platform", "r_platform"):
-        np.testing.assert_array_equal(getattr(setup.components.controller, name), getattr(reference.components.controller, name), name)
+        np.testing.assert_array_equal(
+            getattr(setup.components.controller, name), getattr(reference.components.controller, name), name
+        )
     np.testing.assert_array_equal(setup.task.evaluation.planned_tower_tops, reference.physics.tower_tops)
     assert setup.provenance.plant == FastPlant(**EVERYTHING) and reference.provenance.plant == FastPlant()
 
@@ -239,8 +274,9 @@ def test_a_heavier_cabin_raises_the_cables_vertical_pull_by_its_extra_weight():
     planned = nominal.log.sensordata[0, held.physics.sensor_block("cabin_pos")]
     assert np.abs(heavier.log.qvel[:, 2]).max() < 0.01  # m/s, the cabin's vertical speed
     assert -0.15 < cabin[0, 2] - planned[2] < -0.05
-    assert {c.name: c.value for c in heavier.checks}["cable_tension_max"] > \
-        {c.name: c.value for c in nominal.checks}["cable_tension_max"] + 5.0  # kN
+    assert {c.name: c.value for c in heavier.checks}["cable_tension_max"] > {c.name: c.value for c in nominal.checks}[
+        "cable_tension_max"
+    ] + 5.0  # kN
 
 
 def test_softer_cables_obey_the_plant_s_law_and_let_the_cabin_down():
@@ -253,8 +289,10 @@ def test_softer_cables_obey_the_plant_s_law_and_let_the_cabin_down():
     vectors = physics.data.site_xpos[physics.anchor_sites] - physics.tower_tops
     span = np.hypot(vectors[:, 0], vectors[:, 1])
     l0 = physics.data.ctrl[physics.cable_ids]
+
     def law(ea):
         return l0 * (1 + tension / ea) - (CABLE_WEIGHT * span) ** 2 * l0 / (24 * tension**2)
+
     np.testing.assert_allclose(chords, law(0.9 * CABLE_EA), rtol=0, atol=2e-4)
     assert np.all(chords - law(CABLE_EA) > 0.03)
     origin, rotation = physics.cabin_pose()
@@ -267,8 +305,10 @@ def test_softer_cables_obey_the_plant_s_law_and_let_the_cabin_down():
 def test_a_moved_tower_top_moves_the_cabin_and_the_stabilizer_keeps_the_feed():
     """One tower top 50 mm outward: its cable pulls the cabin toward it; the Stewart stabilizer
     still holds the feed on its path (the checks judge the true feed)."""
-    plant = FastPlant(anchor_errors=((50.0 * math.cos(math.radians(30)), 50.0 * math.sin(math.radians(30)), 0.0),)
-                      + ((0.0, 0.0, 0.0),) * 5)
+    plant = FastPlant(
+        anchor_errors=((50.0 * math.cos(math.radians(30)), 50.0 * math.sin(math.radians(30)), 0.0),)
+        + ((0.0, 0.0, 0.0),) * 5
+    )
     result, setup = hold(plant, stewart=True)
     nominal, _ = hold(stewart=True)
     start = result.log.sensordata[0, setup.physics.sensor_block("cabin_pos")]
@@ -309,10 +349,12 @@ def test_a_field_out_of_its_range_is_refused_naming_it(key, above):
 
 
 def test_api_run_refuses_bad_plants_before_building():
-    for plant, words in [({"cable_ea_error": 0.2}, "plant.cable_ea_error = 0.2 fraction is outside [-0.35, 0.1]"),
-                         ({"anchor_errors": [[0, 0, 0]] * 5}, "plant.anchor_errors has 5 rows, fewer than 6"),
-                         ({"cabin_com_offset": [0, 0]}, "plant.cabin_com_offset has 2 values, not 3"),
-                         ({"tower_height_error": 1.0}, "unknown parameter 'plant.tower_height_error'")]:
+    for plant, words in [
+        ({"cable_ea_error": 0.2}, "plant.cable_ea_error = 0.2 fraction is outside [-0.35, 0.1]"),
+        ({"anchor_errors": [[0, 0, 0]] * 5}, "plant.anchor_errors has 5 rows, fewer than 6"),
+        ({"cabin_com_offset": [0, 0]}, "plant.cabin_com_offset has 2 values, not 3"),
+        ({"tower_height_error": 1.0}, "unknown parameter 'plant.tower_height_error'"),
+    ]:
         with pytest.raises(ParamError) as refused:
             api.run("fast-tracking", plant=plant)
         assert words in str(refused.value), str(refused.value)

@@ -23,8 +23,8 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from planbench.planners.fast import sky as fs
 from planbench.planners.errors import LimitError, PlanningError
+from planbench.planners.fast import sky as fs
 
 DEG = math.pi / 180
 ARCSEC = DEG / 3600
@@ -51,8 +51,7 @@ def _quiet():
 def _horizon(ha, dec, lat=LAT):
     """Spherical trigonometry: hour angle and declination -> (az, el), rad."""
     el = np.arcsin(np.sin(lat) * np.sin(dec) + np.cos(lat) * np.cos(dec) * np.cos(ha))
-    az = np.arctan2(-np.cos(dec) * np.sin(ha),
-                    np.sin(dec) * np.cos(lat) - np.cos(dec) * np.cos(ha) * np.sin(lat))
+    az = np.arctan2(-np.cos(dec) * np.sin(ha), np.sin(dec) * np.cos(lat) - np.cos(dec) * np.cos(ha) * np.sin(lat))
     return np.mod(az, 2 * np.pi), el
 
 
@@ -71,13 +70,15 @@ def _precession_1976(t_tt):
 
     def r3(a):
         c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
-        return np.concatenate([np.concatenate([c, s, o], -1), np.concatenate([-s, c, o], -1),
-                               np.concatenate([o, o, i], -1)], -2)
+        return np.concatenate(
+            [np.concatenate([c, s, o], -1), np.concatenate([-s, c, o], -1), np.concatenate([o, o, i], -1)], -2
+        )
 
     def r2(a):
         c, s, o, i = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
-        return np.concatenate([np.concatenate([c, o, -s], -1), np.concatenate([o, i, o], -1),
-                               np.concatenate([s, o, c], -1)], -2)
+        return np.concatenate(
+            [np.concatenate([c, o, -s], -1), np.concatenate([o, i, o], -1), np.concatenate([s, o, c], -1)], -2
+        )
 
     return r3(-z) @ r2(theta) @ r3(-zeta)
 
@@ -98,8 +99,7 @@ def _era(jd1, jd2):
 
 def hand_azel(ra, dec, jd1, jd2):
     """Mean place of date by IAU 1976 precession, GMST 1982, spherical trig."""
-    v = np.stack(np.broadcast_arrays(np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra),
-                                     np.sin(dec)), -1)
+    v = np.stack(np.broadcast_arrays(np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)), -1)
     p = _precession_1976(_tt_days(jd1, jd2) / 36525.0)
     v = np.einsum("...ij,...j->...i", p, v)
     ra_d, dec_d = np.arctan2(v[..., 1], v[..., 0]), np.arcsin(np.clip(v[..., 2], -1, 1))
@@ -323,17 +323,19 @@ def test_tracking_rates_match_the_closed_form(dec, offset):
 
 # ----------------------------------------------------------------------------- motion scans
 
-scan_params = st.fixed_dictionaries({
-    "ra": ras,
-    "dec": st.floats(-70 * DEG, 70 * DEG),
-    "legs_along": st.sampled_from(["dec", "ra"]),
-    "leg_length": st.floats(0.05 * DEG, 5 * DEG),
-    "n_legs": st.integers(1, 6),
-    "leg_spacing": st.floats(0.005 * DEG, 0.5 * DEG) | st.floats(-0.5 * DEG, -0.005 * DEG),
-    "speed": st.floats(1.0, 60.0).map(lambda v: v * fs.DEG_PER_HOUR),  # deg/h -> rad/s
-    "t2": st.floats(1.0, 300.0),
-    "alternate": st.booleans(),
-})
+scan_params = st.fixed_dictionaries(
+    {
+        "ra": ras,
+        "dec": st.floats(-70 * DEG, 70 * DEG),
+        "legs_along": st.sampled_from(["dec", "ra"]),
+        "leg_length": st.floats(0.05 * DEG, 5 * DEG),
+        "n_legs": st.integers(1, 6),
+        "leg_spacing": st.floats(0.005 * DEG, 0.5 * DEG) | st.floats(-0.5 * DEG, -0.005 * DEG),
+        "speed": st.floats(1.0, 60.0).map(lambda v: v * fs.DEG_PER_HOUR),  # deg/h -> rad/s
+        "t2": st.floats(1.0, 300.0),
+        "alternate": st.booleans(),
+    }
+)
 
 
 def _wrap(a):
@@ -349,8 +351,9 @@ def test_motion_scan_geometry(p):
     np.testing.assert_allclose(scan.leg_end - scan.leg_start, T)
     np.testing.assert_allclose(scan.leg_start[1:] - scan.leg_end[:-1], p["t2"])
     assert scan.duration == pytest.approx(n * T + (n - 1) * p["t2"])
-    assert scan.paper_name.startswith("motion scan along the " +
-                                      ("right ascension" if p["legs_along"] == "dec" else "declination"))
+    assert scan.paper_name.startswith(
+        "motion scan along the " + ("right ascension" if p["legs_along"] == "dec" else "declination")
+    )
     u = np.linspace(0.0, 1.0, 11)
     legs = []
     for i in range(n):
@@ -366,8 +369,7 @@ def test_motion_scan_geometry(p):
         else:
             # along RA: Dec fixed, RA changes by speed / cos(dec) dt
             np.testing.assert_allclose(dec, dec[0], atol=1e-15)
-            np.testing.assert_allclose(_wrap(ra - ra[0]) * np.cos(dec[0]),
-                                       sense * p["speed"] * (t - t[0]), atol=1e-11)
+            np.testing.assert_allclose(_wrap(ra - ra[0]) * np.cos(dec[0]), sense * p["speed"] * (t - t[0]), atol=1e-11)
             legs.append((_wrap(ra[5] - p["ra"]) + p["ra"], dec[0]))
             # on-sky (great-circle) speed over 1 s
             r1, d1, _, _ = scan.sky(t[5] + np.array([0.0, 1.0]))
@@ -394,8 +396,7 @@ def test_motion_scan_geometry(p):
         ra_b, dec_b, on_b, leg_b = scan.sky(scan.leg_start[i + 1])
         assert on_b and leg_b == i + 1
         np.testing.assert_allclose(dec, dec_a + np.array([0.25, 0.5, 0.75]) * (dec_b - dec_a), atol=1e-12)
-        np.testing.assert_allclose(_wrap(ra - ra_a), np.array([0.25, 0.5, 0.75]) * _wrap(ra_b - ra_a),
-                                   atol=1e-12)
+        np.testing.assert_allclose(_wrap(ra - ra_a), np.array([0.25, 0.5, 0.75]) * _wrap(ra_b - ra_a), atol=1e-12)
 
 
 def test_motion_scan_path_in_the_horizon_frame():
@@ -422,8 +423,11 @@ def test_motion_scan_path_in_the_horizon_frame():
     # started 2.8 h after the transit (zenith angle ~39 deg) the raster sets below 40 deg
     with pytest.raises(LimitError) as info:
         scan.path((jd1, jd2 + 2.8 / 24), step=7.0)
-    match = re.search(r"motion scan along the right ascension direction centred .* "
-                      r"zenith angle 40\.0\d\d deg .* \((\d+\.\d) s after the start\)", str(info.value))
+    match = re.search(
+        r"motion scan along the right ascension direction centred .* "
+        r"zenith angle 40\.0\d\d deg .* \((\d+\.\d) s after the start\)",
+        str(info.value),
+    )
     assert match, str(info.value)
     assert 0.0 < float(match.group(1)) < scan.duration
 
@@ -431,39 +435,50 @@ def test_motion_scan_path_in_the_horizon_frame():
 # ----------------------------------------------------------------------------- bad input
 
 T0 = "2026-01-01T00:00:00"
-GOOD_SCAN = {"ra": 1.0, "dec": 0.3, "legs_along": "dec", "leg_length": 0.02, "n_legs": 3,
-             "leg_spacing": 0.001, "speed": 1e-4, "t2": 30.0}
+GOOD_SCAN = {
+    "ra": 1.0,
+    "dec": 0.3,
+    "legs_along": "dec",
+    "leg_length": 0.02,
+    "n_legs": 3,
+    "leg_spacing": 0.001,
+    "speed": 1e-4,
+    "t2": 30.0,
+}
 
 
-@pytest.mark.parametrize("call, text", [
-    (lambda: fs.observed_azel(float("nan"), 0.0, T0), "right ascension nan rad must be finite"),
-    (lambda: fs.observed_azel(0.0, 91 * DEG, T0), "declination 91 deg is beyond +/-90 deg"),
-    (lambda: fs.observed_azel(0.0, -1.7, T0), "declination -97.4028 deg is beyond +/-90 deg"),
-    (lambda: fs.observed_azel(0.0, float("nan"), T0), "declination nan rad must be finite"),
-    (lambda: fs.observed_azel(0.0, 0.0, "yesterday"), "UTC time 'yesterday' is not an ISO 8601 date"),
-    (lambda: fs.observed_azel(0.0, 0.0, np.datetime64("NaT")), "NaT"),
-    (lambda: fs.observed_azel(0.0, 0.0, (2461000.5, float("nan"))), "UTC jd2 nan d must be finite"),
-    (lambda: fs.track(0.0, 0.0, T0, -5.0), "duration -5.0 s must be > 0"),
-    (lambda: fs.track(0.0, 0.0, T0, 60.0, step=0.0), "step 0.0 s must be > 0"),
-    (lambda: fs.track(0.0, 0.0, T0, 1e9, step=1.0), "gives 1e+09 samples; the limit is 2000000"),
-    (lambda: fs.track(0.0, 0.0, T0, 1e9, step=1e-320), "gives inf samples"),
-    (lambda: fs.drift_scan(0.0, 95 * DEG, T0, 60.0), "elevation 95 deg is beyond +/-90 deg"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "speed": 0.0}), "scan speed 0.0 rad/s must be > 0"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "speed": -1e-4}), "scan speed -0.0001 rad/s must be > 0"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "speed": float("nan")}), "scan speed nan rad/s must be finite"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "leg_length": -0.1}), "leg length -0.1 rad must be > 0"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "n_legs": 0}), "number of legs 0 must be an integer >= 1"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "n_legs": 2.5}), "number of legs 2.5"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "t2": -1.0}), "transition time t2 -1.0 s must be >= 0"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "t2": 0.0}), "transition time t2 0.0 s must be > 0 for 3 legs"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "leg_spacing": 0.0}), "leg spacing 0.0 rad must be nonzero"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "legs_along": "az"}), "legs_along 'az' is not one of dec, ra"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "dec": 89.5 * DEG}), "reaches declination 90.0730 deg"),
-    (lambda: fs.MotionScan(**{**GOOD_SCAN, "dec": 100 * DEG}), "declination 100 deg is beyond"),
-    (lambda: fs.MotionScan(**GOOD_SCAN).sky([-1.0]), "time -1.0 s is outside the scan"),
-    (lambda: fs.MotionScan(**GOOD_SCAN).path(T0, step=-2.0), "step -2.0 s must be > 0"),
-    (lambda: fs.horizon_rates([0.0, 0.0], [0.0, 0.1], [1.0, 1.0]), "increasing"),
-])
+@pytest.mark.parametrize(
+    "call, text",
+    [
+        (lambda: fs.observed_azel(float("nan"), 0.0, T0), "right ascension nan rad must be finite"),
+        (lambda: fs.observed_azel(0.0, 91 * DEG, T0), "declination 91 deg is beyond +/-90 deg"),
+        (lambda: fs.observed_azel(0.0, -1.7, T0), "declination -97.4028 deg is beyond +/-90 deg"),
+        (lambda: fs.observed_azel(0.0, float("nan"), T0), "declination nan rad must be finite"),
+        (lambda: fs.observed_azel(0.0, 0.0, "yesterday"), "UTC time 'yesterday' is not an ISO 8601 date"),
+        (lambda: fs.observed_azel(0.0, 0.0, np.datetime64("NaT")), "NaT"),
+        (lambda: fs.observed_azel(0.0, 0.0, (2461000.5, float("nan"))), "UTC jd2 nan d must be finite"),
+        (lambda: fs.track(0.0, 0.0, T0, -5.0), "duration -5.0 s must be > 0"),
+        (lambda: fs.track(0.0, 0.0, T0, 60.0, step=0.0), "step 0.0 s must be > 0"),
+        (lambda: fs.track(0.0, 0.0, T0, 1e9, step=1.0), "gives 1e+09 samples; the limit is 2000000"),
+        (lambda: fs.track(0.0, 0.0, T0, 1e9, step=1e-320), "gives inf samples"),
+        (lambda: fs.drift_scan(0.0, 95 * DEG, T0, 60.0), "elevation 95 deg is beyond +/-90 deg"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "speed": 0.0}), "scan speed 0.0 rad/s must be > 0"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "speed": -1e-4}), "scan speed -0.0001 rad/s must be > 0"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "speed": float("nan")}), "scan speed nan rad/s must be finite"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "leg_length": -0.1}), "leg length -0.1 rad must be > 0"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "n_legs": 0}), "number of legs 0 must be an integer >= 1"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "n_legs": 2.5}), "number of legs 2.5"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "t2": -1.0}), "transition time t2 -1.0 s must be >= 0"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "t2": 0.0}), "transition time t2 0.0 s must be > 0 for 3 legs"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "leg_spacing": 0.0}), "leg spacing 0.0 rad must be nonzero"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "legs_along": "az"}), "legs_along 'az' is not one of dec, ra"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "dec": 89.5 * DEG}), "reaches declination 90.0730 deg"),
+        (lambda: fs.MotionScan(**{**GOOD_SCAN, "dec": 100 * DEG}), "declination 100 deg is beyond"),
+        (lambda: fs.MotionScan(**GOOD_SCAN).sky([-1.0]), "time -1.0 s is outside the scan"),
+        (lambda: fs.MotionScan(**GOOD_SCAN).path(T0, step=-2.0), "step -2.0 s must be > 0"),
+        (lambda: fs.horizon_rates([0.0, 0.0], [0.0, 0.1], [1.0, 1.0]), "increasing"),
+    ],
+)
 def test_bad_input_names_the_value(call, text):
     with pytest.raises(PlanningError) as info:
         call()

@@ -8,9 +8,9 @@ import functools
 import numpy as np
 import pytest
 
-from planbench.planners import fast
 from planbench import fast as fast_sim
 from planbench import runner
+from planbench.planners import fast
 
 
 @functools.cache

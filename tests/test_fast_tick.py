@@ -11,14 +11,15 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from planbench.planners.legs import cross, leg_vectors, structure_matrix
+from planbench import runner
 from planbench.fast import FastTrackingParams, build_scenario
 from planbench.fast.measurement import FusedPoses
 from planbench.fast.physics import _LEVI_CIVITA, index_view
-from planbench import runner
+from planbench.planners.legs import cross, leg_vectors, structure_matrix
 
 
 def _einsum_pairs_first_and_third() -> bool:
@@ -52,8 +53,9 @@ def _vectorized_propagate(state: dict, dt: float, gravity, specific_force, rate)
 
 def _filters(offsets: np.ndarray) -> FusedPoses:
     points = [np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, -1.0, 0.2]])] * 2
-    noise = dict(accel_white=1e-3, accel_walk=1e-4, gyro_white=1e-5, gyro_walk=1e-7, every=5, fix_white=1e-3,
-                 fix_drift=1e-3)
+    noise = dict(
+        accel_white=1e-3, accel_walk=1e-4, gyro_white=1e-5, gyro_walk=1e-7, every=5, fix_white=1e-3, fix_drift=1e-3
+    )
     return FusedPoses(points, offsets, [noise, noise], 0.02, np.array([0.0, 0.0, -9.81]), 12)
 
 
@@ -61,9 +63,13 @@ vectors = arrays(float, (2, 3), elements=st.floats(-20.0, 20.0))
 
 
 @settings(max_examples=80, deadline=None)
-@given(arrays(float, (2, 3), elements=st.floats(-3.0, 3.0)), arrays(float, (2, 3), elements=st.floats(-300.0, 300.0)),
-       st.lists(st.tuples(vectors, arrays(float, (2, 3), elements=st.floats(-0.5, 0.5))), min_size=1, max_size=8),
-       arrays(float, (2, 3), elements=st.floats(-0.05, 0.05)), arrays(float, (2, 3), elements=st.floats(-1e-3, 1e-3)))
+@given(
+    arrays(float, (2, 3), elements=st.floats(-3.0, 3.0)),
+    arrays(float, (2, 3), elements=st.floats(-300.0, 300.0)),
+    st.lists(st.tuples(vectors, arrays(float, (2, 3), elements=st.floats(-0.5, 0.5))), min_size=1, max_size=8),
+    arrays(float, (2, 3), elements=st.floats(-0.05, 0.05)),
+    arrays(float, (2, 3), elements=st.floats(-1e-3, 1e-3)),
+)
 def test_the_scalar_strapdown_tick_is_the_vectorized_one(angles, positions, readings, accel_bias, gyro_bias):
     """Ticks of FusedPoses.propagate from any pose, with any biases: positions, velocities,
     rotations and the bodies' origins as the (B, 3) einsum form gives them."""
@@ -74,8 +80,13 @@ def test_the_scalar_strapdown_tick_is_the_vectorized_one(angles, positions, read
     f = _filters(offsets)
     f.reset(positions, rotations)
     f._accel_bias, f._gyro_bias = accel_bias.tolist(), gyro_bias.tolist()
-    state = {"rotation": rotations.copy(), "velocity": np.zeros((2, 3)), "accel_bias": accel_bias,
-             "gyro_bias": gyro_bias, "position": positions + np.einsum("bij,bj->bi", rotations, offsets)}
+    state = {
+        "rotation": rotations.copy(),
+        "velocity": np.zeros((2, 3)),
+        "accel_bias": accel_bias,
+        "gyro_bias": gyro_bias,
+        "position": positions + np.einsum("bij,bj->bi", rotations, offsets),
+    }
     for force, rate in readings:
         f.propagate(force, rate)
         _vectorized_propagate(state, f.dt, f.gravity, force, rate)
@@ -104,8 +115,11 @@ def test_the_sensors_tick_reads_what_the_vectorized_one_did():
         velocity = np.einsum("kij,kj->ki", rotation, data.sensordata[sensors._vel_columns])
         gyro = data.sensordata[sensors._gyro_columns] + sensors.gyro_error[tick]
         observe(tick, phys)
-        force = (velocity - seen["last"]) / sensors.dt - sensors.gravity if tick else -np.broadcast_to(
-            sensors.gravity, (2, 3))
+        force = (
+            (velocity - seen["last"]) / sensors.dt - sensors.gravity
+            if tick
+            else -np.broadcast_to(sensors.gravity, (2, 3))
+        )
         accel = np.einsum("kji,kj->ki", rotation, force) + sensors.accel_error[tick]
         seen["last"] = velocity
         obs = sensors.observation
@@ -116,13 +130,17 @@ def test_the_sensors_tick_reads_what_the_vectorized_one_did():
         assert_same(sensors.estimates.row("estimate", tick)[:, :3], origins, 400.0)
         np.testing.assert_array_equal(sensors.estimates.row("estimate", tick)[:, 3:], f.rotation.reshape(2, 9))
         np.testing.assert_array_equal(obs["cabin_estimate_position"], sensors.estimates.row("estimate", tick)[0, :3])
-        np.testing.assert_array_equal(obs["platform_estimate_rotation"].ravel(), sensors.estimates.row("estimate", tick)[1, 3:])
+        np.testing.assert_array_equal(
+            obs["platform_estimate_rotation"].ravel(), sensors.estimates.row("estimate", tick)[1, 3:]
+        )
         np.testing.assert_array_equal(obs["platform_estimate_velocity"], f.velocity[1])
         np.testing.assert_array_equal(obs["ab_angles"], data.qpos[physics.ab_qpos])
         np.testing.assert_array_equal(obs["leg_positions"], data.qpos[physics.leg_qpos])
         np.testing.assert_array_equal(obs["leg_setpoints"], data.act[physics.leg_act])
-        np.testing.assert_array_equal(obs["ab_rotation"], data.xmat[physics.cabin_body].reshape(3, 3).T
-                                      @ data.xmat[physics.ab_b_body].reshape(3, 3))
+        np.testing.assert_array_equal(
+            obs["ab_rotation"],
+            data.xmat[physics.cabin_body].reshape(3, 3).T @ data.xmat[physics.ab_b_body].reshape(3, 3),
+        )
         seen["ticks"] += 1
 
     task.observe = checked
@@ -131,8 +149,7 @@ def test_the_sensors_tick_reads_what_the_vectorized_one_did():
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.lists(st.integers(0, 40), min_size=0, max_size=8), st.integers(0, 30), st.integers(-3, 5),
-       st.integers(1, 8))
+@given(st.lists(st.integers(0, 40), min_size=0, max_size=8), st.integers(0, 30), st.integers(-3, 5), st.integers(1, 8))
 def test_an_index_view_indexes_the_elements_of_its_indices(scattered, start, step, size):
     """index_view: a slice (a view) for indices that step evenly upward, the indices
     otherwise; either way the same elements, and a view writes through."""
@@ -150,7 +167,6 @@ def test_an_index_view_indexes_the_elements_of_its_indices(scattered, start, ste
     assert not isinstance(index_view(np.array([-1, 0, 1])), slice)  # -1: the last element
 
 
-
 def _structure_matrix_with_np_cross(anchors, points, position, rotation):
     """planbench.planners.legs.structure_matrix as it was written first: np.cross, leg_vectors."""
     vectors = leg_vectors(anchors, points, position, rotation)
@@ -160,8 +176,13 @@ def _structure_matrix_with_np_cross(anchors, points, position, rotation):
 
 
 @settings(max_examples=100, deadline=None)
-@given(arrays(float, (6, 3), elements=st.floats(-300.0, 300.0)), arrays(float, (6, 3), elements=st.floats(-10.0, 10.0)),
-       st.integers(0, 3), arrays(float, (3, 3), elements=st.floats(-1.0, 1.0)), st.floats(-1.0, 1.0))
+@given(
+    arrays(float, (6, 3), elements=st.floats(-300.0, 300.0)),
+    arrays(float, (6, 3), elements=st.floats(-10.0, 10.0)),
+    st.integers(0, 3),
+    arrays(float, (3, 3), elements=st.floats(-1.0, 1.0)),
+    st.floats(-1.0, 1.0),
+)
 def test_the_structure_matrix_and_cross_are_np_cross_s_arithmetic(anchors, points, batch, angles, scale):
     """structure_matrix with planbench.planners.legs.cross: the same matrix, to the bit and in the same
     memory layout (its transpose feeds matmul), for one pose and for a batch; cross itself
@@ -206,27 +227,38 @@ def test_the_chain_loads_write_through_views_what_they_wrote_by_index():
             data.ctrl[physics.cable_ids] = start + 1e-3 * tick * np.arange(1, 7)
             loads(tick, physics)
             mujoco.mj_step(model, data, nstep=10)
-        runs.append([model.actuator_gainprm[:, :3].copy(), model.actuator_biasprm[:, :3].copy(),
-                     model.tendon_lengthspring.copy(), model.tendon_stiffness.copy(), model.tendon_damping.copy(),
-                     model.body_mass.copy(), model.dof_damping.copy(), data.xfrc_applied.copy(),
-                     loads.log(times.size).column("tension"), loads.log(times.size).column("force"),
-                     data.qpos.copy()])
-    for ours, theirs in zip(*runs):
+        runs.append(
+            [
+                model.actuator_gainprm[:, :3].copy(),
+                model.actuator_biasprm[:, :3].copy(),
+                model.tendon_lengthspring.copy(),
+                model.tendon_stiffness.copy(),
+                model.tendon_damping.copy(),
+                model.body_mass.copy(),
+                model.dof_damping.copy(),
+                data.xfrc_applied.copy(),
+                loads.log(times.size).column("tension"),
+                loads.log(times.size).column("force"),
+                data.qpos.copy(),
+            ]
+        )
+    for ours, theirs in zip(*runs, strict=True):
         np.testing.assert_array_equal(ours, theirs)
 
 
 def _vectorized_correct(f: FusedPoses, body: int, measured: np.ndarray, at_tick: int) -> None:
     """A fix's correction on numpy arrays (the earlier implementation): the fit by
     small_rotation_fit in the world frame, K y, then Phi^k of it."""
+    from planbench.fast.measurement import BA, BG, TH, P, V, _orthonormal, small_rotation_fit
     from planbench.planners.rotations import skew
-    from planbench.fast.measurement import BA, BG, P, TH, V, _orthonormal, small_rotation_fit
 
     samples = f._samples[body]
     _, position, estimated = samples.popleft()
     position, estimated = np.array(position), np.array(estimated).reshape(3, 3)
     centre = measured.mean(axis=0)
-    theta = small_rotation_fit(measured - centre, f._local_points[body] @ estimated.T,
-                               estimated @ f._inverse_inertia[body] @ estimated.T)
+    theta = small_rotation_fit(
+        measured - centre, f._local_points[body] @ estimated.T, estimated @ f._inverse_inertia[body] @ estimated.T
+    )
     imu_fix = centre + (np.eye(3) + skew(theta)) @ (estimated @ f._local_imu[body])
     dx = f.gains[body] @ np.concatenate([imu_fix - position, theta])
     for k, (tick, later_position, later_rotation) in enumerate(samples):
@@ -243,9 +275,14 @@ def _vectorized_correct(f: FusedPoses, body: int, measured: np.ndarray, at_tick:
 
 
 @settings(max_examples=80, deadline=None)
-@given(arrays(float, (2, 3), elements=st.floats(-3.0, 3.0)), arrays(float, (2, 3), elements=st.floats(-300.0, 300.0)),
-       st.lists(st.tuples(vectors, arrays(float, (2, 3), elements=st.floats(-0.5, 0.5))), min_size=1, max_size=6),
-       arrays(float, (3, 3), elements=st.floats(-0.05, 0.05)), st.integers(0, 1), st.integers(1, 3))
+@given(
+    arrays(float, (2, 3), elements=st.floats(-3.0, 3.0)),
+    arrays(float, (2, 3), elements=st.floats(-300.0, 300.0)),
+    st.lists(st.tuples(vectors, arrays(float, (2, 3), elements=st.floats(-0.5, 0.5))), min_size=1, max_size=6),
+    arrays(float, (3, 3), elements=st.floats(-0.05, 0.05)),
+    st.integers(0, 1),
+    st.integers(1, 3),
+)
 def test_the_scalar_fix_correction_is_the_vectorized_one(angles, positions, readings, errors, body, pending):
     """A fix of a body's points (its estimate's points moved by up to 5 cm) taken some ticks
     ago, with later fixes still pending: the corrected estimates (position, velocity,
@@ -269,13 +306,20 @@ def test_the_scalar_fix_correction_is_the_vectorized_one(angles, positions, read
     reference = copy.deepcopy(f)
     f.correct(body, measured, 0)
     _vectorized_correct(reference, body, measured, 0)
-    for name, scale in (("position", 400.0), ("velocity", 20.0), ("rotation", 1.0), ("accel_bias", 1.0),
-                        ("gyro_bias", 1.0)):
-        np.testing.assert_allclose(getattr(f, name), getattr(reference, name), rtol=0.0, atol=1e-12 * scale,
-                                   err_msg=name)
+    for name, scale in (
+        ("position", 400.0),
+        ("velocity", 20.0),
+        ("rotation", 1.0),
+        ("accel_bias", 1.0),
+        ("gyro_bias", 1.0),
+    ):
+        np.testing.assert_allclose(
+            getattr(f, name), getattr(reference, name), rtol=0.0, atol=1e-12 * scale, err_msg=name
+        )
     assert len(f._samples[body]) == len(reference._samples[body])
-    for (tick, position, rotation), (tick_ref, position_ref, rotation_ref) in zip(f._samples[body],
-                                                                                   reference._samples[body]):
+    for (tick, position, rotation), (tick_ref, position_ref, rotation_ref) in zip(
+        f._samples[body], reference._samples[body], strict=True
+    ):
         assert tick == tick_ref
         np.testing.assert_allclose(position, position_ref, rtol=0.0, atol=400e-12)
         np.testing.assert_allclose(rotation, rotation_ref, rtol=0.0, atol=1e-12)

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from planbench import envs
 from planbench.fast.loads import WINCH_MAX_ACCEL, WINCH_MAX_SPEED, Winches
@@ -105,8 +106,11 @@ def _vectorized_winches(winches: Winches, command: np.ndarray, state: dict) -> N
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.lists(st.lists(st.floats(-3e-2, 3e-2), min_size=6, max_size=6), min_size=1, max_size=60),
-       st.floats(0.0, 1e-3), st.floats(0.0, 1.0))
+@given(
+    st.lists(st.lists(st.floats(-3e-2, 3e-2), min_size=6, max_size=6), min_size=1, max_size=60),
+    st.floats(0.0, 1e-3),
+    st.floats(0.0, 1.0),
+)
 def test_the_scalar_ropes_equal_the_vectorized_law_to_the_bit(steps, drift, far):
     """Commands that creep (inside the limits), jitter (the acceleration limit) and jump (the
     speed limit and the braking): every tick's ropes, rates and commands as written equal

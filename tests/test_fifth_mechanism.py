@@ -32,8 +32,14 @@ GRAVITY_TORQUE = 2.0 * 9.81 * 0.5
 def planbench(*args, cwd, check=True, **env):
     """``python -m planbench.cli ARGS`` with the pendulum's root in PLANBENCH_MECHANISMS."""
     environ = {**os.environ, models.ROOTS_VARIABLE: str(PENDULUM), "PYTHONPATH": str(ROOT), **env}
-    done = subprocess.run([sys.executable, "-m", "planbench.cli", *args], cwd=cwd, env=environ,
-                          capture_output=True, text=True, timeout=600)
+    done = subprocess.run(
+        [sys.executable, "-m", "planbench.cli", *args],
+        cwd=cwd,
+        env=environ,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     if check:
         assert done.returncode == 0, done.stderr
     return done
@@ -41,17 +47,26 @@ def planbench(*args, cwd, check=True, **env):
 
 def python(code: str, cwd):
     environ = {**os.environ, models.ROOTS_VARIABLE: str(PENDULUM), "PYTHONPATH": str(ROOT)}
-    done = subprocess.run([sys.executable, "-c", code], cwd=cwd, env=environ, capture_output=True, text=True,
-                          timeout=600)
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=cwd, env=environ, capture_output=True, text=True, timeout=600
+    )
     assert done.returncode == 0, done.stderr
     return done.stdout
 
 
 def test_it_is_listed_and_runs_to_a_pass_that_holds_by_hand(tmp_path):
     assert "pendulum-swing" in planbench("list", cwd=tmp_path).stdout
-    assert "pendulum" not in subprocess.run([sys.executable, "-m", "planbench.cli", "list"], cwd=tmp_path,
-                                            env={**os.environ, "PYTHONPATH": str(ROOT)},
-                                            capture_output=True, text=True, check=True).stdout
+    assert (
+        "pendulum"
+        not in subprocess.run(
+            [sys.executable, "-m", "planbench.cli", "list"],
+            cwd=tmp_path,
+            env={**os.environ, "PYTHONPATH": str(ROOT)},
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+    )
     planbench("run", "pendulum-swing", "--goal", "1.2", "--out", "run", "--quiet", cwd=tmp_path)
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["passed"] is True
@@ -94,7 +109,9 @@ def test_the_dm_control_environment_holds_the_start_and_rewards_tracking(tmp_pat
         "while not step.last():\n"
         "    step = env.step(np.zeros(1))\n"
         "    rewards.append(step.reward)\n"
-        "print(len(rewards), rewards[0], min(rewards))\n", cwd=tmp_path)
+        "print(len(rewards), rewards[0], min(rewards))\n",
+        cwd=tmp_path,
+    )
     n, first, lowest = out.split()
     assert int(n) == 360  # (1.0 s + 0.8 s) / 5 ms
     # Holding the start, the reward is 1 while the plan has barely moved, and falls far
@@ -103,9 +120,19 @@ def test_the_dm_control_environment_holds_the_start_and_rewards_tracking(tmp_pat
 
 
 def test_nothing_outside_its_folders_names_it():
-    listed = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard"], cwd=ROOT,
-                            capture_output=True, text=True, check=True).stdout.split()
-    outside = [f for f in listed if not f.startswith("tests/mechanisms/pendulum/")
-               and f != "tests/test_fifth_mechanism.py" and (ROOT / f).is_file()
-               and "pendulum" in (ROOT / f).read_text(errors="replace").lower()]
+    listed = subprocess.run(
+        ["git", "ls-files", "--cached", "--others", "--exclude-standard"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
+    outside = [
+        f
+        for f in listed
+        if not f.startswith("tests/mechanisms/pendulum/")
+        and f != "tests/test_fifth_mechanism.py"
+        and (ROOT / f).is_file()
+        and "pendulum" in (ROOT / f).read_text(errors="replace").lower()
+    ]
     assert outside == []

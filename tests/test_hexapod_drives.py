@@ -6,15 +6,14 @@ from __future__ import annotations
 
 import math
 
-import mujoco
 import numpy as np
 import pytest
 
-from planbench.planners.hexapod import STRUT_LABELS
-from planbench import runner, scenarios
 from planbench import hexapod as sim_hexapod
+from planbench import runner, scenarios
 from planbench.drives import transmission_stiffness
 from planbench.hexapod import physics as hexapod_physics
+from planbench.planners.hexapod import STRUT_LABELS
 
 DRIVE = hexapod_physics.STRUT_DRIVE
 
@@ -101,14 +100,29 @@ def test_an_unknown_drive_option_is_refused_naming_the_choices():
         scenarios.get("hexapod-sync-move").resolve(drives="geared")
 
 
-@pytest.mark.parametrize("field, value, expect", [
-    ("friction_error", 0.5, lambda m, n: (m.dof_frictionloss[m.joint(f"{n}_motor").dofadr[0]], 1.5 * DRIVE.coulomb_friction)),
-    ("friction_error", -0.5, lambda m, n: (m.dof_damping[m.joint(f"{n}_motor").dofadr[0]], 0.5 * DRIVE.viscous_friction)),
-    ("screw_stiffness_error", -0.3, lambda m, n: (m.tendon_stiffness[m.tendon(f"{n}_transmission").id], 0.7 * DRIVE.stiffness)),
-    ("torque_constant_error", 0.1, lambda m, n: (m.actuator(n).gainprm[0], 1.1 * DRIVE.kp)),
-    ("torque_constant_error", 0.1, lambda m, n: (-m.actuator(n).biasprm[2], 1.1 * DRIVE.kv)),
-    ("torque_constant_error", -0.1, lambda m, n: (m.actuator(n).forcerange[1], 0.9 * DRIVE.peak_force)),
-])
+@pytest.mark.parametrize(
+    "field, value, expect",
+    [
+        (
+            "friction_error",
+            0.5,
+            lambda m, n: (m.dof_frictionloss[m.joint(f"{n}_motor").dofadr[0]], 1.5 * DRIVE.coulomb_friction),
+        ),
+        (
+            "friction_error",
+            -0.5,
+            lambda m, n: (m.dof_damping[m.joint(f"{n}_motor").dofadr[0]], 0.5 * DRIVE.viscous_friction),
+        ),
+        (
+            "screw_stiffness_error",
+            -0.3,
+            lambda m, n: (m.tendon_stiffness[m.tendon(f"{n}_transmission").id], 0.7 * DRIVE.stiffness),
+        ),
+        ("torque_constant_error", 0.1, lambda m, n: (m.actuator(n).gainprm[0], 1.1 * DRIVE.kp)),
+        ("torque_constant_error", 0.1, lambda m, n: (-m.actuator(n).biasprm[2], 1.1 * DRIVE.kv)),
+        ("torque_constant_error", -0.1, lambda m, n: (m.actuator(n).forcerange[1], 0.9 * DRIVE.peak_force)),
+    ],
+)
 def test_the_drive_trains_uncertainty_edits_its_element(field, value, expect):
     plant = sim_hexapod.HexapodPlant(**{field: value})
     model = hexapod_physics.HexapodPhysics.load(45.0, plant, "as-built").model.ptr

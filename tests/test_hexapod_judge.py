@@ -18,11 +18,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from planbench import hexapod as sh
+from planbench import runner, scenarios
+from planbench.hexapod.plan_checks import judge_plans
 from planbench.planners import hexapod as hp
 from planbench.planners.trajectory import TrajectorySample
-from planbench import runner, scenarios
-from planbench import hexapod as sh
-from planbench.hexapod.plan_checks import judge_plans
 
 DT = sh.CONTROL_DT
 ARRIVAL_CHECKS = ("arrival_spread", "arrival_vs_own_time")
@@ -46,8 +46,12 @@ class _RestsOffTarget:
     def sample(self, t):
         s = self.move.sample(t)
         resting = (s.t[:, None] >= self.move.end_times) & (s.t[:, None] < self.duration)
-        return TrajectorySample(s.t, np.where(resting, self.move.target + self.off, s.position),
-                                np.where(resting, 1e-19, s.velocity), s.acceleration)
+        return TrajectorySample(
+            s.t,
+            np.where(resting, self.move.target + self.off, s.position),
+            np.where(resting, 1e-19, s.velocity),
+            s.acceleration,
+        )
 
 
 class RuckigStyle:
@@ -98,8 +102,9 @@ class _TimeScaled:
     def sample(self, t):
         s = self.move.sample(np.asarray(t, dtype=float) * self.rate)
         r = self.rate
-        return TrajectorySample(np.atleast_1d(np.asarray(t, dtype=float)), s.position, r * s.velocity,
-                                r * r * s.acceleration)
+        return TrajectorySample(
+            np.atleast_1d(np.asarray(t, dtype=float)), s.position, r * s.velocity, r * r * s.acceleration
+        )
 
 
 class Hurried:
@@ -142,9 +147,15 @@ def moves_of(targets, synchronous):
 
 
 #: Four moves of 0.1 ... 0.3 mm and 0.01 deg, two of each mode (each ~1.5 s).
-FOUR_MOVES = moves_of([(0.2, -0.1, 0.05, 0.01, 0.0, 0.0), (0.0, 0.2, -0.1, 0.0, 0.01, 0.0),
-                       (-0.2, 0.0, 0.1, 0.0, 0.0, 0.01), (0.1, 0.1, 0.0, -0.01, 0.0, 0.0)],
-                      [True, False, True, False])
+FOUR_MOVES = moves_of(
+    [
+        (0.2, -0.1, 0.05, 0.01, 0.0, 0.0),
+        (0.0, 0.2, -0.1, 0.0, 0.01, 0.0),
+        (-0.2, 0.0, 0.1, 0.0, 0.0, 0.01),
+        (0.1, 0.1, 0.0, -0.01, 0.0, 0.0),
+    ],
+    [True, False, True, False],
+)
 
 
 # --------------------------------------------------------------------------- rest and arrival
@@ -161,23 +172,26 @@ D = 2e-3  # m: every strut's move in the table below, from 0 to D
 TOL = sh.ARRIVAL_TOLERANCE * D
 
 
-@pytest.mark.parametrize("position, velocity, arrival", [
-    # exactly on the target from tick 2: arrived at tick 2
-    ([0.0, 1e-3, D, D, D], [0.0, 0.1, 0.0, 0.0, 0.0], 2 * DT),
-    # 1e-19 m off, at 1e-19 m/s (round-off of a planner's own integration): the same
-    ([0.0, 1e-3, D + 1e-19, D - 1e-19, D + 1e-19], [0.0, 0.1, 1e-19, -1e-19, 0.0], 2 * DT),
-    # within the tolerance, on both sides
-    ([0.0, 1e-3, D + 0.9 * TOL, D - 0.9 * TOL, D], [0.0, 0.1, 0.0, 0.0, 0.0], 2 * DT),
-    # beyond it at tick 2: arrived at tick 3
-    ([0.0, 1e-3, D - 2 * TOL, D, D], [0.0, 0.1, 0.0, 0.0, 0.0], 3 * DT),
-    # on the target at tick 2 but still moving (faster than the tolerance per tick): tick 3
-    ([0.0, 1e-3, D, D, D], [0.0, 0.1, 2 * TOL / DT, 0.0, 0.0], 3 * DT),
-    # passes the target at tick 1 and comes back: arrival is the last entry, tick 3
-    ([0.0, D, D + 1e-6, D, D], [0.0, 0.1, 0.0, 0.0, 0.0], 3 * DT),
-    # never at rest on the target within the window: no arrival
-    ([0.0, 1e-3, D - 1e-6, D - 1e-6, D - 1e-6], [0.0, 0.1, 0.0, 0.0, 0.0], np.nan),
-    ([0.0, 1e-3, D, D, D], [0.0, 0.1, 0.0, 0.0, 1e-6], np.nan),
-])
+@pytest.mark.parametrize(
+    "position, velocity, arrival",
+    [
+        # exactly on the target from tick 2: arrived at tick 2
+        ([0.0, 1e-3, D, D, D], [0.0, 0.1, 0.0, 0.0, 0.0], 2 * DT),
+        # 1e-19 m off, at 1e-19 m/s (round-off of a planner's own integration): the same
+        ([0.0, 1e-3, D + 1e-19, D - 1e-19, D + 1e-19], [0.0, 0.1, 1e-19, -1e-19, 0.0], 2 * DT),
+        # within the tolerance, on both sides
+        ([0.0, 1e-3, D + 0.9 * TOL, D - 0.9 * TOL, D], [0.0, 0.1, 0.0, 0.0, 0.0], 2 * DT),
+        # beyond it at tick 2: arrived at tick 3
+        ([0.0, 1e-3, D - 2 * TOL, D, D], [0.0, 0.1, 0.0, 0.0, 0.0], 3 * DT),
+        # on the target at tick 2 but still moving (faster than the tolerance per tick): tick 3
+        ([0.0, 1e-3, D, D, D], [0.0, 0.1, 2 * TOL / DT, 0.0, 0.0], 3 * DT),
+        # passes the target at tick 1 and comes back: arrival is the last entry, tick 3
+        ([0.0, D, D + 1e-6, D, D], [0.0, 0.1, 0.0, 0.0, 0.0], 3 * DT),
+        # never at rest on the target within the window: no arrival
+        ([0.0, 1e-3, D - 1e-6, D - 1e-6, D - 1e-6], [0.0, 0.1, 0.0, 0.0, 0.0], np.nan),
+        ([0.0, 1e-3, D, D, D], [0.0, 0.1, 0.0, 0.0, 1e-6], np.nan),
+    ],
+)
 def test_arrival_is_the_rest_within_the_tolerance(position, velocity, arrival):
     tolerance, moving = sh.strut_tolerances(np.zeros(6), np.full(6, D))
     assert moving.all() and np.all(tolerance == TOL)
@@ -185,15 +199,18 @@ def test_arrival_is_the_rest_within_the_tolerance(position, velocity, arrival):
     np.testing.assert_array_equal(got, np.full(6, arrival))
 
 
-@pytest.mark.parametrize("start, distance, moving, tolerance", [
-    (-14.1e-3, 28.2e-3, True, 28.2e-12),  # the longest move a strut has (twice the stroke): 28 pm
-    (0.0, 2e-3, True, 2e-12),
-    (0.0, 2e-9, True, 2e-18),
-    # 2 nm at 14 mm from the zero pose: 1e-9 of the move is below the position's round-off
-    (14e-3, 2e-9, True, sh.ARRIVAL_ULPS * np.spacing(14e-3 + 2e-9)),
-    (0.0, 0.9e-9, False, sh.STRUT_MOVE_THRESHOLD_M),  # below 1/100 of an encoder count: idle
-    (0.0, 0.0, False, sh.STRUT_MOVE_THRESHOLD_M),
-])
+@pytest.mark.parametrize(
+    "start, distance, moving, tolerance",
+    [
+        (-14.1e-3, 28.2e-3, True, 28.2e-12),  # the longest move a strut has (twice the stroke): 28 pm
+        (0.0, 2e-3, True, 2e-12),
+        (0.0, 2e-9, True, 2e-18),
+        # 2 nm at 14 mm from the zero pose: 1e-9 of the move is below the position's round-off
+        (14e-3, 2e-9, True, sh.ARRIVAL_ULPS * np.spacing(14e-3 + 2e-9)),
+        (0.0, 0.9e-9, False, sh.STRUT_MOVE_THRESHOLD_M),  # below 1/100 of an encoder count: idle
+        (0.0, 0.0, False, sh.STRUT_MOVE_THRESHOLD_M),
+    ],
+)
 def test_strut_tolerance_is_tied_to_the_move_and_the_encoder(start, distance, moving, tolerance):
     tol, mov = sh.strut_tolerances(np.full(6, start), np.full(6, start + distance))
     assert np.all(mov == moving)
@@ -225,7 +242,9 @@ def test_a_planner_resting_1e19_m_off_the_target_passes_the_arrival_checks(name)
     assert result.passed, [c.to_json() for c in result.checks if not c.passed]
     # The planner-only judge agrees.
     [checks] = judge_plans([params], planner=RuckigStyle())
-    assert by_name(checks)[mine.name].passed and by_name(checks)[mine.name].value == pytest.approx(theirs.value, abs=1e-12)
+    assert by_name(checks)[mine.name].passed and by_name(checks)[mine.name].value == pytest.approx(
+        theirs.value, abs=1e-12
+    )
 
 
 # --------------------------------------------------------------------------- move lists on the tick grid
@@ -248,7 +267,9 @@ def test_every_move_of_a_list_is_evaluated_at_any_dwell(dwell, planner):
     assert np.all(starts[1:] >= ends[:-1] + dwell - 1e-9)
 
 
-@pytest.mark.parametrize("planner", [None, RuckigStyle(), RuckigStyle(extra=0.0049)], ids=["paper", "extra-2.3ms", "extra-4.9ms"])
+@pytest.mark.parametrize(
+    "planner", [None, RuckigStyle(), RuckigStyle(extra=0.0049)], ids=["paper", "extra-2.3ms", "extra-4.9ms"]
+)
 @pytest.mark.parametrize("moves", [None, FOUR_MOVES[:2]], ids=["one", "two"])
 def test_the_default_duration_covers_the_last_arrival_and_its_settling(planner, moves):
     options = {} if moves is None else {"moves": moves}
@@ -262,13 +283,17 @@ def test_the_default_duration_covers_the_last_arrival_and_its_settling(planner, 
 # --------------------------------------------------------------------------- one-sided arrival, hexapod-space speeds
 
 
-@pytest.mark.parametrize("planner, arrival_passes, speed_passes", [
-    (None, True, True),               # the paper's: within two ticks of 2 max(t_i, t'_min)
-    (StrutOptimal(), True, True),     # early where t'_min binds: allowed, judged by the limits
-    (Synchronous(), False, True),     # the fast struts wait for the slowest: late
-    (Slowed(1.1), False, True),       # 10 % slower: late
-    (Hurried(2.5), True, False),      # 2.5 times as fast: early, over the limits (0.45 x 2.5)
-], ids=["paper", "strut-optimal", "synchronous", "slowed", "hurried"])
+@pytest.mark.parametrize(
+    "planner, arrival_passes, speed_passes",
+    [
+        (None, True, True),  # the paper's: within two ticks of 2 max(t_i, t'_min)
+        (StrutOptimal(), True, True),  # early where t'_min binds: allowed, judged by the limits
+        (Synchronous(), False, True),  # the fast struts wait for the slowest: late
+        (Slowed(1.1), False, True),  # 10 % slower: late
+        (Hurried(2.5), True, False),  # 2.5 times as fast: early, over the limits (0.45 x 2.5)
+    ],
+    ids=["paper", "strut-optimal", "synchronous", "slowed", "hurried"],
+)
 @pytest.mark.parametrize("judge", ["run", "plan"])
 def test_async_arrival_is_one_sided_and_the_limits_judge_themselves(planner, arrival_passes, speed_passes, judge):
     if judge == "run":
@@ -319,7 +344,7 @@ class KickedAfterArrival(sh.HexapodController):
 
     def reset(self, context):
         super().reset(context)
-        self.setpoints[self.at:] += self.offset
+        self.setpoints[self.at :] += self.offset
 
 
 def test_following_error_leaves_out_the_settling_after_the_last_arrival():
@@ -361,8 +386,13 @@ class _Recording:
 
 
 def _wind_run(wind: float, steady: bool):
-    setup, _ = build("hexapod-sync-move", controller=sh.HexapodController(integral_time=None),
-                     wind=wind, duration=1.5, elevation=45.0)
+    setup, _ = build(
+        "hexapod-sync-move",
+        controller=sh.HexapodController(integral_time=None),
+        wind=wind,
+        duration=1.5,
+        elevation=45.0,
+    )
     recording = None
     if setup.task.disturbance is not None:
         recording = setup.task.disturbance = _Recording(setup.task.disturbance, steady)
@@ -433,14 +463,22 @@ def test_hexapod_speed_ratios_against_finite_differences_of_the_pose():
 
     def pose(times):
         s = move.sample(times)
-        return hp.forward_kinematics(s.position + hp.RUBIN_CAMERA.nominal_lengths,
-                                     initial=np.zeros((times.size, 6)), tolerance=1e-14)[0]
+        return hp.forward_kinematics(
+            s.position + hp.RUBIN_CAMERA.nominal_lengths, initial=np.zeros((times.size, 6)), tolerance=1e-14
+        )[0]
 
     p = pose(t)
     rate = (pose(t + h) - pose(t - h)) / (2 * h)
     limits = hp.RUBIN_LIMITS
-    expected = np.stack([np.hypot(rate[:, 0], rate[:, 1]) / limits.linear_speed, np.abs(rate[:, 2]) / limits.linear_speed,
-                         np.hypot(rate[:, 3], rate[:, 4]) / limits.angular_speed, np.abs(rate[:, 5]) / limits.angular_speed], 1)
+    expected = np.stack(
+        [
+            np.hypot(rate[:, 0], rate[:, 1]) / limits.linear_speed,
+            np.abs(rate[:, 2]) / limits.linear_speed,
+            np.hypot(rate[:, 3], rate[:, 4]) / limits.angular_speed,
+            np.abs(rate[:, 5]) / limits.angular_speed,
+        ],
+        1,
+    )
     got = hp.hexapod_speed_ratios(p, move.sample(t).velocity)
     np.testing.assert_allclose(got, expected, atol=2e-5)
     assert got.max() > 0.3
@@ -464,8 +502,12 @@ class _Shifted:
     def sample(self, t):
         s = self.move.sample(t)
         fraction = np.clip(np.asarray(s.t)[:, None] / self.duration, 0.0, 1.0)
-        return TrajectorySample(s.t, s.position - self.off * fraction * np.sign(self.move.target - self.move.start),
-                                s.velocity, s.acceleration)
+        return TrajectorySample(
+            s.t,
+            s.position - self.off * fraction * np.sign(self.move.target - self.move.start),
+            s.velocity,
+            s.acceleration,
+        )
 
 
 @pytest.mark.parametrize("name", ["hexapod-sync-move", "hexapod-async-move"])

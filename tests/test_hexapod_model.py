@@ -3,12 +3,13 @@
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from planbench import models
+from planbench.hexapod import HexapodController, HexapodPhysics, top_end_rotation
 from planbench.planners import hexapod
 from planbench.planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
-from planbench.hexapod import HexapodController, HexapodPhysics, top_end_rotation
 from planbench.planners.trajectory import TrajectorySample
 
 G = 9.81
@@ -43,14 +44,18 @@ def test_mass_properties_by_hand():
     assert com == pytest.approx([0.0, 0.0, (3000 * 4.2584 + 150 * 2.637) / 3150], abs=1e-9)
     camera = physics.model.ptr.body("camera")
     r, length = 0.825, 3.0
-    np.testing.assert_allclose(camera.inertia, [3000 * (3 * r * r + length**2) / 12] * 2 + [3000 * r * r / 2], rtol=1e-9)
+    np.testing.assert_allclose(
+        camera.inertia, [3000 * (3 * r * r + length**2) / 12] * 2 + [3000 * r * r / 2], rtol=1e-9
+    )
 
 
 @pytest.mark.parametrize("elevation", [15.0, 45.0, 90.0])
 def test_gravity_direction_in_the_hexapod_frame(elevation):
     physics = HexapodPhysics.load(elevation)
     el = np.radians(elevation)
-    np.testing.assert_allclose(physics.gravity_in_hexapod_frame(), G * np.array([0, -np.cos(el), np.sin(el)]), atol=1e-12)
+    np.testing.assert_allclose(
+        physics.gravity_in_hexapod_frame(), G * np.array([0, -np.cos(el), np.sin(el)]), atol=1e-12
+    )
     rotation = top_end_rotation(elevation)
     np.testing.assert_allclose(rotation.T @ rotation, np.eye(3), atol=1e-15)
     assert np.linalg.det(rotation) == pytest.approx(1.0)
@@ -68,8 +73,9 @@ def test_planner_strut_lengths_equal_mujoco_lengths(seed, elevation):
     assert physics.loop_closure_error() < 1e-12
     np.testing.assert_allclose(physics.platform_pose(), pose, atol=1e-12)
     # The pose sensors (pivot in the hexapod frame) agree.
-    np.testing.assert_allclose(physics.named.data.sensordata["platform_pos"],
-                               RUBIN_CAMERA.rotation_pivot + pose[:3], atol=1e-12)
+    np.testing.assert_allclose(
+        physics.named.data.sensordata["platform_pos"], RUBIN_CAMERA.rotation_pivot + pose[:3], atol=1e-12
+    )
 
 
 class _Still:
@@ -93,10 +99,12 @@ def _hold(physics, seconds):
     from planbench.task import Components, Task
 
     controller = HexapodController()
-    task = Task(problem=None, sensors=hexapod_sim.sensors(physics), evaluation=None, control_dt=0.005,
-                duration=seconds)
-    setup = runner.Setup(physics, task, Components(planner=None, trajectory=_Still(physics.strut_positions(), seconds),
-                                                   controller=controller))
+    task = Task(problem=None, sensors=hexapod_sim.sensors(physics), evaluation=None, control_dt=0.005, duration=seconds)
+    setup = runner.Setup(
+        physics,
+        task,
+        Components(planner=None, trajectory=_Still(physics.strut_positions(), seconds), controller=controller),
+    )
     runner.simulate(setup)
     return controller
 

@@ -3,13 +3,22 @@
 import numpy as np
 import pytest
 
-from planbench.planners.trajectory import TrajectorySample
-from planbench import runner, scenarios
 from planbench import hexapod as sim_hexapod
+from planbench import runner, scenarios
+from planbench.planners.trajectory import TrajectorySample
 from planbench.wind import AIR_DENSITY, kaimal_spectrum, wind_speed_series
 
-EXPECTED = {"strut_velocity", "strut_accel", "hexapod_speed", "following_error", "pose_error_final",
-            "strut_force", "stroke", "simulation_warnings", "controller_errors"}
+EXPECTED = {
+    "strut_velocity",
+    "strut_accel",
+    "hexapod_speed",
+    "following_error",
+    "pose_error_final",
+    "strut_force",
+    "stroke",
+    "simulation_warnings",
+    "controller_errors",
+}
 WIND_M_S = 10.0
 #: The ball constraints' largest violation (um) under the full load: MuJoCo's stiffest
 #: constraint (solref 2 steps, impedance 0.9999) gives way in proportion to the inverse mass
@@ -143,9 +152,13 @@ def test_limit_checks_fail_for_a_planner_that_breaks_them():
     assert not c["strut_accel"].passed
     # An asynchronous plan judged as a synchronous move fails the arrival check, and a
     # synchronous one judged as asynchronous (struts wait for the slowest) fails its own.
-    result, _ = run("hexapod-sync-move", trajectory=sim_hexapod.plan(scenarios.get("hexapod-async-move").params), wind=0.0)
+    result, _ = run(
+        "hexapod-sync-move", trajectory=sim_hexapod.plan(scenarios.get("hexapod-async-move").params), wind=0.0
+    )
     assert not checks(result)["arrival_spread"].passed
-    result, _ = run("hexapod-async-move", trajectory=sim_hexapod.plan(scenarios.get("hexapod-sync-move").params), wind=0.0)
+    result, _ = run(
+        "hexapod-async-move", trajectory=sim_hexapod.plan(scenarios.get("hexapod-sync-move").params), wind=0.0
+    )
     assert not checks(result)["arrival_vs_own_time"].passed
 
 

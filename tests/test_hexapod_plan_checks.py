@@ -8,16 +8,22 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from planbench.planners import hexapod as hp
-from planbench.planners.trajectory import TrajectorySample
 from planbench import api, scenarios
 from planbench.hexapod import HexapodMove, HexapodParams, pose_mm_deg, pose_si, problems
 from planbench.hexapod.plan_checks import judge_plans, judge_trajectories
 from planbench.params import ParamError
+from planbench.planners import hexapod as hp
+from planbench.planners.trajectory import TrajectorySample
 
 #: The checks that judge a limit the paper's generator keeps by construction.
-KEPT = ("arrival_spread", "arrival_vs_own_time", "strut_velocity", "strut_accel", "plan_stroke",
-        "plan_pose_error_final")
+KEPT = (
+    "arrival_spread",
+    "arrival_vs_own_time",
+    "strut_velocity",
+    "strut_accel",
+    "plan_stroke",
+    "plan_pose_error_final",
+)
 
 
 def by_name(checks):
@@ -49,8 +55,11 @@ def test_agrees_with_the_runs_own_planner_checks(name):
     arrival = "arrival_spread" if scenario.params.moves[0].synchronous else "arrival_vs_own_time"
     for key in (arrival, "strut_velocity", "strut_accel"):
         assert plan[key].value == pytest.approx(run[key].value, rel=1e-12, abs=1e-15), key
-        assert (plan[key].limit, plan[key].unit, plan[key].comparison) == \
-            (run[key].limit, run[key].unit, run[key].comparison)
+        assert (plan[key].limit, plan[key].unit, plan[key].comparison) == (
+            run[key].limit,
+            run[key].unit,
+            run[key].comparison,
+        )
     # The run's stroke is the encoders': the plan's within the run's following error.
     following_mm = 1e-3 * run["following_error"].value
     assert plan["plan_stroke"].value == pytest.approx(run["stroke"].value, abs=following_mm)
@@ -71,9 +80,9 @@ def test_fast_path_equals_sampling_every_tick():
     fast = judge_plans(runs)
     ticks = judge_plans(runs, planner=hp.PaperMovePlanner())
     exceeded = 0
-    for a, b in zip(fast, ticks):
+    for a, b in zip(fast, ticks, strict=True):
         assert [c.name for c in a] == [c.name for c in b]
-        for x, y in zip(a, b):
+        for x, y in zip(a, b, strict=True):
             if x.name == "pose_limits":
                 assert x.value == pytest.approx(y.value, abs=1e-5)
                 exceeded += x.value > 1.0
@@ -92,8 +101,10 @@ def test_multi_move_run_reports_its_worst_move():
     [whole] = judge_plans([run])
     single = []
     for move in problems(run):
-        params = HexapodParams(start_pose=pose_mm_deg(move.start_pose),
-                               moves=(HexapodMove(pose_mm_deg(move.target_pose), move.synchronous),))
+        params = HexapodParams(
+            start_pose=pose_mm_deg(move.start_pose),
+            moves=(HexapodMove(pose_mm_deg(move.target_pose), move.synchronous),),
+        )
         single.append(by_name(judge_plans([params])[0]))
     whole = by_name(whole)
     for name, check in whole.items():
@@ -106,10 +117,11 @@ def test_batch_equals_one_at_a_time_bit_for_bit():
     runs = random_params(rng, 40) + random_params(rng, 5, moves_per_run=3)
     rng.shuffle(runs)
     batch = judge_plans(runs)
-    for params, checks in zip(runs, batch):
+    for params, checks in zip(runs, batch, strict=True):
         [alone] = judge_plans([params])
-        assert [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in checks] == \
-            [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in alone]
+        assert [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in checks] == [
+            (c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in alone
+        ]
 
 
 # ----------------------------------------------------------------------------- bad plans fail
@@ -126,8 +138,9 @@ class TimeScaled:
 
     def sample(self, t):
         s = self.trajectory.sample(np.asarray(t, dtype=float) * self.factor)
-        return TrajectorySample(np.asarray(t, dtype=float), s.position, s.velocity * self.factor,
-                                s.acceleration * self.factor**2)
+        return TrajectorySample(
+            np.asarray(t, dtype=float), s.position, s.velocity * self.factor, s.acceleration * self.factor**2
+        )
 
 
 class Shifted:
@@ -169,11 +182,13 @@ def test_hand_made_bad_trajectories_fail():
     far = by_name(judge_trajectories([move], [Shifted(paper, np.full(6, 12e-3))]))
     assert not far["plan_stroke"].passed and far["plan_stroke"].value > 14.1
     assert not far["pose_limits"].passed and "z =" in far["pose_limits"].note
+
     # A move that never comes to rest: its arrivals cannot be judged.
     class Moving(Shifted):
         def sample(self, t):
             s = super().sample(t)
             return TrajectorySample(s.t, s.position, s.velocity + 1e-6, s.acceleration)
+
     restless = by_name(judge_trajectories([move], [Moving(paper, np.zeros(6))]))
     assert not restless["arrival_spread"].passed and not restless["arrival_spread"].evaluated
 
@@ -183,7 +198,7 @@ def test_hand_made_bad_trajectories_fail():
 
 def _pose(draw):
     low, high = hp.RUBIN_LIMITS.pose_lower, hp.RUBIN_LIMITS.pose_upper
-    return np.array([draw(st.floats(float(lo), float(hi), allow_nan=False)) for lo, hi in zip(low, high)])
+    return np.array([draw(st.floats(float(lo), float(hi), allow_nan=False)) for lo, hi in zip(low, high, strict=True)])
 
 
 @st.composite
@@ -220,8 +235,17 @@ def test_random_valid_moves_pass_the_limits_the_generator_keeps(params):
 # ----------------------------------------------------------------------------- the kernels
 
 
-@given(st.lists(st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.just(0.0), st.just(-0.0)),
-                         min_size=6, max_size=6), min_size=1, max_size=20))
+@given(
+    st.lists(
+        st.lists(
+            st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.just(0.0), st.just(-0.0)),
+            min_size=6,
+            max_size=6,
+        ),
+        min_size=1,
+        max_size=20,
+    )
+)
 def test_max_of_the_last_axis_is_numpys(rows):
     from planbench.hexapod.plan_checks import _max_last
 
@@ -247,5 +271,6 @@ def test_the_nearest_anchor_is_the_argmin_of_the_distances(seed, count):
     # Exact ties go to the first anchor, as argmin's.
     tied = object.__new__(_Anchors)
     tied.struts = np.broadcast_to(np.array([0.0, 2.0, 4.0])[None, :, None], (2, 3, 6)).copy()
-    np.testing.assert_array_equal(tied.nearest(np.array([0, 1, 1]), np.array([[1.0] * 6, [3.0] * 6, [2.0] * 6])),
-                                  [0, 3 + 1, 3 + 1])
+    np.testing.assert_array_equal(
+        tied.nearest(np.array([0, 1, 1]), np.array([[1.0] * 6, [3.0] * 6, [2.0] * 6])), [0, 3 + 1, 3 + 1]
+    )

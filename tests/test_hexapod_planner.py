@@ -18,8 +18,8 @@ from planbench.planners.hexapod import (
     RUBIN_CAMERA,
     RUBIN_LIMITS,
     KinematicsError,
-    forward_kinematics,
     euler_rate_matrix,
+    forward_kinematics,
     hexapod_space_min_time,
     jacobian,
     long_move_closed_form,
@@ -46,22 +46,28 @@ LOW, HIGH = LIM.pose_lower, LIM.pose_upper
 
 # REFERENCE.md, "Rubin hexapod" (ts_mthexapod constants.py, camera hexapod), um, the +/- and
 # -/+ pairs written out in order.
-REF_BASE_UM = np.array([
-    [227_600, 653_800, -525_000],
-    [-227_600, 653_800, -525_000],
-    [-680_000, -129_700, -525_000],
-    [-452_300, -524_000, -525_000],
-    [452_300, -524_000, -525_000],
-    [680_000, -129_700, -525_000],
-], dtype=float)
-REF_MIRROR_UM = np.array([
-    [472_800, 512_200, -121_400],
-    [-472_800, 512_200, -121_400],
-    [-680_000, 153_300, -121_400],
-    [-207_200, -665_500, -121_400],
-    [207_200, -665_500, -121_400],
-    [680_000, 153_300, -121_400],
-], dtype=float)
+REF_BASE_UM = np.array(
+    [
+        [227_600, 653_800, -525_000],
+        [-227_600, 653_800, -525_000],
+        [-680_000, -129_700, -525_000],
+        [-452_300, -524_000, -525_000],
+        [452_300, -524_000, -525_000],
+        [680_000, -129_700, -525_000],
+    ],
+    dtype=float,
+)
+REF_MIRROR_UM = np.array(
+    [
+        [472_800, 512_200, -121_400],
+        [-472_800, 512_200, -121_400],
+        [-680_000, 153_300, -121_400],
+        [-207_200, -665_500, -121_400],
+        [207_200, -665_500, -121_400],
+        [680_000, 153_300, -121_400],
+    ],
+    dtype=float,
+)
 REF_PIVOT_UM = np.array([0.0, 0.0, -2_758_400])
 
 BASE = REF_BASE_UM * UM
@@ -147,13 +153,12 @@ angle = st.floats(-np.pi, np.pi, allow_nan=False, allow_infinity=False)
 
 def _axis(lo, hi):
     """Hypothesis favours tiny floats; the scaled integers spread values over the range."""
-    return st.one_of(st.floats(lo, hi),
-                     st.integers(-1000, 1000).map(lambda k: (k / 1000) * (hi if k > 0 else -lo)))
+    return st.one_of(st.floats(lo, hi), st.integers(-1000, 1000).map(lambda k: (k / 1000) * (hi if k > 0 else -lo)))
 
 
 @st.composite
 def poses(draw):
-    return np.array([draw(_axis(float(lo), float(hi))) for lo, hi in zip(LOW, HIGH)])
+    return np.array([draw(_axis(float(lo), float(hi))) for lo, hi in zip(LOW, HIGH, strict=True)])
 
 
 # =========================================================================== 1. kinematics
@@ -161,8 +166,9 @@ def poses(draw):
 
 @given(st.tuples(angle, angle, angle))
 def test_rotation_matrix_is_scipy_intrinsic_xyz(angles):
-    np.testing.assert_allclose(rotation_matrix(np.array(angles)),
-                               Rotation.from_euler("XYZ", angles).as_matrix(), atol=1e-14)
+    np.testing.assert_allclose(
+        rotation_matrix(np.array(angles)), Rotation.from_euler("XYZ", angles).as_matrix(), atol=1e-14
+    )
 
 
 def test_rotation_matrix_vectorized():
@@ -187,9 +193,11 @@ def test_geometry_matches_reference():
 
 
 def test_limits_match_reference():
-    np.testing.assert_allclose(LIM.pose_upper, [11_400 * UM, 11_400 * UM, 13_100 * UM,
-                                                np.radians(0.36), np.radians(0.36),
-                                                np.radians(0.10)], rtol=1e-15)
+    np.testing.assert_allclose(
+        LIM.pose_upper,
+        [11_400 * UM, 11_400 * UM, 13_100 * UM, np.radians(0.36), np.radians(0.36), np.radians(0.10)],
+        rtol=1e-15,
+    )
     np.testing.assert_allclose(LIM.pose_lower, -LIM.pose_upper, rtol=1e-15)
     assert LIM.stroke == pytest.approx(14_100 * UM, rel=1e-15)
     assert LIM.strut_speed == pytest.approx(500 * UM, rel=1e-15)
@@ -262,8 +270,9 @@ def test_components_are_the_array_form_bit_for_bit(pose_list, scale):
     arrays = leg_vectors(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local, position, rotation)
     vectors, arms = leg_vector_components(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local, position, rotation)
     np.testing.assert_array_equal(np.stack(vectors, axis=-1), arrays)
-    np.testing.assert_array_equal(np.stack(arms, axis=-1),
-                                  np.einsum("...jk,nk->...nj", rotation, RUBIN_CAMERA.platform_local))
+    np.testing.assert_array_equal(
+        np.stack(arms, axis=-1), np.einsum("...jk,nk->...nj", rotation, RUBIN_CAMERA.platform_local)
+    )
     np.testing.assert_array_equal(component_norm(*vectors), np.linalg.norm(arrays, axis=-1))
     np.testing.assert_array_equal(jacobian(batch), _jacobian_as_arrays(batch))
     np.testing.assert_array_equal(jacobian(batch[0]), _jacobian_as_arrays(batch[0]))
@@ -271,12 +280,11 @@ def test_components_are_the_array_form_bit_for_bit(pose_list, scale):
 
 def test_ik_independent_formula():
     rng = np.random.default_rng(5)
-    batch = np.vstack([my_random_poses(rng, 500),
-                       rng.uniform(-0.05, 0.05, size=(100, 6))])  # also outside the limits
+    batch = np.vstack([my_random_poses(rng, 500), rng.uniform(-0.05, 0.05, size=(100, 6))])  # also outside the limits
     np.testing.assert_allclose(strut_lengths(batch), my_strut_lengths(batch), rtol=1e-14, atol=0)
-    np.testing.assert_allclose(strut_positions(batch),
-                               my_strut_lengths(batch) - np.linalg.norm(MIRROR - BASE, axis=1),
-                               rtol=0, atol=1e-14)
+    np.testing.assert_allclose(
+        strut_positions(batch), my_strut_lengths(batch) - np.linalg.norm(MIRROR - BASE, axis=1), rtol=0, atol=1e-14
+    )
 
 
 def _provably_unreachable(lengths):
@@ -293,11 +301,14 @@ def _provably_unreachable(lengths):
     return False
 
 
-@pytest.mark.parametrize("lengths", [
-    RUBIN_CAMERA.nominal_lengths + np.array([2.0, 0, 0, 0, 0, 0]),
-    np.zeros(6),
-    RUBIN_CAMERA.nominal_lengths * 0.1,
-])
+@pytest.mark.parametrize(
+    "lengths",
+    [
+        RUBIN_CAMERA.nominal_lengths + np.array([2.0, 0, 0, 0, 0, 0]),
+        np.zeros(6),
+        RUBIN_CAMERA.nominal_lengths * 0.1,
+    ],
+)
 def test_fk_unreachable_lengths_raise(lengths):
     assert _provably_unreachable(lengths)
     with pytest.raises(KinematicsError, match="did not converge|singular"):
@@ -368,11 +379,11 @@ def test_static_forces_general_wrench_balances():
         # here (columns e_x, Rx e_y, Rx Ry e_z). (The docstring of static_strut_forces says
         # -W'; the sign there is wrong, see the report.)
         rx, ry = pose[3], pose[4]
-        e = np.column_stack([[1, 0, 0], [0, np.cos(rx), np.sin(rx)],
-                             [np.sin(ry), -np.sin(rx) * np.cos(ry), np.cos(rx) * np.cos(ry)]])
+        e = np.column_stack(
+            [[1, 0, 0], [0, np.cos(rx), np.sin(rx)], [np.sin(ry), -np.sin(rx) * np.cos(ry), np.cos(rx) * np.cos(ry)]]
+        )
         expected = np.concatenate([wrench[:3], e.T @ wrench[3:]])
-        np.testing.assert_allclose(jacobian(pose).T @ f, expected, rtol=0,
-                                   atol=1e-9 * np.abs(wrench).max())
+        np.testing.assert_allclose(jacobian(pose).T @ f, expected, rtol=0, atol=1e-9 * np.abs(wrench).max())
 
 
 def test_static_forces_virtual_work():
@@ -402,8 +413,10 @@ def test_static_forces_virtual_work():
         dL = (my_strut_lengths(pose + delta)[0] - my_strut_lengths(pose - delta)[0]) / 2
         # Small rotation vector of the Euler-angle change, in the fixed frame.
         r0 = Rotation.from_euler("XYZ", pose[3:])
-        dphi = ((Rotation.from_euler("XYZ", pose[3:] + delta[3:]) * r0.inv()).as_rotvec()
-                - (Rotation.from_euler("XYZ", pose[3:] - delta[3:]) * r0.inv()).as_rotvec()) / 2
+        dphi = (
+            (Rotation.from_euler("XYZ", pose[3:] + delta[3:]) * r0.inv()).as_rotvec()
+            - (Rotation.from_euler("XYZ", pose[3:] - delta[3:]) * r0.inv()).as_rotvec()
+        ) / 2
         external = wrench[:3] @ delta[:3] + wrench[3:] @ dphi
         assert -f @ dL + external == pytest.approx(0.0, abs=1e-6 * abs(external))
 
@@ -440,8 +453,7 @@ def test_strut_min_time_formula():
     short = np.linspace(0, th, 50)
     np.testing.assert_allclose(strut_min_time(short), np.sqrt(2 * short / A_MAX), rtol=1e-14)
     long = np.linspace(th * 1.0001, 0.02, 50)
-    np.testing.assert_allclose(strut_min_time(long), (long - th) / V_MAX + V_MAX / A_MAX,
-                               rtol=1e-14)
+    np.testing.assert_allclose(strut_min_time(long), (long - th) / V_MAX + V_MAX / A_MAX, rtol=1e-14)
     # Continuous at the threshold (both branches give v/a there).
     at = float(strut_min_time(th))
     assert at == pytest.approx(V_MAX / A_MAX, rel=1e-14)
@@ -451,14 +463,17 @@ def test_strut_min_time_formula():
     assert np.all(np.diff(strut_min_time(np.linspace(0, 0.02, 2001))) > 0)
 
 
-@pytest.mark.parametrize("axis, delta, speed", [
-    (0, 0.010, 2_000e-6),
-    (1, -0.007, 2_000e-6),
-    (2, -0.0123, 2_000e-6),
-    (3, np.radians(0.5), np.radians(0.1146)),
-    (4, np.radians(-0.2), np.radians(0.1146)),
-    (5, np.radians(0.2), np.radians(0.1146)),
-])
+@pytest.mark.parametrize(
+    "axis, delta, speed",
+    [
+        (0, 0.010, 2_000e-6),
+        (1, -0.007, 2_000e-6),
+        (2, -0.0123, 2_000e-6),
+        (3, np.radians(0.5), np.radians(0.1146)),
+        (4, np.radians(-0.2), np.radians(0.1146)),
+        (5, np.radians(0.2), np.radians(0.1146)),
+    ],
+)
 def test_hexapod_space_min_time_pure_moves(axis, delta, speed):
     d = np.zeros(6)
     d[axis] = delta
@@ -570,8 +585,9 @@ def small_moves():
     rounding matters (odd tick counts need an extra tick)."""
     rng = np.random.default_rng(18)
     start = my_random_poses(rng, 12_000)
-    target = np.clip(start + rng.uniform(LOW, HIGH, size=start.shape) * 10 ** rng.uniform(
-        -5, -2.5, size=(len(start), 1)), LOW, HIGH)
+    target = np.clip(
+        start + rng.uniform(LOW, HIGH, size=start.shape) * 10 ** rng.uniform(-5, -2.5, size=(len(start), 1)), LOW, HIGH
+    )
     keep = in_stroke(target)
     return start[keep][:10_000], target[keep][:10_000]
 
@@ -590,8 +606,7 @@ def test_durations_equal_independent_time_optimum(random_moves, planned):
     optimum = optimal_strut_time(D).max(axis=1)
     free = 2 * moves.hexapod_half_time < optimum * (1 - 1e-9)
     assert free.sum() > 9000
-    np.testing.assert_allclose(2 * moves.profiles.half_time.max(axis=1)[free], optimum[free],
-                               rtol=1e-12)
+    np.testing.assert_allclose(2 * moves.profiles.half_time.max(axis=1)[free], optimum[free], rtol=1e-12)
     dur = moves.durations[free]
     assert np.all(dur >= optimum[free] * (1 - 1e-12))
     assert np.all(dur < optimum[free] + 2 * DT)
@@ -614,16 +629,24 @@ def test_hexapod_limit_sets_half_time(random_moves, planned):
     D = np.abs(planned[True].target - planned[True].start)
     disp = target - start
     w, v = np.radians(0.1146), 2_000e-6
-    t_hex = np.max(np.stack([np.hypot(disp[:, 0], disp[:, 1]) / v, np.abs(disp[:, 2]) / v,
-                             np.hypot(disp[:, 3], disp[:, 4]) / w, np.abs(disp[:, 5]) / w]),
-                   axis=0)
+    t_hex = np.max(
+        np.stack(
+            [
+                np.hypot(disp[:, 0], disp[:, 1]) / v,
+                np.abs(disp[:, 2]) / v,
+                np.hypot(disp[:, 3], disp[:, 4]) / w,
+                np.abs(disp[:, 5]) / w,
+            ]
+        ),
+        axis=0,
+    )
     np.testing.assert_allclose(planned[True].hexapod_half_time, t_hex, rtol=1e-13)
     half_own = optimal_strut_time(D) / 2
     t_i = np.maximum(half_own, t_hex[:, None])
     np.testing.assert_allclose(planned[False].profiles.half_time, t_i, rtol=1e-12)
-    np.testing.assert_allclose(planned[True].profiles.half_time,
-                               np.broadcast_to(t_i.max(axis=1, keepdims=True), D.shape),
-                               rtol=1e-12)
+    np.testing.assert_allclose(
+        planned[True].profiles.half_time, np.broadcast_to(t_i.max(axis=1, keepdims=True), D.shape), rtol=1e-12
+    )
     binding = t_hex > half_own.max(axis=1) * (1 + 1e-6)
     assert binding.sum() > 50
     dur = planned[True].durations[binding]
@@ -853,9 +876,11 @@ def test_short_long_boundary(sync):
         assert 2 * V_MAX / A_MAX * (1 - 1e-9) <= move.duration < 2 * V_MAX / A_MAX + 2 * DT
     assert max(durations) - min(durations) <= DT * (1 + 1e-9)
     for method in ("closed", "iteration"):
-        prof = solve_profiles(np.array([th - 1e-12, th, th + 1e-12]),
-                              strut_min_time(np.array([th - 1e-12, th, th + 1e-12])),
-                              method=method)
+        prof = solve_profiles(
+            np.array([th - 1e-12, th, th + 1e-12]),
+            strut_min_time(np.array([th - 1e-12, th, th + 1e-12])),
+            method=method,
+        )
         np.testing.assert_allclose(prof.accel, A_MAX, rtol=1e-6)
         assert np.all(prof.accel <= A_MAX * (1 + 1e-12))
 
@@ -897,14 +922,17 @@ def test_hexapod_limit_binds_in_sync_and_async():
 # =========================================================================== 4. bad input
 
 
-@pytest.mark.parametrize("axis, value, pattern", [
-    (0, 0.012, r"target x = 12000\.0 um is beyond its limit 11400\.0 um"),
-    (1, -0.0115, r"target y = -11500\.0 um is beyond its limit -11400\.0 um"),
-    (2, 0.0132, r"target z = 13200\.0 um is beyond its limit 13100\.0 um"),
-    (3, np.radians(0.4), r"target rx = 0\.4000 deg is beyond its limit 0\.3600 deg"),
-    (4, np.radians(-0.37), r"target ry = -0\.3700 deg is beyond its limit -0\.3600 deg"),
-    (5, np.radians(0.11), r"target rz = 0\.1100 deg is beyond its limit 0\.1000 deg"),
-])
+@pytest.mark.parametrize(
+    "axis, value, pattern",
+    [
+        (0, 0.012, r"target x = 12000\.0 um is beyond its limit 11400\.0 um"),
+        (1, -0.0115, r"target y = -11500\.0 um is beyond its limit -11400\.0 um"),
+        (2, 0.0132, r"target z = 13200\.0 um is beyond its limit 13100\.0 um"),
+        (3, np.radians(0.4), r"target rx = 0\.4000 deg is beyond its limit 0\.3600 deg"),
+        (4, np.radians(-0.37), r"target ry = -0\.3700 deg is beyond its limit -0\.3600 deg"),
+        (5, np.radians(0.11), r"target rz = 0\.1100 deg is beyond its limit 0\.1000 deg"),
+    ],
+)
 def test_pose_limit_errors(axis, value, pattern):
     target = np.zeros(6)
     target[axis] = value
@@ -965,22 +993,28 @@ def test_nan_pose_raises(where):
         strut_lengths(bad)
 
 
-@pytest.mark.parametrize("start, target", [
-    (np.zeros(6), np.zeros(5)),
-    (np.zeros(7), np.zeros(7)),
-    (np.zeros((2, 5)), np.zeros((2, 5))),
-    (np.zeros(()), np.zeros(6)),
-])
+@pytest.mark.parametrize(
+    "start, target",
+    [
+        (np.zeros(6), np.zeros(5)),
+        (np.zeros(7), np.zeros(7)),
+        (np.zeros((2, 5)), np.zeros((2, 5))),
+        (np.zeros(()), np.zeros(6)),
+    ],
+)
 def test_wrong_pose_shapes_raise(start, target):
     with pytest.raises(PlanningError):
         plan_moves(start, target)
 
 
-@pytest.mark.parametrize("start, target", [
-    (np.zeros(6), np.zeros(5)),
-    (np.zeros((2, 6)), np.zeros((3, 6))),
-    (np.zeros((2, 7)), np.zeros((2, 7))),
-])
+@pytest.mark.parametrize(
+    "start, target",
+    [
+        (np.zeros(6), np.zeros(5)),
+        (np.zeros((2, 6)), np.zeros((3, 6))),
+        (np.zeros((2, 7)), np.zeros((2, 7))),
+    ],
+)
 def test_wrong_strut_shapes_raise(start, target):
     with pytest.raises(PlanningError):
         plan_strut_moves(start, target)
@@ -998,8 +1032,7 @@ def test_three_dimensional_pose_batch_raises_planning_error():
 
 def test_mismatched_pose_displacement_raises_planning_error():
     with pytest.raises(PlanningError):
-        plan_strut_moves(np.zeros((2, 6)), np.full((2, 6), 1e-3),
-                         pose_displacement=np.zeros((3, 6)))
+        plan_strut_moves(np.zeros((2, 6)), np.full((2, 6), 1e-3), pose_displacement=np.zeros((3, 6)))
 
 
 def test_sample_before_start_holds_start():
@@ -1012,6 +1045,7 @@ def test_sample_before_start_holds_start():
 
 def test_bad_geometry_raises():
     from planbench.planners.hexapod import HexapodGeometry, HexapodLimits
+
     with pytest.raises(PlanningError):
         HexapodGeometry(BASE[:5], MIRROR[:5], PIVOT)
     with pytest.raises(PlanningError):

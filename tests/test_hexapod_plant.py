@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from model_diff import changed_fields
 from plant_model import assert_edits_only
-from planbench.planners import hexapod as hexapod_planner
-from planbench.planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
+
 from planbench import api, hexapod, runner, scenarios
 from planbench.params import ParamError
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("hexapod-sync-move")
@@ -26,9 +26,15 @@ ELEVATION = 45.0  # the scenarios' default
 GRAVITY = 9.81
 CAMERA_Z = 4.2584  # m: the camera's centre of mass from the rotation pivot, along the platform's z
 #: Every field off nominal at once, inside its range.
-EVERYTHING = dict(camera_mass_error=0.05, camera_com_offset=(0.01, -0.02, 0.03), base_pivot_radius_error=2e-4,
-                  platform_pivot_radius_error=-1e-4, drive_stiffness_error=-0.1, drive_force_scale=0.9,
-                  encoder_bias_um=(1.0, -2.0, 0.0, 3.0, 0.0, 0.5))
+EVERYTHING = dict(
+    camera_mass_error=0.05,
+    camera_com_offset=(0.01, -0.02, 0.03),
+    base_pivot_radius_error=2e-4,
+    platform_pivot_radius_error=-1e-4,
+    drive_stiffness_error=-0.1,
+    drive_force_scale=0.9,
+    encoder_bias_um=(1.0, -2.0, 0.0, 3.0, 0.0, 0.5),
+)
 
 
 def plant_model(**fields) -> mujoco.MjModel:
@@ -89,6 +95,7 @@ def _pivots(kind, dr):
         # The spatial tendons' spring lengths (no stiffness) default to their length at qpos0.
         out["tendon_lengthspring"] = {k: [plant.tendon_length0[k]] * 2 for k in range(6)}
         return out
+
     return edits
 
 
@@ -108,16 +115,27 @@ def _bias(nominal, plant):
     return {"actuator_biasprm": {0: bias[0], 5: bias[5]}}
 
 
-@pytest.mark.parametrize("fields, edits", [
-    (dict(camera_mass_error=0.1), _mass),
-    (dict(camera_com_offset=(0.02, -0.01, 0.05)), _com),
-    (dict(base_pivot_radius_error=1e-3), _pivots("base", 1e-3)),
-    (dict(platform_pivot_radius_error=-5e-4), _pivots("platform", -5e-4)),
-    (dict(drive_stiffness_error=0.2), _stiffness),
-    (dict(drive_force_scale=0.8), _force),
-    (dict(encoder_bias_um=(1.0, 0.0, 0.0, 0.0, 0.0, -2.0)), _bias),
-], ids=["camera_mass_error", "camera_com_offset", "base_pivot_radius_error", "platform_pivot_radius_error",
-        "drive_stiffness_error", "drive_force_scale", "encoder_bias_um"])
+@pytest.mark.parametrize(
+    "fields, edits",
+    [
+        (dict(camera_mass_error=0.1), _mass),
+        (dict(camera_com_offset=(0.02, -0.01, 0.05)), _com),
+        (dict(base_pivot_radius_error=1e-3), _pivots("base", 1e-3)),
+        (dict(platform_pivot_radius_error=-5e-4), _pivots("platform", -5e-4)),
+        (dict(drive_stiffness_error=0.2), _stiffness),
+        (dict(drive_force_scale=0.8), _force),
+        (dict(encoder_bias_um=(1.0, 0.0, 0.0, 0.0, 0.0, -2.0)), _bias),
+    ],
+    ids=[
+        "camera_mass_error",
+        "camera_com_offset",
+        "base_pivot_radius_error",
+        "platform_pivot_radius_error",
+        "drive_stiffness_error",
+        "drive_force_scale",
+        "encoder_bias_um",
+    ],
+)
 def test_a_field_changes_its_part_of_the_model_and_nothing_else(fields, edits):
     nominal = hexapod.physics._compiled(ELEVATION)
     plant = plant_model(**fields)
@@ -136,16 +154,19 @@ def test_the_plant_geometry_is_the_model_s():
         platform = model.site_pos[model.site(f"platform_pivot{i + 1}").id] + RUBIN_CAMERA.rotation_pivot
         np.testing.assert_allclose(geometry.base_pivots[i], base, rtol=0, atol=1e-15)
         np.testing.assert_allclose(geometry.platform_pivots[i], platform, rtol=0, atol=1e-15)
-        assert math.hypot(*geometry.base_pivots[i, :2]) - math.hypot(*RUBIN_CAMERA.base_pivots[i, :2]) == \
-            pytest.approx(7e-4, abs=1e-15)
+        assert math.hypot(*geometry.base_pivots[i, :2]) - math.hypot(*RUBIN_CAMERA.base_pivots[i, :2]) == pytest.approx(
+            7e-4, abs=1e-15
+        )
 
 
 def test_the_nominal_compile_stays_cached():
     hexapod.physics._compiled(ELEVATION)
     plant_model(camera_mass_error=0.02)  # a plant compiles its own model, not a nominal one
     before = hexapod.physics._compiled.cache_info()
-    models = [hexapod.HexapodPhysics.load(ELEVATION).model.ptr,
-              hexapod.HexapodPhysics.load(ELEVATION, hexapod.HexapodPlant()).model.ptr]
+    models = [
+        hexapod.HexapodPhysics.load(ELEVATION).model.ptr,
+        hexapod.HexapodPhysics.load(ELEVATION, hexapod.HexapodPlant()).model.ptr,
+    ]
     after = hexapod.physics._compiled.cache_info()
     assert after.misses == before.misses and after.hits == before.hits + 2
     assert all(changed_fields(hexapod.physics._compiled(ELEVATION), m) == {} for m in models)
@@ -171,8 +192,9 @@ def test_the_controller_gets_the_nominal_model_at_the_nominal_start():
     # The plant starts where its encoders read the start pose's strut positions, at rest.
     readings = hexapod_planner.strut_positions(np.zeros(6))
     np.testing.assert_allclose(context.observation["joint_positions"], readings, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(setup.physics.strut_positions(), readings - 1e-6 * np.array(EVERYTHING["encoder_bias_um"]),
-                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        setup.physics.strut_positions(), readings - 1e-6 * np.array(EVERYTHING["encoder_bias_um"]), rtol=0, atol=1e-12
+    )
     assert setup.physics.loop_closure_error() < 1e-9 and not setup.physics.data.qvel.any()
     assert "unknown" in context.sensors[0].bias
     assert setup.provenance.plant == hexapod.HexapodPlant(**EVERYTHING)
@@ -242,8 +264,10 @@ def test_a_camera_com_offset_adds_its_moment(nominal_hold):
 def test_a_softer_drive_deflects_more_under_the_same_load(nominal_hold):
     nominal, _ = nominal_hold
     result, setup = run(dict(drive_stiffness_error=-0.3), **HOLD)
+
     def deflection(r):
         return r.log.act[-1, :6] - r.log.qpos[-1, setup.physics.drive_qpos]
+
     # The same static force through 0.7 kp: the servo's deflection (set-point - the position
     # its loop reads, the motor's) / 0.7.
     np.testing.assert_allclose(deflection(result), deflection(nominal) / 0.7, rtol=2e-3)
@@ -289,8 +313,12 @@ def test_a_pivot_radius_error_puts_the_platform_where_its_geometry_does(nominal_
     target = setup.task.problem.target_pose
     lengths = hexapod_planner.strut_positions(target) + RUBIN_CAMERA.nominal_lengths
     true_pose, _ = hexapod_planner.forward_kinematics(lengths, geometry, initial=target)
-    miss = 1e6 * np.linalg.norm(hexapod_planner.pivot_positions(true_pose) - hexapod_planner.pivot_positions(target),
-                                axis=-1).max()
+    miss = (
+        1e6
+        * np.linalg.norm(
+            hexapod_planner.pivot_positions(true_pose) - hexapod_planner.pivot_positions(target), axis=-1
+        ).max()
+    )
     checks = {c.name: c for c in result.checks}
     nominal_floor = {c.name: c for c in nominal.checks}["pose_error_final"].value
     assert checks["pose_error_final"].value == pytest.approx(miss, abs=nominal_floor + 0.05)
@@ -315,9 +343,11 @@ def test_a_vector_element_out_of_its_range_is_refused_naming_it(key, data, exces
 
 
 def test_api_run_refuses_bad_plants_before_building():
-    for plant, words in [({"camera_mass_error": 0.2}, "plant.camera_mass_error = 0.2 fraction is outside"),
-                         ({"camera_com_offset": [0, 0]}, "plant.camera_com_offset has 2 values, not 3"),
-                         ({"payload_mass_error": 0.1}, "unknown parameter 'plant.payload_mass_error'")]:
+    for plant, words in [
+        ({"camera_mass_error": 0.2}, "plant.camera_mass_error = 0.2 fraction is outside"),
+        ({"camera_com_offset": [0, 0]}, "plant.camera_com_offset has 2 values, not 3"),
+        ({"payload_mass_error": 0.1}, "unknown parameter 'plant.payload_mass_error'"),
+    ]:
         with pytest.raises(ParamError) as refused:
             api.run("hexapod-sync-move", plant=plant)
         assert words in str(refused.value), str(refused.value)

@@ -13,20 +13,64 @@ import dataclasses
 import numpy as np
 import pytest
 
-from planbench import models
-from planbench import runner, scenarios
+from planbench import models, runner, scenarios
 from planbench.params import ParamError
 
 PINNED = {
-    'antenna-paper-motion': {'qpos': 252.34256240492317, 'qvel': 128.28624452325786, 'actuator_force': 20713686.967366107, 'ctrl': 127.9771675287166},
-    'antenna-sea-state': {'qpos': 264.0240670894295, 'qvel': 31.3026832596626, 'actuator_force': 15079585.390954917, 'ctrl': 31.193862731179948},
-    'fast-tracking': {'qpos': 5292.11026597701, 'qvel': 5.350335413100478, 'actuator_force': 17654107.002991028, 'ctrl': 30362.018840919285},
-    'fast-ra-scan': {'qpos': 5292.11026574644, 'qvel': 5.350331607808686, 'actuator_force': 17654107.00424168, 'ctrl': 30362.018839855256},
-    'fast-source-switch': {'qpos': 5292.110264382776, 'qvel': 5.35031396269065, 'actuator_force': 17654107.10910619, 'ctrl': 30362.01883910747},
-    'hexapod-sync-move': {'qpos': 592.1689425602143, 'qvel': 0.10496202700922959, 'actuator_force': 5920776.582194269, 'ctrl': 0.013786003990783786},
-    'hexapod-async-move': {'qpos': 592.1737896568366, 'qvel': 0.15913301070342056, 'actuator_force': 5923083.467612122, 'ctrl': 0.02200296249013369},
-    'loader-supply': {'qpos': 155.88961946411544, 'qvel': 132.0233743032341, 'actuator_force': 259827.5585538222, 'ctrl': 151.97080180492284},
-    'loader-direct': {'qpos': 158.2774618722995, 'qvel': 8.878348235051707, 'actuator_force': 241618.8591297445, 'ctrl': 10.663487705567412},
+    "antenna-paper-motion": {
+        "qpos": 252.34256240492317,
+        "qvel": 128.28624452325786,
+        "actuator_force": 20713686.967366107,
+        "ctrl": 127.9771675287166,
+    },
+    "antenna-sea-state": {
+        "qpos": 264.0240670894295,
+        "qvel": 31.3026832596626,
+        "actuator_force": 15079585.390954917,
+        "ctrl": 31.193862731179948,
+    },
+    "fast-tracking": {
+        "qpos": 5292.11026597701,
+        "qvel": 5.350335413100478,
+        "actuator_force": 17654107.002991028,
+        "ctrl": 30362.018840919285,
+    },
+    "fast-ra-scan": {
+        "qpos": 5292.11026574644,
+        "qvel": 5.350331607808686,
+        "actuator_force": 17654107.00424168,
+        "ctrl": 30362.018839855256,
+    },
+    "fast-source-switch": {
+        "qpos": 5292.110264382776,
+        "qvel": 5.35031396269065,
+        "actuator_force": 17654107.10910619,
+        "ctrl": 30362.01883910747,
+    },
+    "hexapod-sync-move": {
+        "qpos": 592.1689425602143,
+        "qvel": 0.10496202700922959,
+        "actuator_force": 5920776.582194269,
+        "ctrl": 0.013786003990783786,
+    },
+    "hexapod-async-move": {
+        "qpos": 592.1737896568366,
+        "qvel": 0.15913301070342056,
+        "actuator_force": 5923083.467612122,
+        "ctrl": 0.02200296249013369,
+    },
+    "loader-supply": {
+        "qpos": 155.88961946411544,
+        "qvel": 132.0233743032341,
+        "actuator_force": 259827.5585538222,
+        "ctrl": 151.97080180492284,
+    },
+    "loader-direct": {
+        "qpos": 158.2774618722995,
+        "qvel": 8.878348235051707,
+        "actuator_force": 241618.8591297445,
+        "ctrl": 10.663487705567412,
+    },
 }
 
 
@@ -45,8 +89,9 @@ def test_the_as_built_drives_are_another_plant():
     """The pins can fail: the as-built hexapod's log differs from the ideal one's."""
     scenario = scenarios.get("hexapod-sync-move")
     log = runner.simulate(scenario.build(scenario.resolve(duration=0.3)))
-    assert float(np.abs(log.actuator_force).sum()) != pytest.approx(PINNED["hexapod-sync-move"]["actuator_force"],
-                                                                    rel=1e-6)
+    assert float(np.abs(log.actuator_force).sum()) != pytest.approx(
+        PINNED["hexapod-sync-move"]["actuator_force"], rel=1e-6
+    )
 
 
 def _with_drive_train_errors():

@@ -10,14 +10,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from planbench import models
-from planbench.planners.errors import LimitError
-from planbench import runner, scenarios
+from planbench import models, runner, scenarios
 from planbench.drives import MOTOR_SUFFIX, TRANSMISSION_SUFFIX
 from planbench.loader import physics as loader_physics
 from planbench.loader.params import LoaderPlant
 from planbench.loader.physics import TRANSMISSIONS, LoaderPhysics
 from planbench.params import ParamError
+from planbench.planners.errors import LimitError
 
 NAMES = models.loader_spec().names
 
@@ -73,8 +72,11 @@ def test_the_start_holds_the_gravity_load_through_the_reducers(payload):
     set-point off the motor by tau / kp: 0.2 s with the set-points held move no joint by more
     than 1e-7 rad or m."""
     physics = LoaderPhysics.load(payload, drives="as-built")
-    q0 = scenarios.get("loader-supply").build(scenarios.get("loader-supply").resolve(duration=0.01)) \
+    q0 = (
+        scenarios.get("loader-supply")
+        .build(scenarios.get("loader-supply").resolve(duration=0.01))
         .task.problem.key_points[0]
+    )
     physics.set_start(q0)
     model, data = physics.model.ptr, physics.data.ptr
     gravity = data.qfrc_bias[[model.joint(n).dofadr[0] for n in NAMES]].copy()
@@ -83,8 +85,7 @@ def test_the_start_holds_the_gravity_load_through_the_reducers(payload):
         if math.isinf(t.stiffness):
             continue
         standoff = data.qpos[model.joint(name + MOTOR_SUFFIX).qposadr[0]] - q0[j]
-        assert standoff == pytest.approx(gravity[j] / t.stiffness + np.sign(gravity[j]) * t.backlash / 2,
-                                         rel=1e-8)
+        assert standoff == pytest.approx(gravity[j] / t.stiffness + np.sign(gravity[j]) * t.backlash / 2, rel=1e-8)
     assert abs(gravity[1]) > 1000.0  # N m: the shoulder does carry the arm
     mujoco.mj_step(model, data, nstep=400)
     np.testing.assert_allclose(physics.joint_positions(), q0, rtol=0, atol=1e-7)
@@ -149,8 +150,7 @@ def test_the_torque_check_judges_the_motors_demand_with_the_shell_and_the_rotors
 
 def test_the_plants_drive_train_errors_edit_their_elements():
     nominal = LoaderPhysics.load(drives="as-built").model.ptr
-    plant = LoaderPlant(friction_error=1.0, reducer_stiffness_error=-0.3, backlash_error=2.0,
-                        torque_constant_error=0.1)
+    plant = LoaderPlant(friction_error=1.0, reducer_stiffness_error=-0.3, backlash_error=2.0, torque_constant_error=0.1)
     model = LoaderPhysics.load(plant=plant, drives="as-built").model.ptr
     motor = model.joint("elbow" + MOTOR_SUFFIX).dofadr[0]
     tendon = model.tendon("elbow" + TRANSMISSION_SUFFIX).id

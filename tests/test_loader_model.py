@@ -3,7 +3,8 @@
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from planbench import models
 from planbench.planners.loader import forward_kinematics
@@ -29,8 +30,15 @@ def test_spec_matches_compiled_model(model):
 
 
 def test_masses_are_the_readme_values(model):
-    moving = {"carriage": 150.0, "upper_arm": 60.0, "forearm": 40.0, "wrist_pitch_link": 12.0,
-              "wrist_yaw_link": 8.0, "gripper": 15.0, "shell": 45.0}
+    moving = {
+        "carriage": 150.0,
+        "upper_arm": 60.0,
+        "forearm": 40.0,
+        "wrist_pitch_link": 12.0,
+        "wrist_yaw_link": 8.0,
+        "gripper": 15.0,
+        "shell": 45.0,
+    }
     for body, mass in moving.items():
         assert model.body(body).mass[0] == pytest.approx(mass), body
 

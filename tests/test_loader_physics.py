@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from planbench.planners.loader import direct_plan, supply_plan
 from planbench import runner, scenarios
-from planbench.loader.collision import clearance
-from planbench.loader import LoaderPhysics
 from planbench.controllers import ServoFeedforwardController
+from planbench.loader import LoaderPhysics
+from planbench.loader.collision import clearance
+from planbench.planners.loader import direct_plan, supply_plan
 
 
 def run(name, **options):
@@ -34,8 +34,15 @@ def test_supply_checks_hold(supply):
     result, _ = supply
     c = checks(result)
     assert result.passed, [x.to_json() for x in result.checks if not x.passed]
-    assert set(c) == {"keypoint_error", "tracking_error", "obstacle_contacts", "min_clearance",
-                      "joint_torque", "simulation_warnings", "controller_errors"}
+    assert set(c) == {
+        "keypoint_error",
+        "tracking_error",
+        "obstacle_contacts",
+        "min_clearance",
+        "joint_torque",
+        "simulation_warnings",
+        "controller_errors",
+    }
     assert c["obstacle_contacts"].value == 0
     assert c["min_clearance"].value > 0.05  # the planned path clears by ~6 cm
     assert c["keypoint_error"].value < 0.1 and c["joint_torque"].value < 1.0
@@ -135,8 +142,13 @@ def test_dm_control_environment_steps():
 
     env = loader_environment()
     ts = env.reset()
-    assert set(ts.observation) == {"joint_positions", "joint_velocities", "setpoints", "reference_positions",
-                                   "reference_velocities"}
+    assert set(ts.observation) == {
+        "joint_positions",
+        "joint_velocities",
+        "setpoints",
+        "reference_positions",
+        "reference_velocities",
+    }
     # The episode starts where a run starts: the model's keyframe, P2 to its 6 digits; the
     # motors' encoders read the reducers' deflection under gravity on top (1.1e-3 rad at most).
     np.testing.assert_allclose(ts.observation["joint_positions"], ts.observation["reference_positions"], atol=1.5e-3)

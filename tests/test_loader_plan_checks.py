@@ -8,15 +8,14 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from planbench import models
+from planbench import api, models, scenarios
+from planbench.loader import LoaderParams, problem
+from planbench.loader.collision import clearance
+from planbench.loader.plan_checks import _collision, judge_plans, judge_trajectory, random_key_points
 from planbench.planners.errors import PlanningError
 from planbench.planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, si_to_table1
 from planbench.planners.loader.bspline import CubicBSplineTrajectory
 from planbench.planners.trajectory import TrajectorySample
-from planbench import api, scenarios
-from planbench.loader import LoaderParams, problem
-from planbench.loader.collision import clearance
-from planbench.loader.plan_checks import _collision, judge_plans, judge_trajectory, random_key_points
 
 SPEC = models.loader_spec()
 LOW, HIGH = si_to_table1(SPEC.lower), si_to_table1(SPEC.upper)
@@ -27,8 +26,10 @@ def by_name(checks):
 
 
 def params_of(sets, key_interval=0.5):
-    return [LoaderParams(key_points=tuple(tuple(float(v) for v in row) for row in s), key_interval=key_interval)
-            for s in sets]
+    return [
+        LoaderParams(key_points=tuple(tuple(float(v) for v in row) for row in s), key_interval=key_interval)
+        for s in sets
+    ]
 
 
 def unlimited_spline(task):
@@ -53,8 +54,10 @@ def test_clearance_equals_the_clearance_of_the_runs_reference():
     values, _ = clearance(collision.model, reference, collision.robot, collision.obstacles)
     assert plan["plan_min_clearance"].value == values.min()
     assert plan["plan_min_clearance"].value == pytest.approx(run["min_clearance"].value, abs=5e-3)
-    assert (plan["plan_min_clearance"].limit, plan["plan_min_clearance"].comparison) == \
-        (run["min_clearance"].limit, run["min_clearance"].comparison)
+    assert (plan["plan_min_clearance"].limit, plan["plan_min_clearance"].comparison) == (
+        run["min_clearance"].limit,
+        run["min_clearance"].comparison,
+    )
     assert plan["plan_keypoint_error"].limit == run["keypoint_error"].limit
     assert plan["plan_keypoint_error"].value < 1e-9 <= run["keypoint_error"].value
 
@@ -102,18 +105,22 @@ def test_runs_side_by_side_are_each_runs_own_spline_bit_for_bit():
     for i, task in enumerate(tasks):
         alone = CubicBSplinePlanner().plan(task).sample(t)
         for part in ("position", "velocity", "acceleration"):
-            assert np.array_equal(getattr(together, part)[:, 6 * i:6 * i + 6], getattr(alone, part))
+            assert np.array_equal(getattr(together, part)[:, 6 * i : 6 * i + 6], getattr(alone, part))
 
 
 def test_batch_equals_one_at_a_time_bit_for_bit():
     rng = np.random.default_rng(9)
-    runs = (params_of(random_key_points(8, rng, spread_deg=3.0)) + params_of(random_key_points(4, rng))
-            + params_of(random_key_points(3, rng, keys=4, spread_deg=2.0), key_interval=0.6))
+    runs = (
+        params_of(random_key_points(8, rng, spread_deg=3.0))
+        + params_of(random_key_points(4, rng))
+        + params_of(random_key_points(3, rng, keys=4, spread_deg=2.0), key_interval=0.6)
+    )
     rng.shuffle(runs)
     for params, checks in zip(runs, judge_plans(runs), strict=True):
         [alone] = judge_plans([params])
-        assert [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in checks] == \
-            [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in alone]
+        assert [(c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in checks] == [
+            (c.name, float(c.value).hex(), c.limit, c.unit, c.note) for c in alone
+        ]
 
 
 # ----------------------------------------------------------------------------- bad plans fail
@@ -180,8 +187,10 @@ def test_key_points_whose_spline_leaves_the_joint_range_fail_with_the_planners_r
 def key_point_sets(draw):
     """2 to 5 key points inside the joint ranges (Table 1's units), a key interval."""
     n = draw(st.integers(2, 5))
-    points = [[draw(st.floats(float(lo), float(hi), allow_nan=False)) for lo, hi in zip(LOW, HIGH, strict=True)]
-              for _ in range(n)]
+    points = [
+        [draw(st.floats(float(lo), float(hi), allow_nan=False)) for lo, hi in zip(LOW, HIGH, strict=True)]
+        for _ in range(n)
+    ]
     return points, draw(st.sampled_from([0.3, 0.5, 1.0]))
 
 
@@ -226,17 +235,20 @@ def planner_accepts(params) -> bool:
     return True
 
 
-@pytest.mark.parametrize("slide_mm, overshoot_m, accepted", [
-    # Found by hypothesis: the slide's spline dips 7.8e-92 m below its limit 0; the planner
-    # refused it (its round-off tolerance scaled with the values: 1e-104) while joint_range's
-    # ratio rounded to exactly 1.0 and passed.
-    ([0.0, 0.0, 7.02e-88], 7.8e-92, True),
-    ([2e-88, 1e-88, 5e-89, 0.0, 2e-88], 1.5e-92, True),
-    # At the tolerance's scale: 8e-10 m is within JOINT_LIMIT_TOLERANCE, 1.1e-9 m is not.
-    ([0.0, 0.0, 7.2e-6], 8e-10, True),
-    ([0.0, 0.0, 9.9e-6], 1.1e-9, False),
-    ([0.0, 0.0, 0.01], 1.1e-6, False),
-])
+@pytest.mark.parametrize(
+    "slide_mm, overshoot_m, accepted",
+    [
+        # Found by hypothesis: the slide's spline dips 7.8e-92 m below its limit 0; the planner
+        # refused it (its round-off tolerance scaled with the values: 1e-104) while joint_range's
+        # ratio rounded to exactly 1.0 and passed.
+        ([0.0, 0.0, 7.02e-88], 7.8e-92, True),
+        ([2e-88, 1e-88, 5e-89, 0.0, 2e-88], 1.5e-92, True),
+        # At the tolerance's scale: 8e-10 m is within JOINT_LIMIT_TOLERANCE, 1.1e-9 m is not.
+        ([0.0, 0.0, 7.2e-6], 8e-10, True),
+        ([0.0, 0.0, 9.9e-6], 1.1e-9, False),
+        ([0.0, 0.0, 0.01], 1.1e-6, False),
+    ],
+)
 def test_the_planner_refuses_exactly_the_overshoots_joint_range_fails(slide_mm, overshoot_m, accepted):
     """One tolerance, ``JOINT_LIMIT_TOLERANCE`` (1 nm on the slide), for the planner's refusal
     and the check: an overshoot within it is accepted and joint_range passes (at most 1), one
@@ -270,8 +282,9 @@ def test_a_key_point_beyond_the_tolerance_is_refused_and_fails_joint_range():
         points = task.key_points.copy()
         points[:, 0] = 0.0
         points[1, 0] = slide_m
-        task = type(task)(task.key_times, points, task.labels, task.lower, task.upper,
-                          task.rate_limit, task.force_limit)
+        task = type(task)(
+            task.key_times, points, task.labels, task.lower, task.upper, task.rate_limit, task.force_limit
+        )
         try:
             trajectory = CubicBSplinePlanner().plan(task)
             ok = True
@@ -294,15 +307,19 @@ def near_limit_sets(draw):
     """2 to 5 key points whose values sit on the joint limits, just inside them, near zero
     (the slide's limit is 0: down to 1e-88 mm) or anywhere, so that the spline overshoots the
     limits by amounts on every scale from 1e-92 m to centimetres."""
+
     def value(j):
         lo, hi = float(LIMITS[j][0]), float(LIMITS[j][1])
         edge = draw(st.sampled_from([lo, hi]))
         inward = 1.0 if edge == lo else -1.0
-        return draw(st.one_of(
-            st.just(edge),
-            st.builds(lambda e, x: e + inward * x, st.just(edge),
-                      st.floats(1e-90, 1e-3, allow_subnormal=False)),
-            st.floats(lo, hi, allow_nan=False)))
+        return draw(
+            st.one_of(
+                st.just(edge),
+                st.builds(lambda e, x: e + inward * x, st.just(edge), st.floats(1e-90, 1e-3, allow_subnormal=False)),
+                st.floats(lo, hi, allow_nan=False),
+            )
+        )
+
     n = draw(st.integers(2, 5))
     return [[value(j) for j in range(6)] for _ in range(n)], draw(st.sampled_from([0.3, 0.5, 1.0]))
 

@@ -11,21 +11,26 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-from planbench import models
 from model_diff import changed_fields
 from plant_model import assert_edits_only
-from planbench.planners.loader import forward_kinematics, table1_to_si
-from planbench import api, loader, runner, scenarios
+
+from planbench import api, loader, models, runner, scenarios
 from planbench.params import ParamError
+from planbench.planners.loader import forward_kinematics, table1_to_si
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = scenarios.get("loader-supply")
 CHAIN = models.loader_spec()
 GRAVITY = 9.81
 #: Every field off nominal at once, inside its range.
-EVERYTHING = dict(payload_mass_error=0.08, arm_mass_error=-0.04, upper_arm_length_error=0.0015,
-                  joint_viscous_friction=0.05, drive_force_scale=0.9, encoder_bias=(0.5, 0.02, -0.03, 0.01, 0.0, 0.05))
+EVERYTHING = dict(
+    payload_mass_error=0.08,
+    arm_mass_error=-0.04,
+    upper_arm_length_error=0.0015,
+    joint_viscous_friction=0.05,
+    drive_force_scale=0.9,
+    encoder_bias=(0.5, 0.02, -0.03, 0.01, 0.0, 0.05),
+)
 
 
 def plant_model(payload_mass: float = 45.0, **fields) -> mujoco.MjModel:
@@ -63,15 +68,20 @@ def test_the_readme_documents_every_plant_field():
 def _payload(nominal, plant):
     shell = body(nominal, "shell")
     # Its mass and inertia scale; its centre of mass stays (to the round-off of the sums).
-    return {"body_mass": {shell: 45.0 * 1.1}, "body_inertia": {shell: 1.1 * nominal.body_inertia[shell]},
-            "body_ipos": {shell: nominal.body_ipos[shell]}}
+    return {
+        "body_mass": {shell: 45.0 * 1.1},
+        "body_inertia": {shell: 1.1 * nominal.body_inertia[shell]},
+        "body_ipos": {shell: nominal.body_ipos[shell]},
+    }
 
 
 def _arm(nominal, plant):
     rows = [body(nominal, n) for n in loader.ARM_BODIES]
     # Each link's mass and inertia scale; its centre of mass and principal axes stay.
-    return {"body_mass": {r: 1.05 * nominal.body_mass[r] for r in rows},
-            "body_inertia": {r: 1.05 * nominal.body_inertia[r] for r in rows}}
+    return {
+        "body_mass": {r: 1.05 * nominal.body_mass[r] for r in rows},
+        "body_inertia": {r: 1.05 * nominal.body_inertia[r] for r in rows},
+    }
 
 
 def _length(nominal, plant):
@@ -87,8 +97,11 @@ def _friction(nominal, plant):
 
 def _force(nominal, plant):
     rated = np.array([3000, 8000, 4000, 1000, 250, 60.0])
-    return {"actuator_forcerange": {nominal.actuator(n).id: [-0.8 * rated[j], 0.8 * rated[j]]
-                                    for j, n in enumerate(CHAIN.names)}}
+    return {
+        "actuator_forcerange": {
+            nominal.actuator(n).id: [-0.8 * rated[j], 0.8 * rated[j]] for j, n in enumerate(CHAIN.names)
+        }
+    }
 
 
 def _bias(nominal, plant):
@@ -102,15 +115,25 @@ def _bias(nominal, plant):
     return {"actuator_biasprm": rows}
 
 
-@pytest.mark.parametrize("fields, edits", [
-    (dict(payload_mass_error=0.1), _payload),
-    (dict(arm_mass_error=0.05), _arm),
-    (dict(upper_arm_length_error=0.002), _length),
-    (dict(joint_viscous_friction=0.1), _friction),
-    (dict(drive_force_scale=0.8), _force),
-    (dict(encoder_bias=(1.0, 0.05, 0.0, 0.0, 0.0, 0.0)), _bias),
-], ids=["payload_mass_error", "arm_mass_error", "upper_arm_length_error", "joint_viscous_friction",
-        "drive_force_scale", "encoder_bias"])
+@pytest.mark.parametrize(
+    "fields, edits",
+    [
+        (dict(payload_mass_error=0.1), _payload),
+        (dict(arm_mass_error=0.05), _arm),
+        (dict(upper_arm_length_error=0.002), _length),
+        (dict(joint_viscous_friction=0.1), _friction),
+        (dict(drive_force_scale=0.8), _force),
+        (dict(encoder_bias=(1.0, 0.05, 0.0, 0.0, 0.0, 0.0)), _bias),
+    ],
+    ids=[
+        "payload_mass_error",
+        "arm_mass_error",
+        "upper_arm_length_error",
+        "joint_viscous_friction",
+        "drive_force_scale",
+        "encoder_bias",
+    ],
+)
 def test_a_field_changes_its_part_of_the_model_and_nothing_else(fields, edits):
     nominal = models.load("loader")
     plant = plant_model(**fields)
@@ -122,9 +145,16 @@ def test_the_payload_error_is_relative_to_the_payload_the_controller_is_told():
     nominal = loader.LoaderPhysics.load(60.0).model.ptr
     plant = plant_model(60.0, payload_mass_error=-0.1)
     shell = body(nominal, "shell")
-    assert_edits_only(nominal, plant, {"body_mass": {shell: 54.0},
-                                       "body_inertia": {shell: 0.9 * nominal.body_inertia[shell]},
-                                       "body_ipos": {shell: nominal.body_ipos[shell]}}, roundoff=("bvh_aabb",))
+    assert_edits_only(
+        nominal,
+        plant,
+        {
+            "body_mass": {shell: 54.0},
+            "body_inertia": {shell: 0.9 * nominal.body_inertia[shell]},
+            "body_ipos": {shell: nominal.body_ipos[shell]},
+        },
+        roundoff=("bvh_aabb",),
+    )
 
 
 # ------------------------------------------------------------------ the controller keeps the nominal model
@@ -237,14 +267,19 @@ def test_a_longer_upper_arm_moves_the_shell_tip_the_evaluation_reports():
     theta2 = q[CHAIN.names.index("shoulder")]
     nominal_tip = forward_kinematics(q, ["shell_tip"])["shell_tip"].reshape(3)
     # The same joints put the tip 2 mm further along the upper arm (at theta2 above horizontal).
-    np.testing.assert_allclose(np.array(result.metrics["final_shell_tip_m"]) - nominal_tip,
-                               0.002 * np.array([np.cos(theta2), 0.0, np.sin(theta2)]), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        np.array(result.metrics["final_shell_tip_m"]) - nominal_tip,
+        0.002 * np.array([np.cos(theta2), 0.0, np.sin(theta2)]),
+        rtol=0,
+        atol=1e-12,
+    )
     # ... where MuJoCo's plant has it.
     data = mujoco.MjData(setup.physics.model.ptr)
     data.qpos[:] = result.log.qpos[-1]
     mujoco.mj_kinematics(setup.physics.model.ptr, data)
-    np.testing.assert_allclose(result.metrics["final_shell_tip_m"],
-                               data.site_xpos[setup.physics.model.ptr.site("shell_tip").id], atol=1e-12)
+    np.testing.assert_allclose(
+        result.metrics["final_shell_tip_m"], data.site_xpos[setup.physics.model.ptr.site("shell_tip").id], atol=1e-12
+    )
 
 
 # ------------------------------------------------------------------ bad values
@@ -261,9 +296,11 @@ def test_an_encoder_bias_out_of_its_range_names_the_joint(column, excess):
 
 
 def test_api_run_refuses_bad_plants_before_building():
-    for plant, words in [({"payload_mass_error": 0.5}, "plant.payload_mass_error = 0.5 fraction is outside"),
-                         ({"encoder_bias": [0, 0]}, "plant.encoder_bias has 2 values, not 6"),
-                         ({"payload_mass": 50}, "unknown parameter 'plant.payload_mass'")]:
+    for plant, words in [
+        ({"payload_mass_error": 0.5}, "plant.payload_mass_error = 0.5 fraction is outside"),
+        ({"encoder_bias": [0, 0]}, "plant.encoder_bias has 2 values, not 6"),
+        ({"payload_mass": 50}, "unknown parameter 'plant.payload_mass'"),
+    ]:
         with pytest.raises(ParamError) as refused:
             api.run("loader-supply", plant=plant)
         assert words in str(refused.value), str(refused.value)

@@ -17,9 +17,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from planbench import api, logfile, outputs, pipeline, run_limits, runner, scenarios
+from planbench import api, logfile, outputs, run_limits, runner, scenarios
 from planbench.cli import main
 from planbench.logfile import ChunkWriter, read_log
 
@@ -59,8 +60,12 @@ def test_a_block_row_is_its_arrays_side_by_side(tmp_path):
 
 
 @settings(max_examples=60, deadline=None)
-@given(n=st.integers(1, 40), chunk=st.integers(1, 9), history=st.integers(0, 4),
-       block=st.sampled_from([(), ("qpos", "act", "mocap_pos"), ("mocap_pos", "qpos")]))
+@given(
+    n=st.integers(1, 40),
+    chunk=st.integers(1, 9),
+    history=st.integers(0, 4),
+    block=st.sampled_from([(), ("qpos", "act", "mocap_pos"), ("mocap_pos", "qpos")]),
+)
 def test_every_row_arrives_at_every_chunk_boundary(tmp_path_factory, n, chunk, history, block):
     path = tmp_path_factory.mktemp("log") / "log.arrow"
     _write(path, n, chunk, history, block=block)
@@ -88,7 +93,7 @@ def test_a_temporary_log_s_rows_and_spans(n, chunk, start, length):
     log = writer.read_back(n)
     assert log.complete and log.n == n and not writer.path.exists()
     for name in ("qpos", "mocap_pos", "act", "t"):
-        np.testing.assert_array_equal(log.span(name, start, start + length), log.column(name)[start:start + length])
+        np.testing.assert_array_equal(log.span(name, start, start + length), log.column(name)[start : start + length])
     np.testing.assert_array_equal(log.column("qpos")[:, 1], -np.arange(n))
 
 
@@ -105,8 +110,9 @@ def test_a_timeseries_copied_from_the_log_is_savez_s(tmp_path_factory, n, chunk,
     folder = tmp_path_factory.mktemp("npz")
     names = ("t", "qpos", "act", "mocap_pos")
     series = {"names": np.array(["a", "bc"]), "series": np.arange(7.0) / 3}
-    outputs.save_timeseries(folder / "streamed.npz", {**{k: outputs._StridedLog(log, k, stride) for k in names},
-                                                      **series})
+    outputs.save_timeseries(
+        folder / "streamed.npz", {**{k: outputs._StridedLog(log, k, stride) for k in names}, **series}
+    )
     np.savez_compressed(folder / "whole.npz", **{k: log.file.column(k)[::stride] for k in names}, **series)
     streamed, whole = np.load(folder / "streamed.npz"), np.load(folder / "whole.npz")
     assert list(streamed.keys()) == list(whole.keys())
@@ -163,8 +169,16 @@ def test_the_streamed_log_is_the_state_at_every_tick(monkeypatch, tmp_path, name
 
     def stepping(model, data, nstep=1):
         step(model, data, nstep=nstep)
-        seen.append((data.qpos.copy(), data.qvel.copy(), data.act.copy(), data.actuator_force.copy(),
-                     data.sensordata.copy(), data.ctrl.copy()))
+        seen.append(
+            (
+                data.qpos.copy(),
+                data.qvel.copy(),
+                data.act.copy(),
+                data.actuator_force.copy(),
+                data.sensordata.copy(),
+                data.ctrl.copy(),
+            )
+        )
 
     setup = _setup(name, duration=0.405)  # 81 ticks after the start (5 ms ticks)
     monkeypatch.setattr(runner.mujoco, "mj_step", stepping)
@@ -230,6 +244,7 @@ def test_a_run_without_outputs_leaves_no_log_behind(tmp_path, monkeypatch):
 
 # ---------------------------------------------------------------- a killed run, end to end
 
+
 def _staged_log(parent: Path):
     for entry in parent.glob(outputs.STAGING_PREFIX + "*"):
         if (entry / "log.arrow").is_file():
@@ -243,9 +258,25 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
     to the first rows of the same run completed."""
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    proc = subprocess.Popen([sys.executable, "-m", "planbench.cli", "run", "loader-supply", "--duration", "200",
-                             "--out", str(out), "--quiet"], env=env, cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "planbench.cli",
+            "run",
+            "loader-supply",
+            "--duration",
+            "200",
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         child = None
         while proc.poll() is None:
@@ -273,8 +304,8 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
     assert summary["log"]["ticks"] == log.n
     assert _staged_log(tmp_path) is None  # nothing left beside the output
     full = runner.simulate(_setup(duration=log.n * 0.005))
-    np.testing.assert_array_equal(log.column("qpos"), full.qpos[:log.n])
-    np.testing.assert_array_equal(log.column("ctrl"), full.ctrl[:log.n])
+    np.testing.assert_array_equal(log.column("qpos"), full.qpos[: log.n])
+    np.testing.assert_array_equal(log.column("ctrl"), full.ctrl[: log.n])
 
 
 def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path):
@@ -283,9 +314,27 @@ def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path)
     readable, incomplete, equal to the first rows of the same run completed."""
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    proc = subprocess.run([sys.executable, "-m", "planbench.cli", "run", "loader-supply", "--duration", "300",
-                           "--timeout", "5", "--out", str(out), "--quiet"], env=env, cwd=tmp_path,
-                          capture_output=True, text=True, timeout=180)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "planbench.cli",
+            "run",
+            "loader-supply",
+            "--duration",
+            "300",
+            "--timeout",
+            "5",
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        env=env,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
     assert proc.returncode == 1, proc.stderr
     assert "passed its time limit" in proc.stderr
     summary = json.loads((out / "summary.json").read_text())
@@ -296,10 +345,11 @@ def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path)
     assert _staged_log(tmp_path) is None  # nothing left beside the output
     if log.n:
         full = runner.simulate(_setup(duration=log.n * 0.005))
-        np.testing.assert_array_equal(log.column("qpos"), full.qpos[:log.n])
+        np.testing.assert_array_equal(log.column("qpos"), full.qpos[: log.n])
 
 
 # ---------------------------------------------------------------- the disk-space refusal
+
 
 def test_a_log_beyond_the_free_space_is_refused_with_one_line(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(run_limits, "free_bytes", lambda directory: 10 * 2**20)
@@ -316,16 +366,19 @@ def test_the_output_location_is_checked_before_the_first_step(tmp_path, monkeypa
     """The parameters pass against the current directory; the output's file system is full."""
     small = tmp_path / "small"
     small.mkdir()
-    monkeypatch.setattr(run_limits, "free_bytes",
-                        lambda directory: 2**20 if Path(directory) == small else 2**40)
+    monkeypatch.setattr(run_limits, "free_bytes", lambda directory: 2**20 if Path(directory) == small else 2**40)
     monkeypatch.setattr(runner, "simulate", lambda *a, **k: pytest.fail("simulated"))
-    with pytest.raises(run_limits.RunLimitError, match=rf"more than the limit of 1 MiB \(the free space on the file "
-                                                        rf"system of {small}\)"):
+    with pytest.raises(
+        run_limits.RunLimitError,
+        match=rf"more than the limit of 1 MiB \(the free space on the file "
+        rf"system of {small}\)",
+    ):
         api.run("loader-supply", params={"duration": 20}, out=small / "out")
     assert list(small.iterdir()) == []
 
 
 # ---------------------------------------------------------------- evaluation by chunks
+
 
 def test_fast_checks_do_not_depend_on_the_chunks(tmp_path):
     """FAST's evaluation reads the log a chunk at a time: with 7-tick chunks and every 3rd row
@@ -340,8 +393,7 @@ def test_fast_checks_do_not_depend_on_the_chunks(tmp_path):
     chunked = evaluation.evaluate(log)
     series = evaluation.timeseries(log)
     assert not any(log.held(name) for name in logfile.ARRAYS)  # never read whole
-    whole = runner.RunLog(**{name: log.file.column(name) for name in ("t", *logfile.ARRAYS)},
-                          reference=log.reference)
+    whole = runner.RunLog(**{name: log.file.column(name) for name in ("t", *logfile.ARRAYS)}, reference=log.reference)
     held = evaluation.evaluate(whole)
     assert [c.to_json() for c in chunked[0]] == [c.to_json() for c in held[0]]
     assert json.dumps(chunked[1], sort_keys=True) == json.dumps(held[1], sort_keys=True)

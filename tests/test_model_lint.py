@@ -21,11 +21,16 @@ def test_compiles_with_home_keyframe_and_cameras(model):
 
 def test_every_element_is_named(model):
     kinds = {
-        "body": (model.nbody, model.body), "joint": (model.njnt, model.joint),
-        "geom": (model.ngeom, model.geom), "site": (model.nsite, model.site),
-        "actuator": (model.nu, model.actuator), "sensor": (model.nsensor, model.sensor),
-        "camera": (model.ncam, model.camera), "light": (model.nlight, model.light),
-        "equality": (model.neq, model.equality), "tendon": (model.ntendon, model.tendon),
+        "body": (model.nbody, model.body),
+        "joint": (model.njnt, model.joint),
+        "geom": (model.ngeom, model.geom),
+        "site": (model.nsite, model.site),
+        "actuator": (model.nu, model.actuator),
+        "sensor": (model.nsensor, model.sensor),
+        "camera": (model.ncam, model.camera),
+        "light": (model.nlight, model.light),
+        "equality": (model.neq, model.equality),
+        "tendon": (model.ntendon, model.tendon),
     }
     for kind, (count, get) in kinds.items():
         start = 1 if kind == "body" else 0  # body 0 is the world

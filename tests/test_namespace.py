@@ -36,8 +36,14 @@ def _environment(path: Path | None = None) -> dict:
 
 
 def _planbench(*args, cwd: Path, path: Path | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "planbench.cli", *map(str, args)], cwd=cwd,
-                          env=_environment(path), capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "planbench.cli", *map(str, args)],
+        cwd=cwd,
+        env=_environment(path),
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -49,9 +55,24 @@ def wheel(tmp_path_factory) -> Path:
     for folder in ("sims", "planners", "models"):
         shutil.copytree(ROOT / folder, source / folder, ignore=shutil.ignore_patterns("__pycache__"))
     dist = tmp_path_factory.mktemp("dist")
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "--no-build-isolation",
-                    "--no-index", "--wheel-dir", str(dist), str(source)], check=True, capture_output=True,
-                   timeout=300)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            "--quiet",
+            "--no-deps",
+            "--no-build-isolation",
+            "--no-index",
+            "--wheel-dir",
+            str(dist),
+            str(source),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
     [built] = dist.glob("planbench-*.whl")
     return built
 
@@ -61,9 +82,14 @@ def test_the_wheel_holds_planbench_alone_at_the_top_level(wheel, tmp_path):
     version = planbench.__version__
     assert {name.split("/")[0] for name in names} == {"planbench", f"planbench-{version}.dist-info"}
     # The package data and every mechanism's packages are in it, under their planbench names.
-    for path in ("planbench/models/loader/scene.xml", "planbench/models/fast/assets/reflector.obj",
-                 "planbench/planners/hexapod/__init__.py", "planbench/fast/measurement.py",
-                 "planbench/campaign/worker.py", "planbench/py.typed"):
+    for path in (
+        "planbench/models/loader/scene.xml",
+        "planbench/models/fast/assets/reflector.obj",
+        "planbench/planners/hexapod/__init__.py",
+        "planbench/fast/measurement.py",
+        "planbench/campaign/worker.py",
+        "planbench/py.typed",
+    ):
         assert path in names, path
     # Every package folder of the project is one of the wheel's (pyproject.toml lists them).
     prefixes = {"sims": "planbench", "planners": "planbench/planners", "models": "planbench/models"}
@@ -73,8 +99,23 @@ def test_the_wheel_holds_planbench_alone_at_the_top_level(wheel, tmp_path):
             assert f"{prefix}/{relative}" in names, f"{init.relative_to(ROOT)} is missing from the wheel"
     # Installed (without its dependencies, which are this environment's), the same: one name.
     target = tmp_path / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-index",
-                    "--target", str(target), str(wheel)], check=True, capture_output=True, timeout=300)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--no-deps",
+            "--no-index",
+            "--target",
+            str(target),
+            str(wheel),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
     top = {p.name for p in target.iterdir()} - {"bin"}
     assert top == {"planbench", f"planbench-{version}.dist-info"}
 
@@ -91,9 +132,19 @@ def test_users_packages_called_models_sims_and_planners_do_not_disturb_a_run(tmp
         "from planbench.loader.controller import reference_controller\n\n"
         "assert models.OWNER == 'the user', models\n\n"
         "def make():\n"
-        "    return reference_controller()\n")
-    proc = _planbench("run", "loader-supply", "--controller", "mine.py:make", "--out", tmp_path / "out",
-                      "--quiet", cwd=tmp_path, path=tmp_path)
+        "    return reference_controller()\n"
+    )
+    proc = _planbench(
+        "run",
+        "loader-supply",
+        "--controller",
+        "mine.py:make",
+        "--out",
+        tmp_path / "out",
+        "--quiet",
+        cwd=tmp_path,
+        path=tmp_path,
+    )
     assert proc.returncode == 0, proc.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["passed"] and summary["plugins"] == {"controller": "mine.py:make"}
@@ -101,21 +152,25 @@ def test_users_packages_called_models_sims_and_planners_do_not_disturb_a_run(tmp
 
 def test_planbench_imports_no_old_top_level_name(tmp_path):
     # Every module of planbench imported: none of the old top-level names comes with them.
-    code = ("import pkgutil, importlib, sys\n"
-            "import planbench\n"
-            "for m in pkgutil.walk_packages(planbench.__path__, 'planbench.'):\n"
-            "    importlib.import_module(m.name)\n"
-            f"old = sorted(n for n in sys.modules if n.split('.')[0] in {OLD_NAMES!r})\n"
-            "print(len(sys.modules), old)\n"
-            "assert not old, old\n")
-    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True,
-                          text=True, timeout=300)
+    code = (
+        "import pkgutil, importlib, sys\n"
+        "import planbench\n"
+        "for m in pkgutil.walk_packages(planbench.__path__, 'planbench.'):\n"
+        "    importlib.import_module(m.name)\n"
+        f"old = sorted(n for n in sys.modules if n.split('.')[0] in {OLD_NAMES!r})\n"
+        "print(len(sys.modules), old)\n"
+        "assert not old, old\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True, text=True, timeout=300
+    )
     assert proc.returncode == 0, proc.stderr
 
 
-@pytest.mark.parametrize("old, new", [("planners.trajectory", "planbench.planners"),
-                                      ("sims.task", "planbench"),
-                                      ("models", "planbench.models")])
+@pytest.mark.parametrize(
+    "old, new",
+    [("planners.trajectory", "planbench.planners"), ("sims.task", "planbench"), ("models", "planbench.models")],
+)
 def test_a_plugin_with_an_old_name_gets_one_line_with_the_new_one(tmp_path, old, new):
     (tmp_path / "old_style.py").write_text(f"import {old}\n\ndef make():\n    return None\n")
     for spec in ("old_style.py:make", f"{old}:make"):

@@ -26,8 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def planbench(*args, cwd=None, **kwargs) -> subprocess.CompletedProcess:
-    return subprocess.run(PLANBENCH + [str(a) for a in args], capture_output=True, text=True,
-                          cwd=cwd or ROOT, **kwargs)
+    return subprocess.run(PLANBENCH + [str(a) for a in args], capture_output=True, text=True, cwd=cwd or ROOT, **kwargs)
 
 
 def snapshot(directory: Path) -> dict:
@@ -56,8 +55,10 @@ def test_user_directory_survives_run_and_plan(tmp_path, capsys):
     mine.mkdir()
     (mine / "notes.txt").write_text("my thesis")
     before = snapshot(tmp_path)
-    for argv in (["run", "loader-supply", "--duration", "0.3", "--quiet", "--out", str(mine)],
-                 ["plan", "loader-supply", "--out", str(mine)]):
+    for argv in (
+        ["run", "loader-supply", "--duration", "0.3", "--quiet", "--out", str(mine)],
+        ["plan", "loader-supply", "--out", str(mine)],
+    ):
         assert main(argv) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and str(mine) in err[0] and "did not write it" in err[0]
@@ -80,10 +81,16 @@ def test_a_file_added_to_a_planbench_directory_protects_it(tmp_path, capsys):
         OutputDir(out)
 
 
-@pytest.mark.parametrize("raw, why", [
-    (".", "is the current directory"), ("", "is empty"), ("/", "root"), ("..", "holds the current directory"),
-    ("~", "home directory"),
-])
+@pytest.mark.parametrize(
+    "raw, why",
+    [
+        (".", "is the current directory"),
+        ("", "is empty"),
+        ("/", "root"),
+        ("..", "holds the current directory"),
+        ("~", "home directory"),
+    ],
+)
 def test_refused_targets(raw, why, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(OutputError, match=why):
@@ -133,10 +140,21 @@ def test_every_accepted_video_suffix_is_written_and_tagged(suffix, tmp_path):
 
     model = mujoco.MjModel.from_xml_string(
         '<mujoco><visual><global offwidth="64" offheight="48"/></visual><worldbody>'
-        '<camera name="overview" pos="0 0 1"/><geom size=".1"/></worldbody></mujoco>')
+        '<camera name="overview" pos="0 0 1"/><geom size=".1"/></worldbody></mujoco>'
+    )
     n = 4
-    log = RunLog(t=np.arange(n) / 30, qpos=np.zeros((n, 0)), qvel=np.zeros((n, 0)), act=None, ctrl=None,
-                 actuator_force=None, sensordata=None, mocap_pos=None, mocap_quat=None, reference=None)
+    log = RunLog(
+        t=np.arange(n) / 30,
+        qpos=np.zeros((n, 0)),
+        qvel=np.zeros((n, 0)),
+        act=None,
+        ctrl=None,
+        actuator_force=None,
+        sensordata=None,
+        mocap_pos=None,
+        mocap_quat=None,
+        reference=None,
+    )
     path = tmp_path / f"v{suffix}"
     assert render_video(model, log, path, width=64, height=48) == n
     assert path.stat().st_size > 0 and outputs.is_planbench_video(path)
@@ -163,8 +181,9 @@ def test_reader_never_finds_summary_missing(exchange, tmp_path, monkeypatch):
     monkeypatch.setattr(outputs, "USE_EXCHANGE", exchange)
     out = tmp_path / "run"
     write_dummy(OutputDir(out), "0")
-    reader = subprocess.Popen([sys.executable, "-c", _reader_script(out / "summary.json", 3.0)],
-                              stdout=subprocess.PIPE, text=True)
+    reader = subprocess.Popen(
+        [sys.executable, "-c", _reader_script(out / "summary.json", 3.0)], stdout=subprocess.PIPE, text=True
+    )
     time.sleep(0.3)  # the reader is polling
     seen = []
     for i in range(1, 21):
@@ -207,9 +226,14 @@ def test_two_concurrent_cli_runs_do_not_both_succeed(tmp_path):
 
 
 def _start_video_run(out: Path) -> subprocess.Popen:
-    return subprocess.Popen(PLANBENCH + ["run", "loader-supply", "--quiet", "--out", str(out), "--video",
-                                         str(out / "v.mp4")], cwd=ROOT, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    return subprocess.Popen(
+        PLANBENCH + ["run", "loader-supply", "--quiet", "--out", str(out), "--video", str(out / "v.mp4")],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
 
 
 def _wait_for_ffmpeg(proc: subprocess.Popen, timeout: float = 120.0) -> None:
@@ -347,8 +371,9 @@ def test_the_old_output_loses_only_its_listed_files(exchange, tmp_path, monkeypa
     (out / "late.txt").write_text("mine")
     new = outputs._new_staging(tmp_path, "run")
     (new / "summary.json").write_text(json.dumps({"run": "new"}))
-    (new / MANIFEST).write_text(json.dumps({"written_by": "planbench", "target": "run",
-                                            "files": ["summary.json", MANIFEST]}))
+    (new / MANIFEST).write_text(
+        json.dumps({"written_by": "planbench", "target": "run", "files": ["summary.json", MANIFEST]})
+    )
     (new / outputs.STAGING_MARKER).unlink()
     outputs.swap_in(new, out)
     assert json.loads((out / "summary.json").read_text()) == {"run": "new"}
@@ -402,8 +427,9 @@ def test_deleting_the_old_output_never_follows_a_link(exchange, tmp_path, monkey
     out, elsewhere = _output_with_a_linked_folder(tmp_path)
     new = outputs._new_staging(tmp_path, "run")
     (new / "summary.json").write_text("{}")
-    (new / MANIFEST).write_text(json.dumps({"written_by": "planbench", "target": "run",
-                                            "files": ["summary.json", MANIFEST]}))
+    (new / MANIFEST).write_text(
+        json.dumps({"written_by": "planbench", "target": "run", "files": ["summary.json", MANIFEST]})
+    )
     (new / outputs.STAGING_MARKER).unlink()
     outputs.swap_in(new, out)
     assert (elsewhere / "v.mp4").read_bytes() == b"the user's"

@@ -17,14 +17,32 @@ from planbench.plans import write_plan
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 RUNS = {  # short runs (s): every array and metric is written whatever the duration
-    "loader-supply": 0.2, "loader-direct": 0.2, "hexapod-sync-move": 0.2, "hexapod-async-move": 0.2,
-    "antenna-paper-motion": 0.2, "antenna-sea-state": 0.2,
-    "fast-tracking": 0.2, "fast-ra-scan": 0.2, "fast-source-switch": 0.2,
+    "loader-supply": 0.2,
+    "loader-direct": 0.2,
+    "hexapod-sync-move": 0.2,
+    "hexapod-async-move": 0.2,
+    "antenna-paper-motion": 0.2,
+    "antenna-sea-state": 0.2,
+    "fast-tracking": 0.2,
+    "fast-ra-scan": 0.2,
+    "fast-source-switch": 0.2,
 }
-MOVE_LIST = {"duration": 0.2, "moves": [{"target": [0.1, 0, 0, 0, 0, 0], "synchronous": True},
-                                        {"target": [0, 0.1, 0, 0, 0, 0], "synchronous": False}]}
-PLANS = ["loader-supply", "hexapod-sync-move", "antenna-paper-motion", "fast-tracking", "fast-ra-scan",
-         "fast-dec-scan", "fast-source-switch"]
+MOVE_LIST = {
+    "duration": 0.2,
+    "moves": [
+        {"target": [0.1, 0, 0, 0, 0, 0], "synchronous": True},
+        {"target": [0, 0.1, 0, 0, 0, 0], "synchronous": False},
+    ],
+}
+PLANS = [
+    "loader-supply",
+    "hexapod-sync-move",
+    "antenna-paper-motion",
+    "fast-tracking",
+    "fast-ra-scan",
+    "fast-dec-scan",
+    "fast-source-switch",
+]
 
 
 def documented() -> set[str]:
@@ -70,8 +88,11 @@ def test_the_section_lists_every_scenario_of_the_registry():
     assert set(PLANS) >= {"fast-dec-scan"} and set(PLANS) <= set(runs) | set(plans)
 
 
-@pytest.mark.parametrize("name, params", [(n, {"duration": d}) for n, d in RUNS.items()]
-                         + [("hexapod-sync-move", MOVE_LIST)], ids=[*RUNS, "hexapod-move-list"])
+@pytest.mark.parametrize(
+    "name, params",
+    [(n, {"duration": d}) for n, d in RUNS.items()] + [("hexapod-sync-move", MOVE_LIST)],
+    ids=[*RUNS, "hexapod-move-list"],
+)
 def test_every_run_output_is_documented(tmp_path, name, params):
     out = tmp_path / "run"
     api.run(name, params=params, out=out)
@@ -103,5 +124,6 @@ def test_every_plan_output_is_documented(tmp_path, name):
 
 
 def test_an_undocumented_array_fails():
-    assert undocumented({("timeseries.npz", "q_planned"), ("timeseries.npz", "undocumented_array")}) == \
-        ["timeseries.npz: undocumented_array"]
+    assert undocumented({("timeseries.npz", "q_planned"), ("timeseries.npz", "undocumented_array")}) == [
+        "timeseries.npz: undocumented_array"
+    ]

@@ -15,7 +15,7 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 
-PLUGIN = textwrap.dedent('''
+PLUGIN = textwrap.dedent("""
     import os, sys, time
 
     MODE = os.environ["PB_MODE"]
@@ -75,12 +75,19 @@ PLUGIN = textwrap.dedent('''
         if WHERE == "factory":
             act()
         return Planner()
-''')
+""")
 
 MODES = ("raise", "exit0", "exit3", "os_exit0", "sleep")
 #: (where, role): where the fault is, and which plug-in carries it.
-PLACES = (("import", "controller"), ("factory", "controller"), ("reset", "controller"), ("call", "controller"),
-          ("factory", "planner"), ("plan", "planner"), ("sample", "planner"))
+PLACES = (
+    ("import", "controller"),
+    ("factory", "controller"),
+    ("reset", "controller"),
+    ("call", "controller"),
+    ("factory", "planner"),
+    ("plan", "planner"),
+    ("sample", "planner"),
+)
 #: The wall-time limit of a hanging plug-in's run (s): the limit is what ends it.
 TIMEOUT_S = 4
 #: The limit of the other faults' runs (s), never reached: a run slowed by a busy machine is
@@ -97,8 +104,14 @@ def expected_exit(where: str, mode: str) -> int:
 
 
 def planbench(*args, env=None, cwd=None, timeout=120):
-    return subprocess.run([sys.executable, "-m", "planbench.cli", *map(str, args)], capture_output=True, text=True,
-                          env={**os.environ, **(env or {})}, cwd=cwd, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "planbench.cli", *map(str, args)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **(env or {})},
+        cwd=cwd,
+        timeout=timeout,
+    )
 
 
 def leftovers(directory: Path) -> list[str]:
@@ -110,10 +123,21 @@ def leftovers(directory: Path) -> list[str]:
 def test_every_plugin_fault_has_a_verdict_and_leaves_nothing_behind(tmp_path, where, role, mode):
     (tmp_path / "faulty.py").write_text(PLUGIN)
     out = tmp_path / "out"
-    proc = planbench("run", "loader-supply", f"--{role}", f"faulty.py:{role}", "--out", out, "--quiet",
-                     "--duration", "0.2", "--timeout", TIMEOUT_S if mode == "sleep" else LIMIT_NOT_REACHED_S,
-                     env={"PB_MODE": mode, "PB_WHERE": where},
-                     cwd=tmp_path)
+    proc = planbench(
+        "run",
+        "loader-supply",
+        f"--{role}",
+        f"faulty.py:{role}",
+        "--out",
+        out,
+        "--quiet",
+        "--duration",
+        "0.2",
+        "--timeout",
+        TIMEOUT_S if mode == "sleep" else LIMIT_NOT_REACHED_S,
+        env={"PB_MODE": mode, "PB_WHERE": where},
+        cwd=tmp_path,
+    )
     assert proc.returncode == expected_exit(where, mode), (proc.returncode, proc.stdout, proc.stderr)
     assert "Traceback" not in proc.stderr, proc.stderr
     lines = proc.stderr.splitlines()
@@ -139,9 +163,19 @@ def test_every_plugin_fault_has_a_verdict_and_leaves_nothing_behind(tmp_path, wh
 def test_a_run_without_faults_still_passes_under_supervision(tmp_path):
     """The supervision itself is no fault: the same plug-in, doing nothing wrong, passes."""
     (tmp_path / "faulty.py").write_text(PLUGIN)
-    proc = planbench("run", "loader-supply", "--controller", "faulty.py:controller", "--planner", "faulty.py:planner",
-                     "--out", tmp_path / "out", "--quiet", env={"PB_MODE": "none", "PB_WHERE": "nowhere"},
-                     cwd=tmp_path)
+    proc = planbench(
+        "run",
+        "loader-supply",
+        "--controller",
+        "faulty.py:controller",
+        "--planner",
+        "faulty.py:planner",
+        "--out",
+        tmp_path / "out",
+        "--quiet",
+        env={"PB_MODE": "none", "PB_WHERE": "nowhere"},
+        cwd=tmp_path,
+    )
     assert proc.returncode == 0, proc.stderr
     assert "PASSED" in proc.stdout
 
@@ -161,11 +195,23 @@ def _spec(tmp_path: Path, body: str) -> Path:
 
 
 def test_a_campaign_records_a_hung_run_as_an_error_row_and_goes_on(tmp_path):
-    spec = _spec(tmp_path, 'scenario = "loader-supply"\ncontroller = "faulty.py:controller"\nseeds = 2\n'
-                           f'timeout = {TIMEOUT_S}\n[parameters]\nduration = 0.2\n')
+    spec = _spec(
+        tmp_path,
+        'scenario = "loader-supply"\ncontroller = "faulty.py:controller"\nseeds = 2\n'
+        f"timeout = {TIMEOUT_S}\n[parameters]\nduration = 0.2\n",
+    )
     out = tmp_path / "campaign"
-    proc = planbench("sweep", spec, "--out", out, "--quiet", "--workers", "1",
-                     env={"PB_MODE": "sleep", "PB_WHERE": "call"}, cwd=tmp_path)
+    proc = planbench(
+        "sweep",
+        spec,
+        "--out",
+        out,
+        "--quiet",
+        "--workers",
+        "1",
+        env={"PB_MODE": "sleep", "PB_WHERE": "call"},
+        cwd=tmp_path,
+    )
     assert proc.returncode == 1, proc.stderr
     rows = pq.read_table(out / "results.parquet").to_pylist()
     assert [r["status"] for r in rows] == ["error", "error"]
@@ -174,11 +220,11 @@ def test_a_campaign_records_a_hung_run_as_an_error_row_and_goes_on(tmp_path):
 
 @pytest.mark.parametrize("mode", ["raise", "exit0", "os_exit0", "sleep"])
 def test_a_campaign_checks_its_plugins_before_the_first_run(tmp_path, mode):
-    spec = _spec(tmp_path, 'scenario = "loader-supply"\ncontroller = "faulty.py:controller"\nseeds = 2\n'
-                           f'timeout = {TIMEOUT_S}\n')
+    spec = _spec(
+        tmp_path, f'scenario = "loader-supply"\ncontroller = "faulty.py:controller"\nseeds = 2\ntimeout = {TIMEOUT_S}\n'
+    )
     out = tmp_path / "campaign"
-    proc = planbench("sweep", spec, "--out", out, "--quiet", env={"PB_MODE": mode, "PB_WHERE": "import"},
-                     cwd=tmp_path)
+    proc = planbench("sweep", spec, "--out", out, "--quiet", env={"PB_MODE": mode, "PB_WHERE": "import"}, cwd=tmp_path)
     assert proc.returncode == 2, (proc.stdout, proc.stderr)
     lines = proc.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("planbench: error: ") and "Traceback" not in proc.stderr, lines
@@ -193,7 +239,7 @@ def test_a_campaign_with_a_missing_plugin_is_refused_before_any_run(tmp_path):
     assert not (tmp_path / "campaign").exists()
 
 
-@pytest.mark.parametrize("value", ["0", "-3", "\"soon\"", "true", "inf"])
+@pytest.mark.parametrize("value", ["0", "-3", '"soon"', "true", "inf"])
 def test_a_bad_campaign_timeout_is_one_line(tmp_path, value):
     spec = _spec(tmp_path, f'scenario = "loader-supply"\ntimeout = {value}\n')
     proc = planbench("sweep", spec, "--out", tmp_path / "campaign", "--quiet", cwd=tmp_path)

@@ -16,7 +16,7 @@ from planbench import api
 from planbench.cli import main
 from planbench.task import PluginError
 
-PLUGINS = textwrap.dedent('''
+PLUGINS = textwrap.dedent("""
     import numpy as np
 
     class Hold:
@@ -83,7 +83,7 @@ PLUGINS = textwrap.dedent('''
     class NotOnline:
         def plan(self, problem):
             return None
-''')
+""")
 
 # (argv after "run", words the one stderr line must contain)
 BAD = [
@@ -150,8 +150,19 @@ def test_a_module_plugin_and_the_python_api_run_the_same(plugin_file, monkeypatc
     object: bit for bit."""
     monkeypatch.syspath_prepend(str(plugin_file.parent))
     out = plugin_file.parent / "cli"
-    assert main(["run", "hexapod-sync-move", "--controller", "my_plugins:Hold", "--out", str(out),
-                 "--duration", "0.2", "--quiet"]) in (0, 1)
+    assert main(
+        [
+            "run",
+            "hexapod-sync-move",
+            "--controller",
+            "my_plugins:Hold",
+            "--out",
+            str(out),
+            "--duration",
+            "0.2",
+            "--quiet",
+        ]
+    ) in (0, 1)
     import my_plugins
 
     result = api.run("hexapod-sync-move", controller=my_plugins.Hold(), params=dict(duration=0.2))

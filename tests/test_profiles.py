@@ -110,22 +110,21 @@ def check_profile(p, distance, v0, v1, v_max, a_max, duration=None):
     # previous piece's polynomial at its end) against the break's value, to round-off plus
     # the resolution of absolute times (eps T, times the largest jerk for the acceleration).
     left, right = p.evaluate(p.breaks, side="left"), p.evaluate(p.breaks, side="right")
-    np.testing.assert_allclose(left.position, right.position, rtol=0,
-                               atol=RTOL * scale_p * 10 + v_max * dt_res)
-    np.testing.assert_allclose(left.velocity, right.velocity, rtol=0,
-                               atol=RTOL * v_max * 10 + a_max * dt_res)
-    np.testing.assert_allclose(left.acceleration, right.acceleration, rtol=0,
-                               atol=RTOL * a_max * 10 + jerk * dt_res)
+    np.testing.assert_allclose(left.position, right.position, rtol=0, atol=RTOL * scale_p * 10 + v_max * dt_res)
+    np.testing.assert_allclose(left.velocity, right.velocity, rtol=0, atol=RTOL * v_max * 10 + a_max * dt_res)
+    np.testing.assert_allclose(left.acceleration, right.acceleration, rtol=0, atol=RTOL * a_max * 10 + jerk * dt_res)
     # Exact integration between neighbouring samples (no break inside an interval): the
     # acceleration is linear (trapezoid exact), the velocity quadratic (Simpson exact).
     dt = np.diff(t)
-    np.testing.assert_allclose(np.diff(s.velocity), 0.5 * (s.acceleration[1:] + s.acceleration[:-1])
-                               * dt, rtol=0, atol=1e-11 * v_max + 4 * a_max * dt_res)
+    np.testing.assert_allclose(
+        np.diff(s.velocity),
+        0.5 * (s.acceleration[1:] + s.acceleration[:-1]) * dt,
+        rtol=0,
+        atol=1e-11 * v_max + 4 * a_max * dt_res,
+    )
     simpson = dt / 6 * (s.velocity[:-1] + 4 * m.velocity + s.velocity[1:])
-    np.testing.assert_allclose(np.diff(s.position), simpson, rtol=0,
-                               atol=1e-11 * scale_p + 4 * v_max * dt_res)
-    np.testing.assert_allclose(np.diff(s.acceleration), m.jerk * dt, rtol=0,
-                               atol=1e-11 * a_max + 4 * jerk * dt_res)
+    np.testing.assert_allclose(np.diff(s.position), simpson, rtol=0, atol=1e-11 * scale_p + 4 * v_max * dt_res)
+    np.testing.assert_allclose(np.diff(s.acceleration), m.jerk * dt, rtol=0, atol=1e-11 * a_max + 4 * jerk * dt_res)
     return s
 
 
@@ -159,9 +158,10 @@ def feasible(d, a_max, v0, v1):
 # --------------------------------------------------------------------------- the pulse
 
 
-@pytest.mark.parametrize("v0, v1, a", [(0.0, 0.4, A_S_MAX), (0.4, 0.0, A_S_MAX),
-                                       (0.0, 0.01019, A_MAX), (-0.2, 0.3, A_T_MAX),
-                                       (0.1, -0.05, 2.0)])
+@pytest.mark.parametrize(
+    "v0, v1, a",
+    [(0.0, 0.4, A_S_MAX), (0.4, 0.0, A_S_MAX), (0.0, 0.01019, A_MAX), (-0.2, 0.3, A_T_MAX), (0.1, -0.05, 2.0)],
+)
 def test_velocity_change_is_the_triangular_pulse(v0, v1, a):
     p = velocity_change(v0, v1, a)
     T = 2 * abs(v1 - v0) / a
@@ -171,8 +171,7 @@ def test_velocity_change_is_the_triangular_pulse(v0, v1, a):
     s = p.evaluate(np.array([0.0, T / 4, T / 2, 3 * T / 4, T]))
     sgn = np.sign(v1 - v0)
     # Linear rise to the peak at T/2 and linear fall: a = 0, a/2, a, a/2, 0.
-    np.testing.assert_allclose(s.acceleration, sgn * a * np.array([0, 0.5, 1, 0.5, 0]),
-                               rtol=0, atol=1e-15)
+    np.testing.assert_allclose(s.acceleration, sgn * a * np.array([0, 0.5, 1, 0.5, 0]), rtol=0, atol=1e-15)
     np.testing.assert_allclose(s.jerk, sgn * a / (T / 2) * np.array([1, 1, -1, -1, 0]), rtol=1e-12)
     # Point symmetry: the speed at T/2 is the mean.
     assert s.velocity[2] == pytest.approx((v0 + v1) / 2, abs=1e-15)
@@ -189,14 +188,21 @@ def test_velocity_change_without_change_is_empty():
 # --------------------------------------------------------------------------- minimum time
 
 
-@pytest.mark.parametrize("d, v_max, a, T", [
-    (100.0, V_S_MAX, A_S_MAX, 100 / 0.4 + 2 * 0.4 / 0.025),    # 282 s, cruises
-    (5.0, V_S_MAX, A_S_MAX, 2 * math.sqrt(2 * 5 / 0.025)),      # 40 s, no cruise
-    (12.8, V_S_MAX, A_S_MAX, 64.0),                              # 2 v^2 / a: just reaches v_max
-    (-0.5, V_S_MAX, A_MAX, 2 * math.sqrt(2 * 0.5 / 0.01)),      # 20 s
-    (math.radians(26.4), math.radians(0.5), math.radians(0.05),  # an angle, rad
-     math.radians(26.4) / math.radians(0.5) + 2 * 0.5 / 0.05),
-])
+@pytest.mark.parametrize(
+    "d, v_max, a, T",
+    [
+        (100.0, V_S_MAX, A_S_MAX, 100 / 0.4 + 2 * 0.4 / 0.025),  # 282 s, cruises
+        (5.0, V_S_MAX, A_S_MAX, 2 * math.sqrt(2 * 5 / 0.025)),  # 40 s, no cruise
+        (12.8, V_S_MAX, A_S_MAX, 64.0),  # 2 v^2 / a: just reaches v_max
+        (-0.5, V_S_MAX, A_MAX, 2 * math.sqrt(2 * 0.5 / 0.01)),  # 20 s
+        (
+            math.radians(26.4),
+            math.radians(0.5),
+            math.radians(0.05),  # an angle, rad
+            math.radians(26.4) / math.radians(0.5) + 2 * 0.5 / 0.05,
+        ),
+    ],
+)
 def test_rest_to_rest_closed_form(d, v_max, a, T):
     assert T == pytest.approx(rest_to_rest_time(d, v_max, a), rel=1e-14)
     p = move_min_time(d, v_max, a)
@@ -281,8 +287,7 @@ def test_move_in_time_properties(move, stretch):
         u0, u1 = abs(v0), abs(v1)
         v = np.linspace(0, v_max, 20001)
         t_pulses = 2 * (np.abs(v - u0) + np.abs(v - u1)) / a
-        covered = (u0 + v) * np.abs(v - u0) / a + (v + u1) * np.abs(u1 - v) / a \
-            + v * (T - t_pulses)
+        covered = (u0 + v) * np.abs(v - u0) / a + (v + u1) * np.abs(u1 - v) / a + v * (T - t_pulses)
         assert np.min(np.where(t_pulses <= T, covered, np.inf)) > abs(d) * (1 - 1e-9)
         return
     check_profile(p, d, v0, v1, v_max, a, duration=T)
@@ -303,8 +308,7 @@ def test_move_in_time_at_the_minimum_is_the_minimum_profile(move):
     np.testing.assert_allclose(s.position, f.position, rtol=0, atol=1e-9 * abs(d) + 1e-15)
 
 
-@given(limits(), st.floats(-3.0, math.log10(500.0)), st.floats(0.0, 5.0),
-       st.floats(0.05, 1.0), st.floats(0.05, 1.0))
+@given(limits(), st.floats(-3.0, math.log10(500.0)), st.floats(0.0, 5.0), st.floats(0.05, 1.0), st.floats(0.05, 1.0))
 def test_move_in_time_rest_to_rest_has_the_lowest_cruise_speed(lim, log_d, stretch, k1, k2):
     v_max, a = lim
     d = 10**log_d
@@ -312,8 +316,7 @@ def test_move_in_time_rest_to_rest_has_the_lowest_cruise_speed(lim, log_d, stret
     p = move_in_time(d, T, v_max, a)
     check_profile(p, d, 0.0, 0.0, v_max, a, duration=T)
     v = p.peak_speed
-    assert v == pytest.approx((a * T - math.sqrt(max(a * a * T * T - 8 * a * d, 0))) / 4,
-                              rel=1e-6)
+    assert v == pytest.approx((a * T - math.sqrt(max(a * a * T * T - 8 * a * d, 0))) / 4, rel=1e-6)
     # Any member of the family with peaks k1 a, k2 a covering d in T cruises at least as fast:
     # d = v T - c v^2 with c = 1 / a1 + 1 / a2 (lower root, the one with a cruise >= 0).
     c = 1 / (k1 * a) + 1 / (k2 * a)
@@ -342,11 +345,14 @@ def test_move_in_time_hand_examples():
     assert "1.4" in str(err.value) and "1.5" in str(err.value) and "2.0 s" in str(err.value)
 
 
-@pytest.mark.parametrize("move, stretch", [
-    ((100.0, 0.01, 1.0, 0.01, 0.0), 1e-9),  # slows by ~1e-11 m/s over a 1e4 s cruise
-    ((1.0000000000000002, 1.0, 1.0, 1.0, 0.9999999999999999), 0.0),  # a 1e-16 s pulse
-    ((1.0, 0.01, 1.0, 0.0, 0.01), 1e-12),
-])
+@pytest.mark.parametrize(
+    "move, stretch",
+    [
+        ((100.0, 0.01, 1.0, 0.01, 0.0), 1e-9),  # slows by ~1e-11 m/s over a 1e4 s cruise
+        ((1.0000000000000002, 1.0, 1.0, 1.0, 0.9999999999999999), 0.0),  # a 1e-16 s pulse
+        ((1.0, 0.01, 1.0, 0.0, 0.01), 1e-12),
+    ],
+)
 def test_pulses_below_the_time_resolution(move, stretch):
     """A speed change far shorter than eps T is widened to 8 eps T with a lower peak: the
     breaks stay distinct and the speed change and distance stay exact."""
@@ -370,8 +376,7 @@ def test_sampling_before_and_after():
     s = p.evaluate(np.array([-2.0, -1e-9, T + 1e-9, T + 5.0]))
     np.testing.assert_allclose(s.position[:2], [0.1, 0.05e-9], rtol=1e-12)
     np.testing.assert_array_equal(s.velocity[:2], [-0.05, -0.05])
-    np.testing.assert_allclose(s.position[2:], p.end_position + p.end_velocity
-                               * np.array([1e-9, 5.0]), rtol=1e-14)
+    np.testing.assert_allclose(s.position[2:], p.end_position + p.end_velocity * np.array([1e-9, 5.0]), rtol=1e-14)
     np.testing.assert_array_equal(s.velocity[2:], [p.end_velocity] * 2)
     np.testing.assert_array_equal(s.acceleration, 0.0)
     np.testing.assert_array_equal(s.jerk, 0.0)
@@ -391,8 +396,9 @@ def test_sampling_outside_a_profile_that_ends_accelerating():
     np.testing.assert_allclose(s.acceleration, [0.0, 0.5, 1.0, 1.5, 0.0], rtol=0, atol=1e-15)
     np.testing.assert_allclose(s.jerk, [0.0, 0.5, 0.5, 0.0, 0.0], rtol=0, atol=1e-15)
     np.testing.assert_allclose(s.velocity, [0.25, 0.25, 1.0, 2.25, 2.25], rtol=1e-15)
-    np.testing.assert_allclose(s.position, [0.75, 1.0, 1.0 + 0.25 + 0.25 + 0.5 / 6,
-                                            p.end_position, p.end_position + 2.25], rtol=1e-15)
+    np.testing.assert_allclose(
+        s.position, [0.75, 1.0, 1.0 + 0.25 + 0.25 + 0.5 / 6, p.end_position, p.end_position + 2.25], rtol=1e-15
+    )
     left = p.evaluate(2.0, side="left")
     assert left.jerk == 0.5 and left.acceleration == pytest.approx(1.5, rel=1e-15)
 
@@ -459,44 +465,49 @@ def test_concatenate_rejects_a_jump():
 # --------------------------------------------------------------------------- bad input
 
 
-@pytest.mark.parametrize("call, match", [
-    (lambda: move_min_time(float("nan"), 1.0, 1.0), "distance = nan m"),
-    (lambda: move_min_time(float("inf"), 1.0, 1.0), "distance = inf m"),
-    (lambda: move_min_time(1.0, 0.0, 1.0), "v_max = 0.0 m/s must be > 0"),
-    (lambda: move_min_time(1.0, -1.0, 1.0), "v_max = -1.0 m/s must be > 0"),
-    (lambda: move_min_time(1.0, 1.0, 0.0), r"a_max = 0.0 m/s\^2 must be > 0"),
-    (lambda: move_min_time(1.0, 1.0, float("nan")), r"a_max = nan m/s\^2"),
-    (lambda: move_min_time(1.0, 1.0, 1.0, v0=float("nan")), "v0 = nan m/s"),
-    (lambda: move_min_time(1.0, 1.0, 1.0, v1="fast"), "v1 = 'fast' m/s is not a number"),
-    (lambda: move_in_time(1.0, -2.0, 1.0, 1.0), "duration = -2.0 s must be >= 0"),
-    (lambda: move_in_time(1.0, float("nan"), 1.0, 1.0), "duration = nan s"),
-    (lambda: velocity_change(0.0, 1.0, -1.0), r"a_max = -1.0 m/s\^2 must be > 0"),
-    (lambda: cruise(1.0, -1.0), "duration = -1.0 s"),
-    (lambda: move_min_time(1.0, 1.0, 1.0).evaluate(np.array([0.0, np.nan])), "nan s"),
-    (lambda: move_min_time(1.0, 1.0, 1.0).evaluate(0.0, side="middle"), "'middle'"),
-    (lambda: Profile.from_breaks([0.0, 1.0, 1.0], [0.0, 1.0, 0.0]),
-     r"breaks\[2\] = 1.0 s <= breaks\[1\]"),
-    (lambda: Profile.from_breaks([0.5, 1.0], [0.0, 0.0]), r"breaks\[0\] = 0.5 s"),
-    (lambda: Profile([1.0, -2.0], [0.0, 1.0, 0.0]), r"durations\[1\] = -2.0 s"),
-    (lambda: Profile([1.0], [0.0]), "1 pieces needs 2 accelerations, got 1"),
-    (lambda: Profile([1.0], [0.0, np.nan]), "non-finite"),
-])
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: move_min_time(float("nan"), 1.0, 1.0), "distance = nan m"),
+        (lambda: move_min_time(float("inf"), 1.0, 1.0), "distance = inf m"),
+        (lambda: move_min_time(1.0, 0.0, 1.0), "v_max = 0.0 m/s must be > 0"),
+        (lambda: move_min_time(1.0, -1.0, 1.0), "v_max = -1.0 m/s must be > 0"),
+        (lambda: move_min_time(1.0, 1.0, 0.0), r"a_max = 0.0 m/s\^2 must be > 0"),
+        (lambda: move_min_time(1.0, 1.0, float("nan")), r"a_max = nan m/s\^2"),
+        (lambda: move_min_time(1.0, 1.0, 1.0, v0=float("nan")), "v0 = nan m/s"),
+        (lambda: move_min_time(1.0, 1.0, 1.0, v1="fast"), "v1 = 'fast' m/s is not a number"),
+        (lambda: move_in_time(1.0, -2.0, 1.0, 1.0), "duration = -2.0 s must be >= 0"),
+        (lambda: move_in_time(1.0, float("nan"), 1.0, 1.0), "duration = nan s"),
+        (lambda: velocity_change(0.0, 1.0, -1.0), r"a_max = -1.0 m/s\^2 must be > 0"),
+        (lambda: cruise(1.0, -1.0), "duration = -1.0 s"),
+        (lambda: move_min_time(1.0, 1.0, 1.0).evaluate(np.array([0.0, np.nan])), "nan s"),
+        (lambda: move_min_time(1.0, 1.0, 1.0).evaluate(0.0, side="middle"), "'middle'"),
+        (lambda: Profile.from_breaks([0.0, 1.0, 1.0], [0.0, 1.0, 0.0]), r"breaks\[2\] = 1.0 s <= breaks\[1\]"),
+        (lambda: Profile.from_breaks([0.5, 1.0], [0.0, 0.0]), r"breaks\[0\] = 0.5 s"),
+        (lambda: Profile([1.0, -2.0], [0.0, 1.0, 0.0]), r"durations\[1\] = -2.0 s"),
+        (lambda: Profile([1.0], [0.0]), "1 pieces needs 2 accelerations, got 1"),
+        (lambda: Profile([1.0], [0.0, np.nan]), "non-finite"),
+    ],
+)
 def test_bad_input_raises_planning_error(call, match):
     with pytest.raises(PlanningError, match=match):
         call()
 
 
-@pytest.mark.parametrize("call, match", [
-    (lambda: move_min_time(1.0, 0.4, 0.025, v0=0.5), r"\|v0\| = 0.5 m/s exceeds v_max = 0.4"),
-    (lambda: move_min_time(1.0, 0.4, 0.025, v1=-0.1),
-     "v1 = -0.1 m/s points against the distance 1.0 m"),
-    (lambda: move_min_time(0.0, 0.4, 0.025, v0=0.1), "needs at least 0.4000"),
-    (lambda: move_min_time(-1.0, 0.4, 0.01, v0=-0.2),
-     "distance -1.0 m is too short .* v0 = -0.2 .* at least -4.000"),
-    (lambda: move_in_time(1.0, 1.0, 0.4, 0.025),
-     "duration 1.0 s is shorter than the minimum time 17.88854"),
-    (lambda: move_min_time(np.float64(1.0), 0.4, 0.025, v0=np.float64(0.5)), r"\|v0\| = 0.5 m/s"),
-])
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: move_min_time(1.0, 0.4, 0.025, v0=0.5), r"\|v0\| = 0.5 m/s exceeds v_max = 0.4"),
+        (lambda: move_min_time(1.0, 0.4, 0.025, v1=-0.1), "v1 = -0.1 m/s points against the distance 1.0 m"),
+        (lambda: move_min_time(0.0, 0.4, 0.025, v0=0.1), "needs at least 0.4000"),
+        (
+            lambda: move_min_time(-1.0, 0.4, 0.01, v0=-0.2),
+            "distance -1.0 m is too short .* v0 = -0.2 .* at least -4.000",
+        ),
+        (lambda: move_in_time(1.0, 1.0, 0.4, 0.025), "duration 1.0 s is shorter than the minimum time 17.88854"),
+        (lambda: move_min_time(np.float64(1.0), 0.4, 0.025, v0=np.float64(0.5)), r"\|v0\| = 0.5 m/s"),
+    ],
+)
 def test_limits_raise_limit_error(call, match):
     with pytest.raises(LimitError, match=match):
         call()

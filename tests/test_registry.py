@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from planbench import models
-from planbench import scenarios
+from planbench import models, scenarios
 
 
 def test_the_mechanisms_are_the_model_folders():
@@ -35,11 +34,13 @@ def test_a_scenario_found_by_its_mechanism_imports_that_mechanism_alone():
     import subprocess
     import sys
 
-    code = ("import sys; from sims import scenarios\n"
-            "by_mechanism = {m: scenarios.get_of(m, n) for m, n in [('hexapod', 'hexapod-sync-move'), "
-            "('loader', 'loader-supply')]}\n"
-            "print(sorted(m for m in ('planbench.fast', 'planbench.antenna') if m in sys.modules))\n"
-            "print(all(s is scenarios.get(s.name) for s in by_mechanism.values()))\n"
-            "print(scenarios.get_of('hexapod', 'fast-tracking').name)\n")
+    code = (
+        "import sys; from sims import scenarios\n"
+        "by_mechanism = {m: scenarios.get_of(m, n) for m, n in [('hexapod', 'hexapod-sync-move'), "
+        "('loader', 'loader-supply')]}\n"
+        "print(sorted(m for m in ('planbench.fast', 'planbench.antenna') if m in sys.modules))\n"
+        "print(all(s is scenarios.get(s.name) for s in by_mechanism.values()))\n"
+        "print(scenarios.get_of('hexapod', 'fast-tracking').name)\n"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.splitlines() == ["[]", "True", "fast-tracking"]

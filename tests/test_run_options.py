@@ -15,7 +15,7 @@ import re
 import numpy as np
 import pytest
 
-from planbench import antenna, fast, hexapod, loader, run_limits, runner, scenarios, wind
+from planbench import antenna, fast, hexapod, run_limits, runner, scenarios, wind
 from planbench.antenna import ship_motion
 from planbench.checks import NOT_EVALUATED, Check
 from planbench.cli import BadInput, _resolve_source, format_checks, main
@@ -34,8 +34,7 @@ def _space_limit_words():
 
 
 def _snapshot(root):
-    return sorted((str(p.relative_to(root)), p.stat().st_size if p.is_file() else -1)
-                  for p in root.rglob("*"))
+    return sorted((str(p.relative_to(root)), p.stat().st_size if p.is_file() else -1) for p in root.rglob("*"))
 
 
 def _no_nan(text: str):
@@ -137,24 +136,27 @@ def test_the_cable_segment_limit_is_the_models():
 # ---------------------------------------------------------------- what is still accepted
 
 
-@pytest.mark.parametrize("args", [
-    ("loader-supply", "--duration", "0.005"),  # exactly one tick
-    ("fast-tracking", "--duration", "0.02"),  # exactly one tick at the default 50 Hz
-    ("fast-tracking", "--duration", "0.01", "--set", "control_rate_hz=100"),
-    ("fast-tracking", "--set", "control_rate_hz=500"),
-    ("fast-tracking", "--set", "control_rate_hz=10"),
-    ("antenna-sea-state", "--hs", "20", "--tp", "30"),
-    ("antenna-sea-state", "--hs", "6.6", "--tp", "8"),  # just under 1/15
-    ("antenna-sea-state", "--hs", "0.1", "--tp", "1"),
-    ("antenna-sea-state", "--wave-heading", "-360"),
-    ("antenna-sea-state", "--wave-heading", "360"),
-    ("fast-ra-scan", "--wind-direction", "-90", "--wind", "50"),
-    ("fast-tracking", "--cable-segments", "14"),
-    ("hexapod-sync-move", "--elevation", "15", "--wind", "0"),
-    ("antenna-paper-motion", "--set", "imu.rate_hz=1", "--set", "imu.latency_s=1"),
-    ("antenna-paper-motion", "--set", "imu.rate_hz=200", "--set", "imu.latency_s=0"),
-    ("antenna-sea-state", "--duration", "600"),
-])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("loader-supply", "--duration", "0.005"),  # exactly one tick
+        ("fast-tracking", "--duration", "0.02"),  # exactly one tick at the default 50 Hz
+        ("fast-tracking", "--duration", "0.01", "--set", "control_rate_hz=100"),
+        ("fast-tracking", "--set", "control_rate_hz=500"),
+        ("fast-tracking", "--set", "control_rate_hz=10"),
+        ("antenna-sea-state", "--hs", "20", "--tp", "30"),
+        ("antenna-sea-state", "--hs", "6.6", "--tp", "8"),  # just under 1/15
+        ("antenna-sea-state", "--hs", "0.1", "--tp", "1"),
+        ("antenna-sea-state", "--wave-heading", "-360"),
+        ("antenna-sea-state", "--wave-heading", "360"),
+        ("fast-ra-scan", "--wind-direction", "-90", "--wind", "50"),
+        ("fast-tracking", "--cable-segments", "14"),
+        ("hexapod-sync-move", "--elevation", "15", "--wind", "0"),
+        ("antenna-paper-motion", "--set", "imu.rate_hz=1", "--set", "imu.latency_s=1"),
+        ("antenna-paper-motion", "--set", "imu.rate_hz=200", "--set", "imu.latency_s=0"),
+        ("antenna-sea-state", "--duration", "600"),
+    ],
+)
 def test_the_limits_themselves_are_accepted(args):
     params = _read(args)
     assert isinstance(params, type(scenarios.get(args[0]).params))
@@ -230,9 +232,20 @@ def test_log_estimate_matches_the_arrays_a_run_holds(tmp_path, name, extra):
         setup = scenario.build(params)
         path = tmp_path / f"{ticks}.arrow"
         log = runner.simulate(setup, log_path=path)
-        held.append((log.n, path.stat().st_size + _held_bytes(
-            log, setup.components.controller, setup.task.sensors, setup.components.planner, setup.task.disturbance,
-            setup.components.trajectory)))
+        held.append(
+            (
+                log.n,
+                path.stat().st_size
+                + _held_bytes(
+                    log,
+                    setup.components.controller,
+                    setup.task.sensors,
+                    setup.components.planner,
+                    setup.task.disturbance,
+                    setup.components.trajectory,
+                ),
+            )
+        )
     (n1, b1), (n2, b2) = held
     measured = (b2 - b1) / (n2 - n1)
     estimate = params.log_bytes_per_tick()
@@ -245,8 +258,11 @@ def test_log_estimate_matches_the_arrays_a_run_holds(tmp_path, name, extra):
 @pytest.mark.parametrize("name", list(scenarios.SCENARIOS))
 def test_build_refuses_a_duration_under_one_tick(name):
     scenario = scenarios.get(name)
-    with pytest.raises(ValueError, match=rf"duration = {0.5 * scenario.control_dt:g} s is outside .*one control tick "
-                                         rf"\({scenario.control_dt * 1e3:g} ms\)"):
+    with pytest.raises(
+        ValueError,
+        match=rf"duration = {0.5 * scenario.control_dt:g} s is outside .*one control tick "
+        rf"\({scenario.control_dt * 1e3:g} ms\)",
+    ):
         scenario.resolve(duration=0.5 * scenario.control_dt)
     with pytest.raises(run_limits.RunLimitError, match="of log, more than the limit of"):
         scenario.resolve(duration=1e12)
@@ -282,22 +298,27 @@ def test_disk_rule_is_stated_and_follows_the_free_space(monkeypatch, tmp_path):
     assert why == f"the free space on the file system of {tmp_path}"
     assert limit == pytest.approx(shutil.disk_usage(tmp_path).free, rel=0.01)
     monkeypatch.setattr(run_limits, "free_bytes", lambda directory: 4 * 2**30)
-    with pytest.raises(run_limits.RunLimitError,
-                       match=r"duration 1e\+12 s needs ~1\.4 PiB of log, more than the limit of 4 GiB \(the free "):
+    with pytest.raises(
+        run_limits.RunLimitError,
+        match=r"duration 1e\+12 s needs ~1\.4 PiB of log, more than the limit of 4 GiB \(the free ",
+    ):
         run_limits.check_duration(1e12, 0.005, 8.0)  # 2e14 ticks x 8 B = 1.42 PiB
     run_limits.check_duration(1e5, 0.005, 8.0)  # 160 MB: fits
     assert run_limits.format_bytes(12 * 2**30) == "12 GiB" and run_limits.format_bytes(512) == "512 B"
 
 
-@pytest.mark.parametrize("hs, tp, words", [
-    (5.0, 1e-3, "tp = 0.001 s is outside [1, 30] s"),
-    (5.0, 1e4, "tp = 10000 s is outside [1, 30] s"),
-    (1e308, 10.0, "hs = 1e+308 m is above 20 m"),
-    (0.0, 10.0, "hs = 0 m must be > 0"),
-    (float("nan"), 10.0, "hs = nan m must be finite"),
-    (15.0, 8.0, "hs = 15 m, tp = 8 s is steeper than waves can be"),
-    (15.0, 15.0, r"tp = 15 s is steeper than waves can be: 2 pi Hs / \(g Tp\^2\) = 1/23.4 > 1/25"),
-])
+@pytest.mark.parametrize(
+    "hs, tp, words",
+    [
+        (5.0, 1e-3, "tp = 0.001 s is outside [1, 30] s"),
+        (5.0, 1e4, "tp = 10000 s is outside [1, 30] s"),
+        (1e308, 10.0, "hs = 1e+308 m is above 20 m"),
+        (0.0, 10.0, "hs = 0 m must be > 0"),
+        (float("nan"), 10.0, "hs = nan m must be finite"),
+        (15.0, 8.0, "hs = 15 m, tp = 8 s is steeper than waves can be"),
+        (15.0, 15.0, r"tp = 15 s is steeper than waves can be: 2 pi Hs / \(g Tp\^2\) = 1/23.4 > 1/25"),
+    ],
+)
 def test_sea_states_outside_the_models_range_are_named(hs, tp, words):
     with pytest.raises(ship_motion.ShipMotionError, match=words if "\\" in words else re.escape(words)):
         ship_motion.check_sea_state(hs, tp)
@@ -323,8 +344,11 @@ def test_angles_winds_and_the_imu_are_refused_in_the_python_api():
         fast.FastParams(wind_direction=400.0)
     with pytest.raises(ValueError, match=r"elevation = 1e\+308 deg is outside"):
         hexapod.HexapodParams(elevation=1e308)
-    for make in (lambda: CableLoads(1e308), lambda: wind.check_mean_speed(60.0),
-                 lambda: wind.wind_speed_series(np.arange(3.0), 51.0, np.random.default_rng(0))):
+    for make in (
+        lambda: CableLoads(1e308),
+        lambda: wind.check_mean_speed(60.0),
+        lambda: wind.wind_speed_series(np.arange(3.0), 51.0, np.random.default_rng(0)),
+    ):
         with pytest.raises(ValueError, match=r"above 50 m/s"):
             make()
     with pytest.raises(ValueError, match=r"rate_hz = 1e-300 Hz is outside \[1, 200\] Hz"):
@@ -358,8 +382,9 @@ def test_a_nan_check_fails_with_a_note_and_is_null_in_json():
     assert "n/a" not in table.splitlines()[2]
 
 
-@pytest.mark.parametrize("name, check", [("hexapod-sync-move", "arrival_spread"),
-                                         ("hexapod-async-move", "arrival_vs_own_time")])
+@pytest.mark.parametrize(
+    "name, check", [("hexapod-sync-move", "arrival_spread"), ("hexapod-async-move", "arrival_vs_own_time")]
+)
 def test_short_hexapod_run_cannot_claim_its_arrival_or_settling(name, check):
     result = runner.run(name, scenarios.get(name).build(scenarios.get(name).resolve(duration=1.0, wind=0.0)))
     by_name = {c.name: c for c in result.checks}
@@ -373,8 +398,7 @@ def test_short_hexapod_run_cannot_claim_its_arrival_or_settling(name, check):
 
 def test_short_hexapod_run_writes_a_failed_check_with_a_note_and_no_nan(tmp_path, capsys):
     out = tmp_path / "short"
-    code = main(["run", "hexapod-sync-move", "--duration", "0.5", "--wind", "0", "--out", str(out),
-                 "--quiet"])
+    code = main(["run", "hexapod-sync-move", "--duration", "0.5", "--wind", "0", "--out", str(out), "--quiet"])
     captured = capsys.readouterr()
     assert code == 1, captured.err
     summary = _no_nan((out / "summary.json").read_text())
@@ -395,6 +419,7 @@ def test_no_nan_in_any_short_run():
             for c in result.checks:
                 assert c.evaluated or c.note.startswith(NOT_EVALUATED), (name, c)
                 assert c.evaluated or not c.passed
-            text = json.dumps({"checks": [c.to_json() for c in result.checks],
-                               "metrics": result.metrics}, default=float)
+            text = json.dumps(
+                {"checks": [c.to_json() for c in result.checks], "metrics": result.metrics}, default=float
+            )
             _no_nan(text)

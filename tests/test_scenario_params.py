@@ -21,11 +21,11 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from planbench.planners.fast import sky
 from planbench import antenna, fast, hexapod, loader, params, runner, scenarios
 from planbench.antenna.ship_motion import GRAVITY, steepness_limit
 from planbench.cli import main
 from planbench.params import ParamError
+from planbench.planners.fast import sky
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Scenario files (campaign specs, *_campaign.toml, are tests/test_campaign.py's).
@@ -61,22 +61,39 @@ def _fraction(draw, low, high, inner=1.0):
 @st.composite
 def loader_params(draw):
     k = draw(st.integers(2, 5))
-    rows = [tuple(_fraction(draw, lo, hi, 0.4) for lo, hi in zip(loader.params._KEY_LOW, loader.params._KEY_HIGH, strict=True))
-            for _ in range(k)]
-    return loader.LoaderParams(key_points=tuple(rows), key_interval=draw(st.floats(0.4, 2.0)),
-                               settle=draw(st.floats(0.0, 1.0)), payload_mass=draw(st.floats(0.0, 90.0)),
-                               seed=draw(st.integers(0, 2**63 - 1)))
+    rows = [
+        tuple(
+            _fraction(draw, lo, hi, 0.4) for lo, hi in zip(loader.params._KEY_LOW, loader.params._KEY_HIGH, strict=True)
+        )
+        for _ in range(k)
+    ]
+    return loader.LoaderParams(
+        key_points=tuple(rows),
+        key_interval=draw(st.floats(0.4, 2.0)),
+        settle=draw(st.floats(0.0, 1.0)),
+        payload_mass=draw(st.floats(0.0, 90.0)),
+        seed=draw(st.integers(0, 2**63 - 1)),
+    )
 
 
 @st.composite
 def hexapod_params(draw):
     def pose():
-        return tuple(_fraction(draw, lo, hi, 0.25) for lo, hi in zip(hexapod.params._POSE_LOW, hexapod.params._POSE_HIGH, strict=True))
+        return tuple(
+            _fraction(draw, lo, hi, 0.25)
+            for lo, hi in zip(hexapod.params._POSE_LOW, hexapod.params._POSE_HIGH, strict=True)
+        )
+
     start = pose()
     moves = tuple(hexapod.HexapodMove(pose(), draw(st.booleans())) for _ in range(draw(st.integers(1, 3))))
     try:  # a move of zero length (no strut length changes) is refused; the rest must build
-        return hexapod.HexapodParams(start_pose=start, moves=moves, elevation=draw(st.floats(15.0, 90.0)),
-                                     wind=draw(st.floats(0.0, 50.0)), dwell=draw(st.floats(1.0, 3.0)))
+        return hexapod.HexapodParams(
+            start_pose=start,
+            moves=moves,
+            elevation=draw(st.floats(15.0, 90.0)),
+            wind=draw(st.floats(0.0, 50.0)),
+            dwell=draw(st.floats(1.0, 3.0)),
+        )
     except ParamError as e:
         assume("a move of zero length" not in str(e))
         raise
@@ -89,32 +106,53 @@ def antenna_sea_params(draw):
     lat, lon = draw(st.floats(-50.0, 50.0)), draw(st.floats(-180.0, 180.0))
     satellite = {"satellite_lon": (lon + draw(st.floats(-40.0, 40.0)) + 180.0) % 360.0 - 180.0}
     if draw(st.booleans()):
-        satellite = {"satellite_look": (draw(st.floats(0.0, 360.0)), draw(st.floats(10.0, 85.0)),
-                                        draw(st.floats(-60.0, 60.0)))}
-    return antenna.AntennaSeaParams.from_mapping(dict(
-        hs=draw(st.floats(0.1, 0.95)) * hs_max, tp=tp, gamma=draw(st.floats(1.0, 7.0)),
-        wave_heading=draw(st.floats(-360.0, 360.0)), ship_heading=draw(st.floats(-360.0, 360.0)),
-        ship_speed=draw(st.floats(0.0, 15.0)), ship_lat=lat, ship_lon=lon,
-        imu=dict(rate_hz=200.0 / draw(st.integers(1, 200)), latency_s=0.005 * draw(st.integers(0, 200))),
-        duration=5.0, seed=draw(st.integers(0, 2**32)), **satellite))
+        satellite = {
+            "satellite_look": (draw(st.floats(0.0, 360.0)), draw(st.floats(10.0, 85.0)), draw(st.floats(-60.0, 60.0)))
+        }
+    return antenna.AntennaSeaParams.from_mapping(
+        dict(
+            hs=draw(st.floats(0.1, 0.95)) * hs_max,
+            tp=tp,
+            gamma=draw(st.floats(1.0, 7.0)),
+            wave_heading=draw(st.floats(-360.0, 360.0)),
+            ship_heading=draw(st.floats(-360.0, 360.0)),
+            ship_speed=draw(st.floats(0.0, 15.0)),
+            ship_lat=lat,
+            ship_lon=lon,
+            imu=dict(rate_hz=200.0 / draw(st.integers(1, 200)), latency_s=0.005 * draw(st.integers(0, 200))),
+            duration=5.0,
+            seed=draw(st.integers(0, 2**32)),
+            **satellite,
+        )
+    )
 
 
 @st.composite
 def antenna_paper_params(draw):
     return antenna.AntennaPaperParams(
-        heading_amplitude=draw(st.floats(0.0, 180.0)), heading_period=draw(st.floats(1.0, 3600.0)),
-        turn_rate=draw(st.floats(-10.0, 10.0)), pitch_amplitude=draw(st.floats(0.0, 60.0)),
-        pitch_period=draw(st.floats(1.0, 60.0)), roll_amplitude=draw(st.floats(0.0, 60.0)),
-        roll_period=draw(st.floats(1.0, 60.0)), ship_heading=draw(st.floats(-360.0, 360.0)), duration=5.0)
+        heading_amplitude=draw(st.floats(0.0, 180.0)),
+        heading_period=draw(st.floats(1.0, 3600.0)),
+        turn_rate=draw(st.floats(-10.0, 10.0)),
+        pitch_amplitude=draw(st.floats(0.0, 60.0)),
+        pitch_period=draw(st.floats(1.0, 60.0)),
+        roll_amplitude=draw(st.floats(0.0, 60.0)),
+        roll_period=draw(st.floats(1.0, 60.0)),
+        ship_heading=draw(st.floats(-360.0, 360.0)),
+        duration=5.0,
+    )
 
 
 @st.composite
 def fast_tracking_params(draw):
     return fast.FastTrackingParams(
-        source=draw(st.sampled_from(sorted(fast.SOURCES))), tracking=draw(st.floats(10.0, 1800.0)),
-        wind=draw(st.floats(0.0, 50.0)), wind_direction=draw(st.floats(-360.0, 360.0)),
+        source=draw(st.sampled_from(sorted(fast.SOURCES))),
+        tracking=draw(st.floats(10.0, 1800.0)),
+        wind=draw(st.floats(0.0, 50.0)),
+        wind_direction=draw(st.floats(-360.0, 360.0)),
         turbulence_intensity=draw(st.none() | st.floats(0.0, 0.5)),
-        wind_spectrum=draw(st.sampled_from(("kaimal", "davenport"))), stewart=draw(st.booleans()))
+        wind_spectrum=draw(st.sampled_from(("kaimal", "davenport"))),
+        stewart=draw(st.booleans()),
+    )
 
 
 @given(loader_params())
@@ -139,8 +177,9 @@ def test_any_valid_hexapod_parameters_build_and_plan(p):
     trajectory = scenario.plan(p)
     setup = scenario.build(p)
     assert setup.task.duration == pytest.approx(trajectory.duration + hexapod.SETTLE_S)
-    np.testing.assert_allclose(setup.physics.poses_from_qpos(setup.physics.data.qpos)[0],
-                               hexapod.pose_si(p.start_pose), atol=1e-9)
+    np.testing.assert_allclose(
+        setup.physics.poses_from_qpos(setup.physics.data.qpos)[0], hexapod.pose_si(p.start_pose), atol=1e-9
+    )
 
 
 @given(antenna_sea_params())
@@ -174,7 +213,10 @@ def test_fast_scans_and_switches_of_other_sizes_plan():
     switch = fast.FastSwitchParams(sources=("3C 286", "3C 295", "3C 286"), tracking=60.0)
     plan = fast.goal_plan(switch)
     assert [s.name for s in plan.segments if s.name.startswith("observation")] == [
-        "observation (3C 286)", "observation (3C 295)", "observation (3C 286)"]
+        "observation (3C 286)",
+        "observation (3C 295)",
+        "observation (3C 286)",
+    ]
     setup = scenarios.get("fast-source-switch").build(switch.replace(duration=0.5))
     assert setup.components.trajectory.duration == pytest.approx(plan.duration)
 
@@ -234,13 +276,15 @@ def test_out_of_range_by_any_amount_names_the_key_value_and_range(key, excess):
 
 def test_wrong_types_and_unknown_keys_are_named():
     spec = scenarios.get("hexapod-sync-move")
-    for overrides, words in [({"wind": "strong"}, "wind = 'strong' is not a number"),
-                             ({"moves": [{"target": [1, 2]}]}, "moves[0].target has 2 values, not 6"),
-                             ({"moves": [{"targte": [0] * 6}]}, "unknown parameter 'moves[0].targte'"),
-                             ({"moves": []}, "moves has 0 items, fewer than 1"),
-                             ({"start_pose": [20, 0, 0, 0, 0, 0]}, "start_pose[0] = 20 mm is outside [-11.4, 11.4] mm"),
-                             ({"moves": [{"target": [0] * 6}]}, "moves[0].target equals the pose before it"),
-                             ({"hs": 3.0}, "unknown parameter 'hs'")]:
+    for overrides, words in [
+        ({"wind": "strong"}, "wind = 'strong' is not a number"),
+        ({"moves": [{"target": [1, 2]}]}, "moves[0].target has 2 values, not 6"),
+        ({"moves": [{"targte": [0] * 6}]}, "unknown parameter 'moves[0].targte'"),
+        ({"moves": []}, "moves has 0 items, fewer than 1"),
+        ({"start_pose": [20, 0, 0, 0, 0, 0]}, "start_pose[0] = 20 mm is outside [-11.4, 11.4] mm"),
+        ({"moves": [{"target": [0] * 6}]}, "moves[0].target equals the pose before it"),
+        ({"hs": 3.0}, "unknown parameter 'hs'"),
+    ]:
         with pytest.raises(ParamError) as refused:
             spec.resolve(overrides)
         assert words in str(refused.value), str(refused.value)
@@ -272,8 +316,9 @@ def test_the_help_of_a_scenario_names_its_parameters_and_no_others(capsys, name)
 def test_the_readme_tables_are_the_declarations():
     readme = (ROOT / "README.md").read_text()
     for cls in _classes():
-        assert params.markdown_table(cls) in readme, f"README's table of {cls.__name__} differs: regenerate it " \
-                                                     "with planbench.params.markdown_table"
+        assert params.markdown_table(cls) in readme, (
+            f"README's table of {cls.__name__} differs: regenerate it with planbench.params.markdown_table"
+        )
     # and the nested tables (a scenario's ``sensors``, list items): the whole generated section
     assert params.readme_tables().rstrip("\n") in readme, "README's parameter tables differ: python -m planbench.params"
 
@@ -305,8 +350,9 @@ def test_every_example_scenario_file_runs_through_the_cli(tmp_path, capsys, path
 
 
 def test_a_hexapod_list_of_three_moves_checks_each_arrival(tmp_path, capsys):
-    code, captured = _run(capsys, EXAMPLES[[p.name for p in EXAMPLES].index("three_moves.toml")],
-                          "--out", tmp_path / "three")
+    code, captured = _run(
+        capsys, EXAMPLES[[p.name for p in EXAMPLES].index("three_moves.toml")], "--out", tmp_path / "three"
+    )
     assert code == 0, captured.out + captured.err
     summary = json.loads((tmp_path / "three" / "summary.json").read_text())
     moves = summary["metrics"]["moves"]
@@ -326,8 +372,15 @@ def test_a_hexapod_list_of_three_moves_checks_each_arrival(tmp_path, capsys):
 
 def test_a_short_list_of_moves_does_not_claim_the_later_arrivals():
     spec = scenarios.get("hexapod-async-move")
-    p = spec.resolve({"moves": [{"target": [1, 0, 0, 0, 0, 0], "synchronous": False},
-                                {"target": [0, 1, 0, 0, 0, 0], "synchronous": True}], "wind": 0.0})
+    p = spec.resolve(
+        {
+            "moves": [
+                {"target": [1, 0, 0, 0, 0, 0], "synchronous": False},
+                {"target": [0, 1, 0, 0, 0, 0], "synchronous": True},
+            ],
+            "wind": 0.0,
+        }
+    )
     first = spec.plan(p).pieces[0].duration
     result = runner.run("short", spec.build(p.replace(duration=first + 1.2)))
     by_name = {c.name: c for c in result.checks}
@@ -350,8 +403,26 @@ def test_fast_tracks_another_source_at_another_time_as_pyerfa_says():
     jd1, jd2 = sky.utc_jd("2026-12-01T15:00:00", tau)
     ra, dec = fast.SOURCES["Crab"]
     site = sky.FAST_SITE
-    aob, zob, *_ = erfa.atco13(ra, dec, 0.0, 0.0, 0.0, 0.0, jd1, jd2, 0.0, site.longitude, site.latitude,
-                               site.height, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    aob, zob, *_ = erfa.atco13(
+        ra,
+        dec,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        jd1,
+        jd2,
+        0.0,
+        site.longitude,
+        site.latitude,
+        site.height,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    )
     arcsec = np.radians(1 / 3600)
     assert np.abs((az_plan - aob + np.pi) % (2 * np.pi) - np.pi).max() * np.cos(el_plan).max() < 30 * arcsec
     assert np.abs(el_plan - (np.pi / 2 - zob)).max() < 30 * arcsec
@@ -363,8 +434,9 @@ def test_fast_tracks_another_source_at_another_time_as_pyerfa_says():
 
 
 def test_a_source_that_leaves_fasts_sky_is_refused_with_its_keys(tmp_path, capsys):
-    code, captured = _run(capsys, "fast-tracking", "--source", "Crab", "--start-utc", "2026-12-01T06:00:00",
-                          "--out", tmp_path / "out")
+    code, captured = _run(
+        capsys, "fast-tracking", "--source", "Crab", "--start-utc", "2026-12-01T06:00:00", "--out", tmp_path / "out"
+    )
     assert code == 2 and "source, start_utc, tracking" in captured.err and "40" in captured.err
     assert not (tmp_path / "out").exists()
 
@@ -373,8 +445,20 @@ def test_the_antenna_elsewhere_points_as_the_geostationary_formulas_say(tmp_path
     """A ship at 15 N 62 E, a satellite at 64.2 E: the run's look angles against the
     spherical-Earth geostationary formulas (Pratt & Bostian; WGS84 differs by < 0.2 deg)."""
     lat, lon, sat = 15.0, 62.0, 64.2
-    code, captured = _run(capsys, "antenna-sea-state", "--ship-lat", lat, "--ship-lon", lon, "--satellite-lon", sat,
-                          "--duration", 3, "--out", tmp_path / "a")
+    code, captured = _run(
+        capsys,
+        "antenna-sea-state",
+        "--ship-lat",
+        lat,
+        "--ship-lon",
+        lon,
+        "--satellite-lon",
+        sat,
+        "--duration",
+        3,
+        "--out",
+        tmp_path / "a",
+    )
     assert code in (0, 1), captured.err
     az, el, _ = json.loads((tmp_path / "a" / "summary.json").read_text())["metrics"]["satellite_az_el_pol_deg"]
     phi, dl = np.radians(lat), np.radians(sat - lon)
@@ -407,12 +491,14 @@ def test_a_resolved_summary_reruns_bit_identically(tmp_path, capsys):
 
 
 def test_scenario_file_errors_name_the_file_and_the_key(tmp_path, capsys):
-    cases = [('scenario = "hexapod-sync-move"\n[parameters]\nwnid = 3\n', "unknown parameter 'wnid'"),
-             ('scenario = "hexapod-sync-move"\n[parameters]\nwind = "calm"\n', "wind = 'calm' is not a number"),
-             ('scenario = "hexapod-sync-move"\n[parameters]\nwind = 80\n', "wind = 80 m/s is outside [0, 50] m/s"),
-             ('scenario = "nope"\n', "unknown scenario 'nope'"),
-             ('senario = "loader-supply"\n', "unknown key 'senario'"),
-             ('scenario = "loader-supply"\n[parameters\n', "not TOML")]
+    cases = [
+        ('scenario = "hexapod-sync-move"\n[parameters]\nwnid = 3\n', "unknown parameter 'wnid'"),
+        ('scenario = "hexapod-sync-move"\n[parameters]\nwind = "calm"\n', "wind = 'calm' is not a number"),
+        ('scenario = "hexapod-sync-move"\n[parameters]\nwind = 80\n', "wind = 80 m/s is outside [0, 50] m/s"),
+        ('scenario = "nope"\n', "unknown scenario 'nope'"),
+        ('senario = "loader-supply"\n', "unknown key 'senario'"),
+        ('scenario = "loader-supply"\n[parameters\n', "not TOML"),
+    ]
     for i, (text, words) in enumerate(cases):
         path = tmp_path / f"bad{i}.toml"
         path.write_text(text)
@@ -441,8 +527,13 @@ def test_measured_wind_is_validated_and_resampled(tmp_path):
     speed, direction = record.resample(np.array([0.0, 5.0, 10.0]))
     np.testing.assert_allclose(speed, [4.0, 5.0, 6.0])
     np.testing.assert_allclose(direction[1], [np.sqrt(0.5), np.sqrt(0.5), 0.0])
-    for text, words in [("0,4\n0,5\n", "does not increase"), ("0,4\n", "at least 2"), ("0,60\n1,4\n", "speed 60"),
-                        ("0,4\n1,x\n", "not numbers"), ("0,4,1\n1,5\n", "columns")]:
+    for text, words in [
+        ("0,4\n0,5\n", "does not increase"),
+        ("0,4\n", "at least 2"),
+        ("0,60\n1,4\n", "speed 60"),
+        ("0,4\n1,x\n", "not numbers"),
+        ("0,4,1\n1,5\n", "columns"),
+    ]:
         bad = tmp_path / "bad.csv"
         bad.write_text(text)
         with pytest.raises(WindFileError, match=words):

@@ -28,9 +28,15 @@ import pytest
 from planbench import runner, scenarios
 
 RUNS = {  # the shortest runs that see several readings of the slowest sensor (s)
-    "loader-supply": 0.5, "loader-direct": 0.5, "hexapod-sync-move": 0.5, "hexapod-async-move": 0.5,
-    "antenna-paper-motion": 1.0, "antenna-sea-state": 1.0,
-    "fast-tracking": 2.0, "fast-ra-scan": 2.0, "fast-source-switch": 2.0,
+    "loader-supply": 0.5,
+    "loader-direct": 0.5,
+    "hexapod-sync-move": 0.5,
+    "hexapod-async-move": 0.5,
+    "antenna-paper-motion": 1.0,
+    "antenna-sea-state": 1.0,
+    "fast-tracking": 2.0,
+    "fast-ra-scan": 2.0,
+    "fast-source-switch": 2.0,
 }
 
 
@@ -86,15 +92,19 @@ def test_readings_are_no_newer_than_their_latency(name):
         period = 1.0 / sensor.rate_hz
         if stem is not None:
             stamp = np.array([r[f"{stem}_time"][0] for r in rec.readings])
-            count = (np.array([r[f"{stem}_count"][0] for r in rec.readings]) if f"{stem}_count" in keys
-                     else np.ones_like(stamp))
+            count = (
+                np.array([r[f"{stem}_count"][0] for r in rec.readings])
+                if f"{stem}_count" in keys
+                else np.ones_like(stamp)
+            )
             seen = count > 0
             assert seen.sum() >= 3, (sensor.name, "fewer than 3 ticks with a reading")
             age = t[seen] - stamp[seen]
             worst = int(np.argmin(age))
             assert age.min() >= sensor.latency_s - 1e-9, (
                 f"{name}: {sensor.name} read at t = {t[seen][worst]:.3f} s is {age[worst] * 1e3:.1f} ms old, "
-                f"its spec says a latency of {sensor.latency_s * 1e3:.1f} ms")
+                f"its spec says a latency of {sensor.latency_s * 1e3:.1f} ms"
+            )
             assert age.max() <= sensor.latency_s + period + dt + 1e-9, (name, sensor.name, age.max())
             steps = np.diff(np.unique(stamp[seen]))
             if steps.size:

@@ -10,7 +10,6 @@ from hypothesis import strategies as st
 from scipy import integrate
 from scipy.spatial.transform import Rotation
 
-from planbench.planners.errors import PlanningError
 from planbench.antenna.ship_motion import (
     AXES,
     HEADING,
@@ -28,14 +27,14 @@ from planbench.antenna.ship_motion import (
     jonswap_spectrum,
     world_from_ship,
 )
+from planbench.planners.errors import PlanningError
 
 angle = st.floats(-2 * np.pi, 2 * np.pi, allow_nan=False)
 
 
 def _vee(m):
     """The vector of a skew-symmetric (n, 3, 3) matrix."""
-    return np.stack([m[:, 2, 1] - m[:, 1, 2], m[:, 0, 2] - m[:, 2, 0],
-                     m[:, 1, 0] - m[:, 0, 1]], axis=-1) / 2.0
+    return np.stack([m[:, 2, 1] - m[:, 1, 2], m[:, 0, 2] - m[:, 2, 0], m[:, 1, 0] - m[:, 0, 1]], axis=-1) / 2.0
 
 
 def _gyro_by_finite_differences(motion, t, h=1e-5):
@@ -51,6 +50,7 @@ def _sea(seed=0, **kw):
 
 
 # ---- attitude kinematics --------------------------------------------------------------------
+
 
 @given(angle, angle, angle)
 def test_world_from_ship_is_scipy_intrinsic_zxy(psi, phi, gamma):
@@ -84,8 +84,7 @@ def test_body_angular_velocity_matches_finite_differences_of_attitude():
     t = np.linspace(0.0, 300.0, 37)
     for motion in (PaperShipMotion(), _sea(3, course_deg=30.0, speed=6.0)):
         gyro = motion.sample(t).body_angular_velocity()
-        np.testing.assert_allclose(gyro, _gyro_by_finite_differences(motion, t),
-                                   rtol=0, atol=1e-8 * np.abs(gyro).max())
+        np.testing.assert_allclose(gyro, _gyro_by_finite_differences(motion, t), rtol=0, atol=1e-8 * np.abs(gyro).max())
 
 
 @given(angle, angle, angle, angle, angle, angle)
@@ -95,7 +94,7 @@ def test_body_angular_velocity_of_constant_rates(psi, phi, gam, dpsi, dphi, dgam
     rates = np.array([dpsi, dphi, dgam])
     angles = np.array([psi, phi, gam])
     r0 = world_from_ship(*angles)[0]
-    dr = (world_from_ship(*(angles + h * rates))[0] - world_from_ship(*(angles - h * rates))[0])
+    dr = world_from_ship(*(angles + h * rates))[0] - world_from_ship(*(angles - h * rates))[0]
     expected = _vee((r0.T @ dr / (2 * h))[None])[0]
     got = body_angular_velocity(psi, phi, gam, dpsi, dphi, dgam)[0]
     np.testing.assert_allclose(got, expected, atol=1e-7 * (1 + np.abs(rates).max()))
@@ -112,11 +111,19 @@ def test_ship_state_joint_arrays_in_deck_joint_order():
     np.testing.assert_array_equal(pos[:, ROLL], state.roll)
     assert len(state) == 3
     with pytest.raises(ShipMotionError, match=r"rate has shape \(3, 3\)"):
-        ShipState(t=state.t, heave=state.heave, heading=state.heading, pitch=state.pitch,
-                  roll=state.roll, rate=vel[:, :3], accel=acc)
+        ShipState(
+            t=state.t,
+            heave=state.heave,
+            heading=state.heading,
+            pitch=state.pitch,
+            roll=state.roll,
+            rate=vel[:, :3],
+            accel=acc,
+        )
 
 
 # ---- the paper's motion (eq. 15-16) ---------------------------------------------------------
+
 
 def test_paper_motion_is_eq_15_16_with_t_as_sample_count():
     s = np.array([0.0, 1.0, 137.0, 12345.0, 29999.0])  # sample counts
@@ -134,9 +141,9 @@ def test_paper_motion_periods_and_turn_rate():
     m = PaperShipMotion()
     t = np.linspace(0.0, 20.0, 201)
     a, b8, b10, half8 = m.sample(t), m.sample(t + 8.0), m.sample(t + 10.0), m.sample(t + 4.0)
-    np.testing.assert_allclose(b8.pitch, a.pitch, atol=1e-12)      # pitch: 8 s
+    np.testing.assert_allclose(b8.pitch, a.pitch, atol=1e-12)  # pitch: 8 s
     np.testing.assert_allclose(half8.pitch, -a.pitch, atol=1e-12)  # and not 4 s
-    np.testing.assert_allclose(b10.roll, a.roll, atol=1e-12)       # roll: 10 s
+    np.testing.assert_allclose(b10.roll, a.roll, atol=1e-12)  # roll: 10 s
     np.testing.assert_allclose(m.sample(t + 5.0).roll, -a.roll, atol=1e-12)
     assert m.periods() == pytest.approx({"heading": 300.0, "pitch": 8.0, "roll": 10.0})
     # Heading: 300 s oscillation on a 1 deg/s turn; over whole periods the mean rate is 1 deg/s.
@@ -157,14 +164,20 @@ def test_paper_motion_derivatives_match_finite_differences(motion):
 
 # ---- JONSWAP --------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("hs, tp, gamma", [(1.0, 6.0, 1.0), (5.0, 10.0, 3.3), (2.5, 8.0, 2.0),
-                                           (9.0, 14.0, 7.0), (0.3, 3.0, 1.5)])
+
+@pytest.mark.parametrize(
+    "hs, tp, gamma", [(1.0, 6.0, 1.0), (5.0, 10.0, 3.3), (2.5, 8.0, 2.0), (9.0, 14.0, 7.0), (0.3, 3.0, 1.5)]
+)
 def test_jonswap_variance_is_hs2_over_16_and_peak_at_omega_p(hs, tp, gamma):
     wp = 2 * np.pi / tp
+
     def f(w):
         return float(jonswap_spectrum(w, hs, tp, gamma))
-    m0 = sum(integrate.quad(f, a * wp, b * wp, epsrel=1e-11, limit=200)[0]
-             for a, b in ((0.2, 1.0), (1.0, 4.0), (4.0, np.inf)))
+
+    m0 = sum(
+        integrate.quad(f, a * wp, b * wp, epsrel=1e-11, limit=200)[0]
+        for a, b in ((0.2, 1.0), (1.0, 4.0), (4.0, np.inf))
+    )
     assert m0 == pytest.approx(hs**2 / 16, rel=1e-8)
     assert 4 * np.sqrt(m0) == pytest.approx(hs, rel=1e-8)
     w = np.linspace(0.5 * wp, 2.0 * wp, 30001)
@@ -179,13 +192,13 @@ def test_jonswap_is_pierson_moskowitz_times_peak_enhancement():
     np.testing.assert_allclose(jonswap_spectrum(w, hs, tp, 1.0), pm, rtol=1e-12)
     sigma = np.where(w <= wp, 0.07, 0.09)
     enhancement = 3.3 ** np.exp(-((w - wp) ** 2) / (2 * sigma**2 * wp**2))
-    np.testing.assert_allclose(jonswap_spectrum(w, hs, tp, 3.3),
-                               jonswap_normalization(3.3) * pm * enhancement, rtol=1e-12)
+    np.testing.assert_allclose(
+        jonswap_spectrum(w, hs, tp, 3.3), jonswap_normalization(3.3) * pm * enhancement, rtol=1e-12
+    )
     assert jonswap_spectrum(0.0, hs, tp) == 0.0
 
 
-@pytest.mark.parametrize("gamma, dnv_error", [(1.0, 0.0), (2.0, -0.0022), (3.3, 0.0024),
-                                               (7.0, -0.0175)])
+@pytest.mark.parametrize("gamma, dnv_error", [(1.0, 0.0), (2.0, -0.0022), (3.3, 0.0024), (7.0, -0.0175)])
 def test_jonswap_normalization_against_dnv_fit(gamma, dnv_error):
     # The docstring's numbers: DNV's A_gamma = 1 - 0.287 ln(gamma) against the exact factor.
     dnv = 1 - 0.287 * np.log(gamma)
@@ -214,14 +227,13 @@ def test_sea_state_does_not_repeat():
     a, b = m.wave_elevation(t), m.wave_elevation(t + period)
     assert abs(np.corrcoef(a, b)[0, 1]) < 0.3
     analytic_a = a + 1j * m._sum(t, m.amplitude[:, None], -np.ones((m.omega.size, 1)))[:, 0]
-    analytic_b = b + 1j * m._sum(t + period, m.amplitude[:, None],
-                                 -np.ones((m.omega.size, 1)))[:, 0]
-    coherence = abs(np.vdot(analytic_a, analytic_b)) / np.linalg.norm(analytic_a) \
-        / np.linalg.norm(analytic_b)
+    analytic_b = b + 1j * m._sum(t + period, m.amplitude[:, None], -np.ones((m.omega.size, 1)))[:, 0]
+    coherence = abs(np.vdot(analytic_a, analytic_b)) / np.linalg.norm(analytic_a) / np.linalg.norm(analytic_b)
     assert coherence < 0.3
 
 
 # ---- RAOs -----------------------------------------------------------------------------------
+
 
 def test_roll_rao_peaks_at_roll_natural_frequency_and_vanishes_head_and_following():
     v = VesselRAO()
@@ -236,8 +248,7 @@ def test_roll_rao_peaks_at_roll_natural_frequency_and_vanishes_head_and_followin
         assert np.abs(v.rao(w, np.radians(beta_deg))[:, ROLL]).max() < 1e-12
         assert np.abs(v.rao(w, np.radians(beta_deg))[:, HEADING]).max() < 1e-12
     # Beam seas from starboard and from port roll the ship in opposite senses.
-    np.testing.assert_allclose(v.rao(w, np.radians(-90.0))[:, ROLL],
-                               -v.rao(w, np.radians(90.0))[:, ROLL], atol=1e-15)
+    np.testing.assert_allclose(v.rao(w, np.radians(-90.0))[:, ROLL], -v.rao(w, np.radians(90.0))[:, ROLL], atol=1e-15)
 
 
 def test_pitch_and_yaw_raos_vanish_in_beam_seas():
@@ -259,12 +270,9 @@ def test_long_wave_limits_follow_the_water_surface(beta_deg):
     assert r[HEAVE] == pytest.approx(1.0, abs=1e-4)
     # Pitch = slope along Y, roll = r x minus the slope along X: 90 deg behind the elevation.
     assert r[PITCH] == pytest.approx(-1j * k * np.cos(beta), rel=1e-3, abs=1e-12)
-    assert r[ROLL] == pytest.approx(-1j * v.wave_slope_coefficient * k * np.sin(beta),
-                                    rel=1e-3, abs=1e-12)
-    assert r[HEADING] == pytest.approx(-v.yaw_coefficient * k * np.sin(beta) * np.cos(beta),
-                                       rel=1e-3, abs=1e-12)
-    np.testing.assert_allclose(np.abs(v.rao([1e-4, 1e-3, 0.02], beta)[:, HEAVE]), 1.0,
-                               atol=1e-3)
+    assert r[ROLL] == pytest.approx(-1j * v.wave_slope_coefficient * k * np.sin(beta), rel=1e-3, abs=1e-12)
+    assert r[HEADING] == pytest.approx(-v.yaw_coefficient * k * np.sin(beta) * np.cos(beta), rel=1e-3, abs=1e-12)
+    np.testing.assert_allclose(np.abs(v.rao([1e-4, 1e-3, 0.02], beta)[:, HEAVE]), 1.0, atol=1e-3)
 
 
 def test_raos_are_finite_with_speed_and_short_waves_are_filtered():
@@ -283,6 +291,7 @@ def test_raos_are_finite_with_speed_and_short_waves_are_filtered():
 
 
 # ---- sea-state motion -----------------------------------------------------------------------
+
 
 def test_same_seed_same_motion_different_seed_different():
     t = np.linspace(0.0, 300.0, 3001)
@@ -311,10 +320,8 @@ def test_sea_state_derivatives_match_finite_differences():
     for m in (_sea(1), _sea(2, heading_deg=60.0, speed=7.0, course_deg=-40.0, gamma=1.0)):
         s, lo, hi = m.sample(t), m.sample(t - h), m.sample(t + h)
         scale = np.abs(s.rate).max(axis=0)
-        np.testing.assert_allclose(s.rate, (hi.position - lo.position) / (2 * h),
-                                   rtol=0, atol=1e-6 * scale.max())
-        np.testing.assert_allclose(s.accel, (hi.rate - lo.rate) / (2 * h),
-                                   rtol=0, atol=1e-6 * np.abs(s.accel).max())
+        np.testing.assert_allclose(s.rate, (hi.position - lo.position) / (2 * h), rtol=0, atol=1e-6 * scale.max())
+        np.testing.assert_allclose(s.accel, (hi.rate - lo.rate) / (2 * h), rtol=0, atol=1e-6 * np.abs(s.accel).max())
         assert np.all(scale > 0)
 
 
@@ -328,8 +335,7 @@ def test_sea_state_scalar_and_blocked_samples_agree():
     keep = np.arange(t.size) != 7
     for x, y in zip(whole.joint_arrays(), direct.joint_arrays(), strict=True):
         np.testing.assert_allclose(x[keep], y[keep], rtol=0, atol=1e-12 * np.abs(x).max())
-    np.testing.assert_allclose(m.wave_elevation(t)[keep], m.wave_elevation(uneven)[keep],
-                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(m.wave_elevation(t)[keep], m.wave_elevation(uneven)[keep], rtol=0, atol=1e-12)
     for x, y in zip(direct.joint_arrays(), m.sample(uneven[7]).joint_arrays(), strict=True):
         np.testing.assert_allclose(x[7], y[0], rtol=1e-12, atol=1e-12)
     for i in (0, 4567, 12000):
@@ -364,38 +370,40 @@ def test_course_shifts_heading_only():
 
 # ---- bad input ------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("make, message", [
-    (lambda: _sea(hs=-1.0), r"significant wave height hs = -1 m must be > 0"),
-    (lambda: _sea(hs=0.0), r"hs = 0 m must be > 0"),
-    (lambda: _sea(hs=float("nan")), r"hs = nan m must be finite"),
-    (lambda: _sea(hs=float("inf")), r"hs = inf m must be finite"),
-    (lambda: _sea(tp=0.0), r"peak period tp = 0 s must be > 0"),
-    (lambda: _sea(tp=-3.0), r"tp = -3 s must be > 0"),
-    (lambda: _sea(gamma=0.5), r"gamma = 0.5 must be >= 1"),
-    (lambda: _sea(gamma=float("nan")), r"gamma = nan must be >= 1"),
-    (lambda: _sea(heading_deg=float("nan")), r"heading_deg = nan deg must be finite"),
-    (lambda: _sea(course_deg=float("inf")), r"course_deg = inf deg must be finite"),
-    (lambda: _sea(speed=-2.0), r"ship speed = -2 m/s must be >= 0"),
-    (lambda: _sea(n_components=0), r"n_components = 0 must be an integer >= 1"),
-    (lambda: _sea(n_components=2.5), r"n_components = 2.5 must be an integer >= 1"),
-    (lambda: _sea(omega_min=1.0, omega_max=0.5),
-     r"omega_max = 0.5 rad/s must be > omega_min = 1 rad/s"),
-    (lambda: _sea(omega_min=-1.0), r"omega_min = -1 rad/s must be > 0"),
-    (lambda: _sea().sample([0.0, float("nan")]), r"t\[1\] = nan s must be finite"),
-    (lambda: _sea().wave_elevation(float("inf")), r"t\[0\] = inf s must be finite"),
-    (lambda: _sea().sample(np.zeros((2, 2))), r"shape \(2, 2\)"),
-    (lambda: PaperShipMotion().sample(float("nan")), r"t\[0\] = nan s must be finite"),
-    (lambda: PaperShipMotion(sample_time=0.0), r"paper sample time = 0 s must be > 0"),
-    (lambda: jonswap_spectrum(1.0, hs=-1.0, tp=10.0), r"hs = -1 m must be > 0"),
-    (lambda: jonswap_spectrum(1.0, hs=2.0, tp=10.0, gamma=0.9), r"gamma = 0.9 must be >= 1"),
-    (lambda: VesselRAO(length=-100.0), r"vessel length = -100 m must be > 0"),
-    (lambda: VesselRAO(roll_period=0.0), r"vessel roll_period = 0 s must be > 0"),
-    (lambda: VesselRAO(roll_damping=0.0), r"vessel roll_damping = 0 must be in \(0, 1\]"),
-    (lambda: VesselRAO(block_coefficient=1.2),
-     r"vessel block_coefficient = 1.2 must be in \(0, 1\]"),
-    (lambda: VesselRAO(yaw_coefficient=-0.1), r"vessel yaw_coefficient = -0.1 must be in \[0, 1\]"),
-    (lambda: VesselRAO(draft=float("nan")), r"vessel draft = nan m must be finite"),
-])
+
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: _sea(hs=-1.0), r"significant wave height hs = -1 m must be > 0"),
+        (lambda: _sea(hs=0.0), r"hs = 0 m must be > 0"),
+        (lambda: _sea(hs=float("nan")), r"hs = nan m must be finite"),
+        (lambda: _sea(hs=float("inf")), r"hs = inf m must be finite"),
+        (lambda: _sea(tp=0.0), r"peak period tp = 0 s must be > 0"),
+        (lambda: _sea(tp=-3.0), r"tp = -3 s must be > 0"),
+        (lambda: _sea(gamma=0.5), r"gamma = 0.5 must be >= 1"),
+        (lambda: _sea(gamma=float("nan")), r"gamma = nan must be >= 1"),
+        (lambda: _sea(heading_deg=float("nan")), r"heading_deg = nan deg must be finite"),
+        (lambda: _sea(course_deg=float("inf")), r"course_deg = inf deg must be finite"),
+        (lambda: _sea(speed=-2.0), r"ship speed = -2 m/s must be >= 0"),
+        (lambda: _sea(n_components=0), r"n_components = 0 must be an integer >= 1"),
+        (lambda: _sea(n_components=2.5), r"n_components = 2.5 must be an integer >= 1"),
+        (lambda: _sea(omega_min=1.0, omega_max=0.5), r"omega_max = 0.5 rad/s must be > omega_min = 1 rad/s"),
+        (lambda: _sea(omega_min=-1.0), r"omega_min = -1 rad/s must be > 0"),
+        (lambda: _sea().sample([0.0, float("nan")]), r"t\[1\] = nan s must be finite"),
+        (lambda: _sea().wave_elevation(float("inf")), r"t\[0\] = inf s must be finite"),
+        (lambda: _sea().sample(np.zeros((2, 2))), r"shape \(2, 2\)"),
+        (lambda: PaperShipMotion().sample(float("nan")), r"t\[0\] = nan s must be finite"),
+        (lambda: PaperShipMotion(sample_time=0.0), r"paper sample time = 0 s must be > 0"),
+        (lambda: jonswap_spectrum(1.0, hs=-1.0, tp=10.0), r"hs = -1 m must be > 0"),
+        (lambda: jonswap_spectrum(1.0, hs=2.0, tp=10.0, gamma=0.9), r"gamma = 0.9 must be >= 1"),
+        (lambda: VesselRAO(length=-100.0), r"vessel length = -100 m must be > 0"),
+        (lambda: VesselRAO(roll_period=0.0), r"vessel roll_period = 0 s must be > 0"),
+        (lambda: VesselRAO(roll_damping=0.0), r"vessel roll_damping = 0 must be in \(0, 1\]"),
+        (lambda: VesselRAO(block_coefficient=1.2), r"vessel block_coefficient = 1.2 must be in \(0, 1\]"),
+        (lambda: VesselRAO(yaw_coefficient=-0.1), r"vessel yaw_coefficient = -0.1 must be in \[0, 1\]"),
+        (lambda: VesselRAO(draft=float("nan")), r"vessel draft = nan m must be finite"),
+    ],
+)
 def test_bad_input_raises_naming_value_and_limit(make, message):
     with pytest.raises(ShipMotionError, match=message) as info:
         make()

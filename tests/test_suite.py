@@ -22,7 +22,7 @@ LOGGED = ("t", "qpos", "qvel", "act", "ctrl", "actuator_force", "sensordata", "m
 NAMES = list(scenarios.SCENARIOS)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def short_run(name: str, seed: int):
     setup = scenarios.get(name).build(scenarios.get(name).resolve(duration=SHORT_S, seed=seed))
     return setup, runner.run(name, setup)
@@ -89,7 +89,9 @@ def test_the_summary_is_strict_json_and_names_what_ran(name, tmp_path):
     assert summary["scenario"] == name and summary["seed"] == 1
     components = summary["components"]
     assert set(components) == {"planner", "trajectory", "controller", "sensors", "disturbance"}
-    assert components["planner"].startswith("planbench.planners.") and components["trajectory"].startswith("planbench.planners.")
+    assert components["planner"].startswith("planbench.planners.") and components["trajectory"].startswith(
+        "planbench.planners."
+    )
     assert components["controller"].startswith("planbench.") and components["sensors"].startswith("planbench.")
     assert summary["plugins"] == {}
     assert summary["sensors"] and all(s["rate_hz"] > 0 and s["name"] for s in summary["sensors"])
@@ -126,8 +128,11 @@ def test_a_controller_fault_ends_the_run_as_a_failed_check(name, fault, fault_ti
     checks = {c.name: c for c in result.checks}
     error = checks["controller_errors"]
     assert not error.passed and error.value == 1 and not result.passed
-    expected = ("RuntimeError: observation 'imu' missing in my controller" if fault == "raise"
-                else f"({setup.physics.model.actuator(setup.physics.model.nu - 1).name}) = nan")
+    expected = (
+        "RuntimeError: observation 'imu' missing in my controller"
+        if fault == "raise"
+        else f"({setup.physics.model.actuator(setup.physics.model.nu - 1).name}) = nan"
+    )
     assert expected in error.note, error.note
     assert checks["simulation_warnings"].passed  # no NaN ever reached MuJoCo
     assert result.log.t.size == fault_tick + 1  # ended at the fault
@@ -180,14 +185,15 @@ def test_a_hold_still_plugin_controller_runs_and_is_judged(name, tmp_path):
 def test_the_nominal_plant_runs_bit_for_bit_as_without_one(name):
     # A scenario's nominal plant, given explicitly, is the machine built without one (issue
     # 15: plant uncertainty perturbs only when it is set).
-    from planbench import api
 
     scenario = scenarios.get(name)
     assert scenario.plant is not None and scenario.plant.is_nominal
     setup, result = short_run(name, 1)
     params = scenario.resolve(duration=SHORT_S, seed=1)
-    for other_setup in (scenario.build(params, plant=type(scenario.plant)()),
-                        pipeline.build(scenario, params, scenario.resolve_plant({}))):
+    for other_setup in (
+        scenario.build(params, plant=type(scenario.plant)()),
+        pipeline.build(scenario, params, scenario.resolve_plant({})),
+    ):
         other = runner.run(name, other_setup)
         for key in LOGGED:
             np.testing.assert_array_equal(getattr(other.log, key), getattr(result.log, key), err_msg=key)

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from planbench.fast.controller import winch_feedforward
 from planbench.planners import fast
 from planbench.planners.fast import plan as fp
-from planbench.fast.controller import winch_feedforward
 
 
 class FeedforwardOnly:

@@ -13,9 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from planbench.planners import fast
+from planbench.planners import fast, profiles
 from planbench.planners.fast import plan as fp
-from planbench.planners import profiles
 
 
 class StraightSwitch:
@@ -29,8 +28,9 @@ class StraightSwitch:
                 start = switch[0].evaluate(np.array([0.0]))[0][0]
                 end = switch[-1].evaluate(np.array([switch[-1].duration]))[0][0]
                 duration = sum(s.duration for s in switch)
-                profile = profiles.move_in_time(float(np.linalg.norm(end - start)), duration, fast.V_S_MAX,
-                                                fast.A_S_MAX)
+                profile = profiles.move_in_time(
+                    float(np.linalg.norm(end - start)), duration, fast.V_S_MAX, fast.A_S_MAX
+                )
                 segments.append(fp.LineSegment("switch-chord", 0.0, duration, fast.A_S_MAX, start, end, profile))
                 switch = []
             if segment is not None:

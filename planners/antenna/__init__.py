@@ -40,8 +40,8 @@ constant-rate rotation, the matrix logarithm of N(t + dt) N(t)^T over dt.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -85,8 +85,7 @@ def rotation_log(r) -> np.ndarray:
     v = vee(r)  # axis * sin(angle)
     small = angle < 1e-4
     # angle / sin(angle), with its series where sin(angle) is tiny.
-    scale = np.where(small, 1.0 + angle**2 / 6.0 + 7.0 * angle**4 / 360.0,
-                     angle / np.where(small, 1.0, np.sin(angle)))
+    scale = np.where(small, 1.0 + angle**2 / 6.0 + 7.0 * angle**4 / 360.0, angle / np.where(small, 1.0, np.sin(angle)))
     return v * scale[..., None]
 
 
@@ -112,12 +111,15 @@ def satellite_attitude(azimuth, elevation, polarization) -> np.ndarray:
     """
     a, e, s = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (azimuth, elevation, polarization)))
     ca, sa, ce, se, cs, ss = np.cos(a), np.sin(a), np.cos(e), np.sin(e), np.cos(s), np.sin(s)
-    return np.stack([
-        # Row 1: the printed CE_e of (1,1) and (1,2) corrected to CA_e.
-        np.stack([ca * ss - cs * sa * se, ca * cs + sa * se * ss, ce * sa], -1),
-        np.stack([-sa * ss - ca * cs * se, -cs * sa + ca * se * ss, ca * ce], -1),
-        np.stack([ce * cs, -ce * ss, se], -1),
-    ], -2)
+    return np.stack(
+        [
+            # Row 1: the printed CE_e of (1,1) and (1,2) corrected to CA_e.
+            np.stack([ca * ss - cs * sa * se, ca * cs + sa * se * ss, ce * sa], -1),
+            np.stack([-sa * ss - ca * cs * se, -cs * sa + ca * se * ss, ca * ce], -1),
+            np.stack([ce * cs, -ce * ss, se], -1),
+        ],
+        -2,
+    )
 
 
 def ship_attitude(heading, pitch, roll) -> np.ndarray:
@@ -154,8 +156,7 @@ def forward_kinematics(theta) -> np.ndarray:
     if theta.shape == (4,):
         m0 = (c1 * c3 - s1 * c2 * s3, s1 * c3 + c1 * c2 * s3, -s2 * s3)
         m1 = (-c1 * s3 - s1 * c2 * c3, -s1 * s3 + c1 * c2 * c3, -s2 * c3)
-        return np.array([[c4 * m2[r] + s4 * m0[r], -s4 * m2[r] + c4 * m0[r], m1[r]]
-                         for r in range(3)])
+        return np.array([[c4 * m2[r] + s4 * m0[r], -s4 * m2[r] + c4 * m0[r], m1[r]] for r in range(3)])
     m = np.empty(theta.shape[:-1] + (3, 3))
     # M = Rz(t1) Rx(-t2) Rz(t3); A = M C0 has columns (M_2, M_0, M_1).
     m0 = (c1 * c3 - s1 * c2 * s3, s1 * c3 + c1 * c2 * s3, -s2 * s3)  # M column 0
@@ -177,8 +178,7 @@ def jacobian(theta) -> np.ndarray:
         c1, s1 = math.cos(theta[0]), math.sin(theta[0])
         c2, s2 = math.cos(theta[1]), math.sin(theta[1])
         a4 = forward_kinematics(theta)[:, 2]
-        return np.array([[0.0, -c1, -s1 * s2, a4[0]], [0.0, -s1, c1 * s2, a4[1]],
-                         [1.0, 0.0, c2, a4[2]]])
+        return np.array([[0.0, -c1, -s1 * s2, a4[0]], [0.0, -s1, c1 * s2, a4[1]], [1.0, 0.0, c2, a4[2]]])
     t1, t2 = theta[..., 0], theta[..., 1]
     c1, s1, c2, s2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
     zero, one = np.zeros_like(c1), np.ones_like(c1)
@@ -195,8 +195,10 @@ def joint_angles_at_rest(azimuth, elevation, polarization) -> np.ndarray:
     Azimuth is wrapped to (-180, 180] deg, so the paper's Az 223.49 deg gives 136.51 deg.
     """
     t1 = np.angle(np.exp(-1j * np.asarray(azimuth, dtype=float)))
-    return np.stack(np.broadcast_arrays(t1, -np.asarray(elevation, dtype=float), 0.0 * t1,
-                                        np.asarray(polarization, dtype=float)), -1)
+    return np.stack(
+        np.broadcast_arrays(t1, -np.asarray(elevation, dtype=float), 0.0 * t1, np.asarray(polarization, dtype=float)),
+        -1,
+    )
 
 
 # --------------------------------------------------------------------------------------
@@ -342,8 +344,7 @@ def _angular_velocity(n_now, n_next, dt, method):
     raise PlanningError(f"angular velocity method {method!r} is not 'eq6' or 'log'")
 
 
-def pinv_integration_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS,
-                          omega_method: str = "eq6"):
+def pinv_integration_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, omega_method: str = "eq6"):
     """The paper's baseline (section 5.2): Theta_{n+1} = Theta_n + Thetadot_n dt, eq. (6)-(7).
 
     Open-loop integration of the joint rates; its attitude error accumulates (Figure 4).
@@ -355,9 +356,19 @@ def pinv_integration_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS
     return new, StepInfo(float(frobenius_error(forward_kinematics(new), n_next)))
 
 
-def crr_step(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
-             limits: AntennaLimits | None = None, omega_method: str = "eq6",
-             full_correction: bool = False, tol: float = 1e-15, max_iter: int = 20):
+def crr_step(
+    theta,
+    n_now,
+    n_next,
+    dt: float,
+    weights=PAPER_WEIGHTS,
+    *,
+    limits: AntennaLimits | None = None,
+    omega_method: str = "eq6",
+    full_correction: bool = False,
+    tol: float = 1e-15,
+    max_iter: int = 20,
+):
     """One update of the constant-rotation-ratio algorithm (section 4.2, steps 3-7).
 
     Step 3: the average angular velocity over the update, eq. (6) (``omega_method="log"``:
@@ -443,9 +454,17 @@ def _fk_floats(t1: float, t2: float, t3: float, t4: float) -> tuple:
     m20, m21, m22 = -s1 * s2, c1 * s2, c2  # column 2 of M = Rz(t1) Rx(-t2) Rz(t3)
     m00, m01, m02 = c1 * c3 - s1 * c2 * s3, s1 * c3 + c1 * c2 * s3, -s2 * s3  # column 0
     m10, m11, m12 = -c1 * s3 - s1 * c2 * c3, -s1 * s3 + c1 * c2 * c3, -s2 * c3  # column 1
-    return (c4 * m20 + s4 * m00, -s4 * m20 + c4 * m00, m10,
-            c4 * m21 + s4 * m01, -s4 * m21 + c4 * m01, m11,
-            c4 * m22 + s4 * m02, -s4 * m22 + c4 * m02, m12)
+    return (
+        c4 * m20 + s4 * m00,
+        -s4 * m20 + c4 * m00,
+        m10,
+        c4 * m21 + s4 * m01,
+        -s4 * m21 + c4 * m01,
+        m11,
+        c4 * m22 + s4 * m02,
+        -s4 * m22 + c4 * m02,
+        m12,
+    )
 
 
 def _jacobian_rows(t1: float, t2: float, t3: float) -> tuple:
@@ -454,18 +473,28 @@ def _jacobian_rows(t1: float, t2: float, t3: float) -> tuple:
     c1, s1 = math.cos(t1), math.sin(t1)
     c2, s2 = math.cos(t2), math.sin(t2)
     c3, s3 = math.cos(t3), math.sin(t3)
-    return ((0.0, -c1, -s1 * s2, -c1 * s3 - s1 * c2 * c3),
-            (0.0, -s1, c1 * s2, -s1 * s3 + c1 * c2 * c3),
-            (1.0, 0.0, c2, -s2 * c3))
+    return (
+        (0.0, -c1, -s1 * s2, -c1 * s3 - s1 * c2 * c3),
+        (0.0, -s1, c1 * s2, -s1 * s3 + c1 * c2 * c3),
+        (1.0, 0.0, c2, -s2 * c3),
+    )
 
 
 def _relative_floats(a, b) -> tuple:
     """A B^T of two 3 x 3 matrices given as 9 floats each, row by row."""
     a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
     b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
-    return (a0 * b0 + a1 * b1 + a2 * b2, a0 * b3 + a1 * b4 + a2 * b5, a0 * b6 + a1 * b7 + a2 * b8,
-            a3 * b0 + a4 * b1 + a5 * b2, a3 * b3 + a4 * b4 + a5 * b5, a3 * b6 + a4 * b7 + a5 * b8,
-            a6 * b0 + a7 * b1 + a8 * b2, a6 * b3 + a7 * b4 + a8 * b5, a6 * b6 + a7 * b7 + a8 * b8)
+    return (
+        a0 * b0 + a1 * b1 + a2 * b2,
+        a0 * b3 + a1 * b4 + a2 * b5,
+        a0 * b6 + a1 * b7 + a2 * b8,
+        a3 * b0 + a4 * b1 + a5 * b2,
+        a3 * b3 + a4 * b4 + a5 * b5,
+        a3 * b6 + a4 * b7 + a5 * b8,
+        a6 * b0 + a7 * b1 + a8 * b2,
+        a6 * b3 + a7 * b4 + a8 * b5,
+        a6 * b6 + a7 * b7 + a8 * b8,
+    )
 
 
 def _log_floats(r) -> tuple:
@@ -492,12 +521,14 @@ def _gram_floats(jac, w_inv) -> tuple:
     ja1, ja2, ja3 = a1 * w1, a2 * w2, a3 * w3
     jb1, jb2, jb3 = b1 * w1, b2 * w2, b3 * w3
     jc0, jc2, jc3 = c0 * w0, c2 * w2, c3 * w3
-    gram = (ja1 * a1 + ja2 * a2 + ja3 * a3,
-            ja1 * b1 + ja2 * b2 + ja3 * b3,
-            ja2 * c2 + ja3 * c3,
-            jb1 * b1 + jb2 * b2 + jb3 * b3,
-            jb2 * c2 + jb3 * c3,
-            jc0 * c0 + jc2 * c2 + jc3 * c3)
+    gram = (
+        ja1 * a1 + ja2 * a2 + ja3 * a3,
+        ja1 * b1 + ja2 * b2 + ja3 * b3,
+        ja2 * c2 + ja3 * c3,
+        jb1 * b1 + jb2 * b2 + jb3 * b3,
+        jb2 * c2 + jb3 * c3,
+        jc0 * c0 + jc2 * c2 + jc3 * c3,
+    )
     return ((0.0, ja1, ja2, ja3), (0.0, jb1, jb2, jb3), (jc0, 0.0, jc2, jc3)), gram
 
 
@@ -588,14 +619,23 @@ def joint_rates_scalar(theta, omega, weights=PAPER_WEIGHTS, limits: AntennaLimit
     online path's fast version. theta (4,), omega (3,); returns (rates (4,), damped,
     rate_limited), equal to ``joint_rates`` to round-off (tested)."""
     w_inv = [1.0 / float(w) for w in weights]
-    rates, damped, limited = _joint_rates_floats([float(v) for v in theta], [float(v) for v in omega],
-                                                 w_inv, limits)
+    rates, damped, limited = _joint_rates_floats([float(v) for v in theta], [float(v) for v in omega], w_inv, limits)
     return np.array(rates), damped, limited
 
 
-def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
-                    limits: AntennaLimits | None = None, omega_method: str = "eq6",
-                    full_correction: bool = False, tol: float = 1e-15, max_iter: int = 20):
+def crr_step_scalar(
+    theta,
+    n_now,
+    n_next,
+    dt: float,
+    weights=PAPER_WEIGHTS,
+    *,
+    limits: AntennaLimits | None = None,
+    omega_method: str = "eq6",
+    full_correction: bool = False,
+    tol: float = 1e-15,
+    max_iter: int = 20,
+):
     """``crr_step`` for one pose in plain floats: the same update (section 4.2, steps 3-7:
     the angular velocity of eq. 6 or its exact log, the weighted pseudo-inverse of eq. 9 with
     the safeguards of ``joint_rates``, RK4 of eq. 11, the rotation ratio of eq. 12-14, Newton
@@ -611,8 +651,11 @@ def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
         rotvec = _log_floats(relative)
         omega = (rotvec[0] / dt, rotvec[1] / dt, rotvec[2] / dt)
     else:  # vee(N(t + dt) N(t)^T) / dt
-        omega = (0.5 * (relative[7] - relative[5]) / dt, 0.5 * (relative[2] - relative[6]) / dt,
-                 0.5 * (relative[3] - relative[1]) / dt)
+        omega = (
+            0.5 * (relative[7] - relative[5]) / dt,
+            0.5 * (relative[2] - relative[6]) / dt,
+            0.5 * (relative[3] - relative[1]) / dt,
+        )
     w_inv = [1.0 / float(w) for w in weights]
     rate_limits = None if limits is None else [float(v) for v in limits.rate]
     info = StepInfo()
@@ -653,8 +696,12 @@ def crr_step_scalar(theta, n_now, n_next, dt: float, weights=PAPER_WEIGHTS, *,
                 break
         if rate_limits is not None:  # (given with the limits)
             l0, l1, l2, l3 = rate_limits
-            cap = min(l0 / max(abs(q0), 1e-300), l1 / max(abs(q1), 1e-300), l2 / max(abs(q2), 1e-300),
-                      l3 / max(abs(q3), 1e-300))
+            cap = min(
+                l0 / max(abs(q0), 1e-300),
+                l1 / max(abs(q1), 1e-300),
+                l2 / max(abs(q2), 1e-300),
+                l3 / max(abs(q3), 1e-300),
+            )
             if abs(xi) > cap:
                 xi = math.copysign(cap, xi)
                 info.rate_limited = True
@@ -706,9 +753,17 @@ class JointPath:
         return np.diff(self.theta, axis=0) / np.diff(self.t)[:, None]
 
 
-def solve_joint_path(attitudes, dt: float, theta0, method: str = "crr",
-                     weights=PAPER_WEIGHTS, limits: AntennaLimits | None = None,
-                     omega_method: str = "eq6", t0: float = 0.0, scalar: bool = False) -> JointPath:
+def solve_joint_path(
+    attitudes,
+    dt: float,
+    theta0,
+    method: str = "crr",
+    weights=PAPER_WEIGHTS,
+    limits: AntennaLimits | None = None,
+    omega_method: str = "eq6",
+    t0: float = 0.0,
+    scalar: bool = False,
+) -> JointPath:
     """Joint angles that hold the attitudes N(t0 + n dt) (n, 3, 3), from Theta0.
 
     method: "pinv" (the paper's baseline, section 5.2), "crr" (section 4.2) or "crr-full"
@@ -737,12 +792,20 @@ def solve_joint_path(attitudes, dt: float, theta0, method: str = "crr",
     limited = np.zeros(n, dtype=bool)
     for i in range(n - 1):
         if method == "pinv":
-            theta[i + 1], info = pinv_integration_step(theta[i], attitudes[i], attitudes[i + 1],
-                                                       dt, weights, omega_method)
+            theta[i + 1], info = pinv_integration_step(
+                theta[i], attitudes[i], attitudes[i + 1], dt, weights, omega_method
+            )
         else:
             theta[i + 1], info = (crr_step_scalar if scalar else crr_step)(
-                theta[i], attitudes[i], attitudes[i + 1], dt, weights, limits=limits, omega_method=omega_method,
-                full_correction=method == "crr-full")
+                theta[i],
+                attitudes[i],
+                attitudes[i + 1],
+                dt,
+                weights,
+                limits=limits,
+                omega_method=omega_method,
+                full_correction=method == "crr-full",
+            )
         error[i + 1] = info.error_fro
         iterations[i + 1] = info.iterations
         damped[i + 1] = info.damped
@@ -775,8 +838,9 @@ def check_rates(rates, limits: AntennaLimits, where: str = "") -> None:
     peak = np.abs(rates).max(axis=0)
     for name, value, limit in zip(JOINT_LABELS, peak, limits.rate, strict=True):
         if value > limit:
-            raise LimitError(f"{name} rate {np.degrees(value):.2f} deg/s is beyond its limit "
-                             f"{np.degrees(limit):.2f} deg/s{where}")
+            raise LimitError(
+                f"{name} rate {np.degrees(value):.2f} deg/s is beyond its limit {np.degrees(limit):.2f} deg/s{where}"
+            )
 
 
 # --------------------------------------------------------------------------------------
@@ -839,10 +903,20 @@ class CrrPlanner:
     def step(self, t: float, attitude: np.ndarray) -> np.ndarray:
         """Joint angles for ``attitude`` at ``t`` (s), after the previous step (or reset, t = 0)."""
         if not t > self.t:
-            raise PlanningError(f"CRR step at t = {t:.6g} s does not come after the previous one at {self.t:.6g} s: "
-                                "the angular velocity (eq. 6) needs an interval > 0")
+            raise PlanningError(
+                f"CRR step at t = {t:.6g} s does not come after the previous one at {self.t:.6g} s: "
+                "the angular velocity (eq. 6) needs an interval > 0"
+            )
         p = self.problem
-        theta, info = crr_step_scalar(self.theta, self.attitude, attitude, t - self.t, p.weights, limits=p.limits,
-                                      omega_method=self.omega_method, full_correction=self.method == "crr-full")
+        theta, info = crr_step_scalar(
+            self.theta,
+            self.attitude,
+            attitude,
+            t - self.t,
+            p.weights,
+            limits=p.limits,
+            omega_method=self.omega_method,
+            full_correction=self.method == "crr-full",
+        )
         self.theta, self.attitude, self.t, self.last_info = theta, attitude, t, info
         return theta

@@ -36,8 +36,9 @@ def _enu_basis(lat: float, lon: float) -> np.ndarray:
     return np.array([[-sl, cl, 0.0], [-sp * cl, -sp * sl, cp], [cp * cl, cp * sl, sp]])
 
 
-def look_angles(satellite_lon: float, lat: float, lon: float, height: float = 0.0,
-                polarization: str = "horizontal") -> tuple[float, float, float]:
+def look_angles(
+    satellite_lon: float, lat: float, lon: float, height: float = 0.0, polarization: str = "horizontal"
+) -> tuple[float, float, float]:
     """(azimuth, elevation, polarization) in rad from a ship to a geostationary satellite.
 
     Args:
@@ -49,8 +50,12 @@ def look_angles(satellite_lon: float, lat: float, lon: float, height: float = 0.
     """
     import erfa  # pyerfa: WGS84 geodetic -> Earth-fixed position
 
-    for name, value in (("satellite longitude", satellite_lon), ("latitude", lat),
-                        ("longitude", lon), ("height", height)):
+    for name, value in (
+        ("satellite longitude", satellite_lon),
+        ("latitude", lat),
+        ("longitude", lon),
+        ("height", height),
+    ):
         if not np.isfinite(value):
             raise PlanningError(f"{name} {value!r} must be finite")
     if abs(lat) > np.pi / 2:
@@ -67,11 +72,15 @@ def look_angles(satellite_lon: float, lat: float, lon: float, height: float = 0.
         raise LimitError(
             f"the satellite at {np.degrees(satellite_lon):.2f} deg is {np.degrees(elevation):.2f} deg "
             f"below the horizon of a ship at ({np.degrees(lat):.2f}, {np.degrees(lon):.2f}) deg; "
-            f"the limit is 0 deg")
+            f"the limit is 0 deg"
+        )
     azimuth = float(np.arctan2(look[0], look[1]) % (2.0 * np.pi))
     # The E-field in ENU, projected on the aperture plane (perpendicular to the boresight).
-    field = enu @ (np.array([0.0, 0.0, 1.0]) if polarization == "vertical"
-                   else np.array([-np.sin(satellite_lon), np.cos(satellite_lon), 0.0]))
+    field = enu @ (
+        np.array([0.0, 0.0, 1.0])
+        if polarization == "vertical"
+        else np.array([-np.sin(satellite_lon), np.cos(satellite_lon), 0.0])
+    )
     frame = satellite_attitude(azimuth, elevation, 0.0)
     y0, boresight = frame[:, 1], frame[:, 2]
     field = field - (field @ boresight) * boresight

@@ -99,10 +99,10 @@ class FastGeometry:
         models/fast/fast.xml has the same masses (tests/test_fast_model.py).
     """
 
-    tower_anchors: np.ndarray = field(default_factory=lambda: _ring(
-        300.0, [30, 90, 150, 210, 270, 330], -REFLECTOR_RADIUS + 270.0))
-    cabin_anchors: np.ndarray = field(default_factory=lambda: _ring(
-        6.5, [60, 60, 180, 180, 300, 300], 0.0))
+    tower_anchors: np.ndarray = field(
+        default_factory=lambda: _ring(300.0, [30, 90, 150, 210, 270, 330], -REFLECTOR_RADIUS + 270.0)
+    )
+    cabin_anchors: np.ndarray = field(default_factory=lambda: _ring(6.5, [60, 60, 180, 180, 300, 300], 0.0))
     ab_center: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -2.0]))
     r_ab_s: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -3.5]))
     r_s_feed: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -1.0]))
@@ -155,16 +155,18 @@ class StewartGeometry:
     """
 
     base_anchors: np.ndarray = field(default_factory=lambda: _paired_ring(1.6, [0, 120, 240], 15.0, -1.5))
-    platform_anchors: np.ndarray = field(default_factory=lambda: np.roll(
-        _paired_ring(1.1, [60, 180, 300], 15.0, 0.0), 1, axis=0))
+    platform_anchors: np.ndarray = field(
+        default_factory=lambda: np.roll(_paired_ring(1.1, [60, 180, 300], 15.0, 0.0), 1, axis=0)
+    )
     stroke: float = 0.25
 
 
 STEWART = StewartGeometry()
 
 
-def stewart_leg_lengths(offset=None, rotation=None, geometry: FastGeometry = FAST,
-                        stewart: StewartGeometry = STEWART) -> np.ndarray:
+def stewart_leg_lengths(
+    offset=None, rotation=None, geometry: FastGeometry = FAST, stewart: StewartGeometry = STEWART
+) -> np.ndarray:
     """(..., 6) Stewart leg lengths, m, for a platform displaced by ``offset`` (..., 3) in the
     AB frame and turned by ``rotation`` (..., 3, 3) from its nominal pose at r_AB-s (the same
     leg formula as the cables and the hexapod, planbench.planners.legs)."""
@@ -234,8 +236,9 @@ def check_zenith_angle(direction, limit: float = MAX_ZENITH_ANGLE, times=None) -
     if bad.size:
         i = int(bad[0])
         where = f" at t = {float(np.atleast_1d(times)[i]):.3f} s" if times is not None else f" (sample {i})"
-        raise ZenithLimitError(f"zenith angle {math.degrees(za[i]):.3f} deg{where} is beyond the limit "
-                               f"{math.degrees(limit):.1f} deg")
+        raise ZenithLimitError(
+            f"zenith angle {math.degrees(za[i]):.3f} deg{where} is beyond the limit {math.degrees(limit):.1f} deg"
+        )
 
 
 def feed_position(direction, radius: float = FOCAL_SURFACE_RADIUS) -> np.ndarray:
@@ -305,8 +308,9 @@ def cabin_pose(feed, axis, cabin_tilt, geometry: FastGeometry = FAST) -> CabinPo
     return CabinPose(feed, axis, phi, cabin_tilt, ab_tilt, theta_a, theta_b, rotation, ab_point, origin)
 
 
-def feed_from_cabin(origin, rotation, theta_a, theta_b, geometry: FastGeometry = FAST,
-                    stewart_offset=None) -> np.ndarray:
+def feed_from_cabin(
+    origin, rotation, theta_a, theta_b, geometry: FastGeometry = FAST, stewart_offset=None
+) -> np.ndarray:
     """Forward kinematics, eq. (1) and (4): the feed from the cabin pose and the A-B angles.
 
     ``stewart_offset`` (..., 3): a displacement of the Stewart platform in the AB frame
@@ -337,8 +341,7 @@ def cabin_com_at(ab_rotation=None, geometry: FastGeometry = FAST) -> np.ndarray:
     return geometry.cabin_com + (geometry.ab_mass / geometry.cabin_mass) * shift
 
 
-def gravity_wrench(origin, rotation, lengths, geometry: FastGeometry = FAST,
-                   ab_rotation=None) -> np.ndarray:
+def gravity_wrench(origin, rotation, lengths, geometry: FastGeometry = FAST, ab_rotation=None) -> np.ndarray:
     """(..., 6) weight of the cabin and the lumped half cable weights, about the cabin origin.
 
     Force in N, moment in N m (inertial axes). ``ab_rotation`` (..., 3, 3): R_AB, whose tilt
@@ -359,8 +362,7 @@ def gravity_wrench(origin, rotation, lengths, geometry: FastGeometry = FAST,
     return np.concatenate([force, moment], axis=-1)
 
 
-def cable_tensions(origin, rotation, geometry: FastGeometry = FAST, extra_wrench=None,
-                   ab_rotation=None) -> np.ndarray:
+def cable_tensions(origin, rotation, geometry: FastGeometry = FAST, extra_wrench=None, ab_rotation=None) -> np.ndarray:
     """(..., 6) static cable tensions, N (positive pulls), from A t + W = 0.
 
     W: the cabin's weight (its centre of mass moved by the A-B tilt ``ab_rotation``, if
@@ -375,10 +377,11 @@ def cable_tensions(origin, rotation, geometry: FastGeometry = FAST, extra_wrench
     return leg_forces(a, wrench)
 
 
-def pose_tensions(pose: "CabinPose", geometry: FastGeometry = FAST) -> np.ndarray:
+def pose_tensions(pose: CabinPose, geometry: FastGeometry = FAST) -> np.ndarray:
     """(..., 6) static cable tensions, N, of a ``CabinPose`` (its A-B tilt included)."""
-    return cable_tensions(pose.origin, pose.rotation, geometry,
-                          ab_rotation=ab_rotation(pose.theta_a, pose.theta_b, geometry.alpha))
+    return cable_tensions(
+        pose.origin, pose.rotation, geometry, ab_rotation=ab_rotation(pose.theta_a, pose.theta_b, geometry.alpha)
+    )
 
 
 def _softmin(values: np.ndarray, scale: float) -> np.ndarray:
@@ -395,8 +398,15 @@ class TiltSplit:
     tensions: np.ndarray  # (..., 6) N
 
 
-def split_tilt(feed, axis, geometry: FastGeometry = FAST, limits: FastLimits = FAST_LIMITS,
-               iterations: int = 48, softness: float = 2e3, check: bool = True) -> TiltSplit:
+def split_tilt(
+    feed,
+    axis,
+    geometry: FastGeometry = FAST,
+    limits: FastLimits = FAST_LIMITS,
+    iterations: int = 48,
+    softness: float = 2e3,
+    check: bool = True,
+) -> TiltSplit:
     """Split the feed's tilt between the cabin and the A-B rotator (vectorized over poses).
 
     Among cabin tilts theta_C in [max(0, ZA - ab_tilt), min(cabin_tilt, ZA)] it takes the one
@@ -415,9 +425,11 @@ def split_tilt(feed, axis, geometry: FastGeometry = FAST, limits: FastLimits = F
     hi = np.minimum(limits.cabin_tilt, za)
     if check and np.any(lo > hi + 1e-12):
         i = int(np.flatnonzero((lo > hi + 1e-12).ravel())[0])
-        raise ZenithLimitError(f"zenith angle {math.degrees(za.ravel()[i]):.3f} deg (pose {i}) is beyond the "
-                               f"cabin's {math.degrees(limits.cabin_tilt):.1f} deg plus the A-B rotator's "
-                               f"{math.degrees(limits.ab_tilt):.1f} deg")
+        raise ZenithLimitError(
+            f"zenith angle {math.degrees(za.ravel()[i]):.3f} deg (pose {i}) is beyond the "
+            f"cabin's {math.degrees(limits.cabin_tilt):.1f} deg plus the A-B rotator's "
+            f"{math.degrees(limits.ab_tilt):.1f} deg"
+        )
     hi = np.maximum(hi, lo)
 
     def objective(tilt):
@@ -446,13 +458,17 @@ def split_tilt(feed, axis, geometry: FastGeometry = FAST, limits: FastLimits = F
 def check_tensions(tensions, limits: FastLimits = FAST_LIMITS, times=None) -> None:
     """LimitError naming the first cable tension outside [tension_min, tension_max]."""
     t = np.asarray(tensions, dtype=float).reshape(-1, 6)
-    for bad, limit, word in ((t < limits.tension_min, limits.tension_min, "below the minimum"),
-                             (t > limits.tension_max, limits.tension_max, "above the maximum")):
+    for bad, limit, word in (
+        (t < limits.tension_min, limits.tension_min, "below the minimum"),
+        (t > limits.tension_max, limits.tension_max, "above the maximum"),
+    ):
         if bad.any():
             i, j = np.argwhere(bad)[0]
             where = f" at t = {float(np.ravel(times)[i]):.3f} s" if times is not None else f" (pose {i})"
-            raise LimitError(f"{CABLE_LABELS[j]} tension {t[i, j] / 1e3:.1f} kN{where} is {word} "
-                             f"{limit / 1e3:.0f} kN: no cabin tilt keeps the cables in range")
+            raise LimitError(
+                f"{CABLE_LABELS[j]} tension {t[i, j] / 1e3:.1f} kN{where} is {word} "
+                f"{limit / 1e3:.0f} kN: no cabin tilt keeps the cables in range"
+            )
 
 
 # ----------------------------------------------------------------------------- tilt law
@@ -472,8 +488,7 @@ class TiltLaw:
     computed for the actual pose.
     """
 
-    def __init__(self, geometry: FastGeometry = FAST, limits: FastLimits = FAST_LIMITS,
-                 points: int = 49):
+    def __init__(self, geometry: FastGeometry = FAST, limits: FastLimits = FAST_LIMITS, points: int = 49):
         from scipy.interpolate import RectBivariateSpline
 
         self.geometry, self.limits = geometry, limits

@@ -105,8 +105,7 @@ class LineSegment(Segment):
         length = float(np.linalg.norm(d))
         unit = d / length if length > 0 else np.zeros(3)
         p = self.profile.evaluate(tau)
-        return (self.start + p.position[:, None] * unit, p.velocity[:, None] * unit,
-                p.acceleration[:, None] * unit)
+        return (self.start + p.position[:, None] * unit, p.velocity[:, None] * unit, p.acceleration[:, None] * unit)
 
 
 @dataclass
@@ -156,8 +155,10 @@ def tangential_limit(a_max: float, v_max: float, radius: float = R_FOCAL) -> flo
     under a_max^2 at speeds up to v_max (at 400 mm/s the centripetal part is 0.99 mm/s^2)."""
     centripetal = v_max * v_max / radius
     if centripetal >= a_max:
-        raise LimitError(f"speed {v_max:g} m/s on the focal sphere needs {centripetal:g} m/s^2 "
-                         f"of centripetal acceleration, beyond the limit {a_max:g} m/s^2")
+        raise LimitError(
+            f"speed {v_max:g} m/s on the focal sphere needs {centripetal:g} m/s^2 "
+            f"of centripetal acceleration, beyond the limit {a_max:g} m/s^2"
+        )
     return math.sqrt(a_max * a_max - centripetal * centripetal)
 
 
@@ -204,10 +205,15 @@ def _tilt_state(point: np.ndarray, geometry, limits):
     return float(pose.cabin_tilt), (float(pose.theta_a), float(pose.theta_b))
 
 
-def switch_times(p0, p1, multifeed0: float = 0.0, multifeed1: float = 0.0,
-                 mechanisms: MechanismLimits = MECHANISM_LIMITS,
-                 geometry: fast.FastGeometry = fast.FAST,
-                 limits: fast.FastLimits = fast.FAST_LIMITS) -> SwitchTimes:
+def switch_times(
+    p0,
+    p1,
+    multifeed0: float = 0.0,
+    multifeed1: float = 0.0,
+    mechanisms: MechanismLimits = MECHANISM_LIMITS,
+    geometry: fast.FastGeometry = fast.FAST,
+    limits: fast.FastLimits = fast.FAST_LIMITS,
+) -> SwitchTimes:
     """Segment times of a source switch P0 -> Ph -> P1 (section 3.2, eq. 10).
 
     T_focal: the feed's minimum time along the focal arc Ph -> P1 (V_s-max, A_s-max).
@@ -276,8 +282,7 @@ def start_segment(observation: Segment, a_max: float = fast.A_MAX) -> ArcSegment
     a = ps / np.linalg.norm(ps)
     p1 = R_FOCAL * (math.cos(angle) * a - math.sin(angle) * tangent)
     direction = math.cos(angle) * tangent + math.sin(angle) * a  # the arc's tangent at P1
-    return ArcSegment("start", observation.t0 - profile.duration, profile.duration, a_max, p1,
-                      direction, profile)
+    return ArcSegment("start", observation.t0 - profile.duration, profile.duration, a_max, p1, direction, profile)
 
 
 def start_angle(observation: Segment, start: Segment) -> float:
@@ -312,8 +317,9 @@ def termination_segment(observation: Segment, a_max: float = fast.A_MAX) -> ArcS
 # ----------------------------------------------------------------------------- observation
 
 
-def observation_segment(times, directions, t0: float = 0.0, name: str = "observation",
-                        a_max: float = fast.A_MAX, angles=None) -> SampledSegment:
+def observation_segment(
+    times, directions, t0: float = 0.0, name: str = "observation", a_max: float = fast.A_MAX, angles=None
+) -> SampledSegment:
     """The feed following a sky path: P_feed = -r s(t) through a cubic spline in time;
     ``angles`` (rad, at the same times): the multi-feed rotation along it (e.g. the
     parallactic angle, so the 19 beams keep their pattern on the sky)."""
@@ -333,8 +339,9 @@ def observation_segment(times, directions, t0: float = 0.0, name: str = "observa
     return SampledSegment(name, t0, float(times[-1] - times[0]), a_max, spline, angle_spline)
 
 
-def transition_segment(p0, v0, p1, v1, duration: float, t0: float,
-                       a_limit: float = fast.A_T_MAX, name: str = "transition") -> SampledSegment:
+def transition_segment(
+    p0, v0, p1, v1, duration: float, t0: float, a_limit: float = fast.A_T_MAX, name: str = "transition"
+) -> SampledSegment:
     """A transition between two observation legs (section 3.3): the cubic Hermite curve from
     (P, V) at one leg's end to (P, V) at the next leg's start in ``duration``, projected on the
     focal sphere, as a spline on a 0.5 s grid."""
@@ -367,8 +374,7 @@ def transition_time(p0, v0, p1, v1, a_limit: float = fast.A_T_MAX) -> float:
     while hermite_peak_acceleration(p0, v0, p1, v1, hi) > a_limit:
         hi *= 2.0
         if hi > 1e5:
-            raise LimitError("no transition within 1e5 s keeps the acceleration under "
-                             f"{a_limit * 1e3:.1f} mm/s^2")
+            raise LimitError(f"no transition within 1e5 s keeps the acceleration under {a_limit * 1e3:.1f} mm/s^2")
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         if hermite_peak_acceleration(p0, v0, p1, v1, mid) > a_limit:
@@ -393,8 +399,9 @@ def paper_ra_scan_fits(v_dec_deg_h: float, t2: float) -> dict:
     return {"V_m_mm_s": v_m, "p_m": p_m, "V_c_mm_s": v_c, "l_2_mm": 0.5 * t2 * v_c}
 
 
-def paper_dec_scan_t2(v_asc: float, a_max_mm_s2: float = fast.A_MAX * 1e3,
-                      a_s_max_mm_s2: float = fast.A_S_MAX * 1e3) -> dict:
+def paper_dec_scan_t2(
+    v_asc: float, a_max_mm_s2: float = fast.A_MAX * 1e3, a_s_max_mm_s2: float = fast.A_S_MAX * 1e3
+) -> dict:
     """Eq. (15)-(20), the motion scan along declination; units as printed (mm/s, s, deg/h).
 
     V_m = -0.751 V_asc + 11.3, V_m-inv = 0.751 V_asc + 11.3, t3 = 2 V_m / A_max +
@@ -409,14 +416,12 @@ def paper_dec_scan_t2(v_asc: float, a_max_mm_s2: float = fast.A_MAX * 1e3,
     a = a_s_max_mm_s2
     b = 2 * a * t3 + 8 * v_d
     t2 = (b + math.sqrt(b * b - 4 * (a * t3) ** 2)) / (2 * a)
-    return {"V_m_mm_s": v_m, "V_m_inv_mm_s": v_m_inv, "t3_s": t3, "V_dec_deg_h": v_dec,
-            "V_D_mm_s": v_d, "t2_s": t2}
+    return {"V_m_mm_s": v_m, "V_m_inv_mm_s": v_m_inv, "t3_s": t3, "V_dec_deg_h": v_dec, "V_D_mm_s": v_d, "t2_s": t2}
 
 
 # ----------------------------------------------------------------------------- the plan
 
-PLAN_LABELS = ("feed_x", "feed_y", "feed_z", "cabin_tilt", "theta_a", "theta_b", "multifeed",
-               *fast.CABLE_LABELS)
+PLAN_LABELS = ("feed_x", "feed_y", "feed_z", "cabin_tilt", "theta_a", "theta_b", "multifeed", *fast.CABLE_LABELS)
 PLAN_KINDS = ("slide",) * 3 + ("hinge",) * 4 + ("slide",) * 6
 RATE_STEP = 0.01  # s: central differences of the derived channels' rates
 
@@ -452,9 +457,16 @@ class FastPlanSample:
     stewart_leg: np.ndarray
 
 
-def feed_state(t, feed, feed_velocity, feed_acceleration, multifeed, segment=None,
-               geometry: fast.FastGeometry = fast.FAST, limits: fast.FastLimits = fast.FAST_LIMITS
-               ) -> FastPlanSample:
+def feed_state(
+    t,
+    feed,
+    feed_velocity,
+    feed_acceleration,
+    multifeed,
+    segment=None,
+    geometry: fast.FastGeometry = fast.FAST,
+    limits: fast.FastLimits = fast.FAST_LIMITS,
+) -> FastPlanSample:
     """Everything the mechanism must do to put the feed at ``feed`` (n, 3) m: the focal axis,
     the tilt law, the cabin pose, the A-B angles, the cable lengths and the static tensions
     (planbench.planners.fast), at the times ``t`` (n,) s. ``segment``: (n,) segment indices, or None
@@ -466,16 +478,39 @@ def feed_state(t, feed, feed_velocity, feed_acceleration, multifeed, segment=Non
     tensions = fast.pose_tensions(p, geometry)
     stewart = np.broadcast_to(fast.stewart_leg_lengths(), (t.size, 6))
     segment = np.full(t.size, -1) if segment is None else segment
-    return FastPlanSample(t, segment, feed, feed_velocity, feed_acceleration, axis, fast.zenith_angle(axis),
-                          p.cabin_tilt, p.ab_tilt, p.phi, p.theta_a, p.theta_b, multifeed, p.rotation,
-                          p.ab_point, p.origin, lengths, tensions, stewart.copy())
+    return FastPlanSample(
+        t,
+        segment,
+        feed,
+        feed_velocity,
+        feed_acceleration,
+        axis,
+        fast.zenith_angle(axis),
+        p.cabin_tilt,
+        p.ab_tilt,
+        p.phi,
+        p.theta_a,
+        p.theta_b,
+        multifeed,
+        p.rotation,
+        p.ab_point,
+        p.origin,
+        lengths,
+        tensions,
+        stewart.copy(),
+    )
 
 
 def reference_state(reference) -> FastPlanSample:
     """``feed_state`` of a sampled FAST trajectory (its channels PLAN_LABELS: the feed position
     and the multi-feed angle are used; the rest follows from them)."""
-    return feed_state(reference.t, reference.position[:, :3], reference.velocity[:, :3],
-                      reference.acceleration[:, :3], reference.position[:, PLAN_LABELS.index("multifeed")])
+    return feed_state(
+        reference.t,
+        reference.position[:, :3],
+        reference.velocity[:, :3],
+        reference.acceleration[:, :3],
+        reference.position[:, PLAN_LABELS.index("multifeed")],
+    )
 
 
 @dataclass
@@ -531,8 +566,10 @@ class FastPlan:
                 q, qd = (float(x[0]) for x in segs[k - 1].angle(np.array([segs[k - 1].duration])))
                 seg.angle_profile = _rate_ramp(qd, 0.0, seg.duration)
                 seg.angle_start = q
+
         def has_angle(seg):
             return isinstance(seg, SampledSegment) or seg.angle_profile is not None
+
         k = 0
         while k < len(segs):
             if has_angle(segs[k]):
@@ -545,8 +582,9 @@ class FastPlan:
             before = float(segs[first - 1].angle(np.array([segs[first - 1].duration]))[0][0]) if first > 0 else 0.0
             after = float(segs[last + 1].angle(np.array([0.0]))[0][0]) if last + 1 < len(segs) else before
             total = sum(segs[i].duration for i in run)
-            move = prof.move_in_time(after - before, total, MECHANISM_LIMITS.multifeed_rate,
-                                     MECHANISM_LIMITS.multifeed_accel)
+            move = prof.move_in_time(
+                after - before, total, MECHANISM_LIMITS.multifeed_rate, MECHANISM_LIMITS.multifeed_accel
+            )
             offset = 0.0
             for i in run:
                 segs[i].angle_profile = _Window(move, offset, segs[i].duration)
@@ -559,8 +597,9 @@ class FastPlan:
         return float(self._breaks[-1])
 
     def segment_table(self) -> list[dict]:
-        return [{"name": s.name, "t0": s.t0, "duration": s.duration, "accel_limit": s.accel_limit}
-                for s in self.segments]
+        return [
+            {"name": s.name, "t0": s.t0, "duration": s.duration, "accel_limit": s.accel_limit} for s in self.segments
+        ]
 
     def feed(self, t):
         """(index, position, velocity, acceleration) of the feed at times t (s)."""
@@ -617,9 +656,11 @@ class FastPlan:
         bad = np.flatnonzero(acc > limit * (1 + 1e-6))
         if bad.size:
             i = int(bad[0])
-            raise LimitError(f"feed acceleration {acc[i] * 1e3:.3f} mm/s^2 at t = {t[i]:.2f} s on the "
-                             f"{self.segments[s.segment[i]].name} segment is beyond its limit "
-                             f"{limit[i] * 1e3:.1f} mm/s^2")
+            raise LimitError(
+                f"feed acceleration {acc[i] * 1e3:.3f} mm/s^2 at t = {t[i]:.2f} s on the "
+                f"{self.segments[s.segment[i]].name} segment is beyond its limit "
+                f"{limit[i] * 1e3:.1f} mm/s^2"
+            )
 
 
 # ----------------------------------------------------------------------------- motion scans
@@ -642,8 +683,7 @@ def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX,
     legs = []
     for k in range(scan.n_legs):
         mask = (path.t >= scan.leg_start[k] - 1e-9) & (path.t <= scan.leg_end[k] + 1e-9)
-        legs.append(observation_segment(path.t[mask], directions[mask], name=f"leg {k + 1}",
-                                        angles=angles[mask]))
+        legs.append(observation_segment(path.t[mask], directions[mask], name=f"leg {k + 1}", angles=angles[mask]))
     segments = [legs[0]]
     peaks = []
     for k in range(1, scan.n_legs):
@@ -654,8 +694,10 @@ def scan_segments(scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX,
         peaks.append(peak)
         if peak > a_limit:
             need = transition_time(p0, v0, p1, v1, a_limit)
-            raise LimitError(f"transition {k} needs {peak * 1e3:.2f} mm/s^2 in t2 = {scan.t2:.1f} s, "
-                             f"beyond A_t-max {a_limit * 1e3:.1f} mm/s^2; t2 >= {need:.1f} s keeps it")
+            raise LimitError(
+                f"transition {k} needs {peak * 1e3:.2f} mm/s^2 in t2 = {scan.t2:.1f} s, "
+                f"beyond A_t-max {a_limit * 1e3:.1f} mm/s^2; t2 >= {need:.1f} s keeps it"
+            )
         segments += [transition_segment(p0, v0, p1, v1, scan.t2, 0.0, a_limit, f"transition {k}"), b]
     return segments, path, peaks
 
@@ -676,19 +718,21 @@ def _transition_peaks(scan, start, step: float, dut1: float = 0.0) -> list[float
     return peaks
 
 
-def minimum_t2(make_scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX,
-               tolerance: float = 0.01, dut1: float = 0.0) -> float:
+def minimum_t2(
+    make_scan, start, step: float = 1.0, a_limit: float = fast.A_T_MAX, tolerance: float = 0.01, dut1: float = 0.0
+) -> float:
     """The shortest t2 (to ``tolerance`` s) whose transitions all keep |a| <= A_t-max: the
     geometric t2. ``make_scan(t2)`` builds the MotionScan; the sky turns during t2, so the
     legs' end states depend on it and every trial rebuilds the raster (bisection)."""
+
     def feasible(t2):
         return max(_transition_peaks(make_scan(t2), start, step, dut1), default=0.0) <= a_limit
+
     lo, hi = 0.0, 1.0
     while not feasible(hi):
         lo, hi = hi, 2.0 * hi
         if hi > 1e4:
-            raise LimitError(f"no transition time up to 1e4 s keeps the acceleration under "
-                             f"{a_limit * 1e3:.1f} mm/s^2")
+            raise LimitError(f"no transition time up to 1e4 s keeps the acceleration under {a_limit * 1e3:.1f} mm/s^2")
     while hi - lo > tolerance:
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if feasible(mid) else (mid, hi)
@@ -749,7 +793,7 @@ class FastProblem:
 
     park: np.ndarray
     windows: tuple
-    goal: "FastPlan"
+    goal: FastPlan
     info: dict = field(default_factory=dict)
     geometry: fast.FastGeometry = fast.FAST
     limits: fast.FastLimits = fast.FAST_LIMITS
@@ -763,14 +807,17 @@ class FastProblem:
 class PaperPlanner:
     """The paper's planner (sections 3.1-3.3): its plan of the session is the goal itself."""
 
-    def plan(self, problem: FastProblem) -> "FastPlan":
+    def plan(self, problem: FastProblem) -> FastPlan:
         return problem.goal
 
 
-def problem_of(plan: "FastPlan", observing_prefixes: tuple, park=None) -> FastProblem:
+def problem_of(plan: FastPlan, observing_prefixes: tuple, park=None) -> FastProblem:
     """The problem whose goal is ``plan``: its windows are the segments whose names start with
     ``observing_prefixes``; the park position is the plan's first feed position."""
-    windows = tuple(ObservingWindow(s.name, float(s.t0), float(s.t0 + s.duration))
-                    for s in plan.segments if s.name.startswith(observing_prefixes))
+    windows = tuple(
+        ObservingWindow(s.name, float(s.t0), float(s.t0 + s.duration))
+        for s in plan.segments
+        if s.name.startswith(observing_prefixes)
+    )
     start = plan.feed(np.array([0.0]))[1][0] if park is None else np.asarray(park, dtype=float)
     return FastProblem(start, windows, plan, dict(plan.info), plan.geometry, plan.limits)

@@ -183,8 +183,7 @@ def _dut1(dut1) -> float:
     """UT1 - UTC, s: finite, |dut1| < 0.9 s."""
     v = float(_finite("UT1 - UTC", dut1, "s"))
     if not abs(v) < MAX_DUT1:
-        raise PlanningError(f"UT1 - UTC {v!r} s is outside (-{MAX_DUT1:g}, {MAX_DUT1:g}) s, the range UTC "
-                            "keeps it in")
+        raise PlanningError(f"UT1 - UTC {v!r} s is outside (-{MAX_DUT1:g}, {MAX_DUT1:g}) s, the range UTC keeps it in")
     return v
 
 
@@ -230,8 +229,7 @@ def _parse_datetime(value) -> np.ndarray:
 
 def as_utc_jd(utc) -> tuple[np.ndarray, np.ndarray]:
     """UTC as datetime64 / ISO string(s) / (jd1, jd2) -> ERFA's two-part quasi JD (arrays)."""
-    if isinstance(utc, tuple) and len(utc) == 2 and all(
-            np.asarray(x).dtype.kind in "fiu" for x in utc):
+    if isinstance(utc, tuple) and len(utc) == 2 and all(np.asarray(x).dtype.kind in "fiu" for x in utc):
         jd1 = _finite("UTC jd1", utc[0], "d")
         jd2 = _finite("UTC jd2", utc[1], "d")
         return np.broadcast_arrays(jd1, jd2)
@@ -257,8 +255,9 @@ def jd_to_iso(jd1, jd2) -> str | np.ndarray:
     """UTC (jd1, jd2) -> ISO 8601 string(s) to the millisecond, e.g. "2025-06-01T12:00:00.000Z"."""
     with _quiet_erfa():
         iy, im, iday, ihmsf = erfa.d2dtf("UTC", 3, jd1, jd2)
-    fmt = np.vectorize(lambda y, m, d, h, mi, s, f:
-                       f"{y:04d}-{m:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}.{f:03d}Z", otypes=[object])
+    fmt = np.vectorize(
+        lambda y, m, d, h, mi, s, f: f"{y:04d}-{m:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}.{f:03d}Z", otypes=[object]
+    )
     out = fmt(iy, im, iday, ihmsf["h"], ihmsf["m"], ihmsf["s"], ihmsf["f"])
     return str(out) if np.ndim(out) == 0 else out
 
@@ -279,11 +278,12 @@ def _astrom(jd1, jd2, site: Site, dut1: float = 0.0):
     f = hours - k
     anchors, inverse = np.unique(np.concatenate([k.ravel(), k.ravel() + 1.0]), return_inverse=True)
     with _quiet_erfa():
-        table, _ = erfa.apco13(_J2000, anchors / per_day, dut1, site.longitude, site.latitude,
-                               site.height, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        table, _ = erfa.apco13(
+            _J2000, anchors / per_day, dut1, site.longitude, site.latitude, site.height, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        )
         table = np.atleast_1d(table)
-        lo = table[inverse[:k.size].reshape(k.shape)]
-        hi = table[inverse[k.size:].reshape(k.shape)]
+        lo = table[inverse[: k.size].reshape(k.shape)]
+        hi = table[inverse[k.size :].reshape(k.shape)]
         astrom = lo.copy()
         for name in table.dtype.names:
             w = f.reshape(f.shape + (1,) * (lo[name].ndim - f.ndim))
@@ -302,8 +302,25 @@ def _observed(ra, dec, utc, site: Site, exact: bool, dut1: float = 0.0):
     with _quiet_erfa():
         if exact:
             aob, zob, hob, dob, _, _ = erfa.atco13(
-                ra, dec, 0.0, 0.0, 0.0, 0.0, jd1, jd2, dut1, site.longitude, site.latitude,
-                site.height, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+                ra,
+                dec,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                jd1,
+                jd2,
+                dut1,
+                site.longitude,
+                site.latitude,
+                site.height,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            )
         else:
             astrom = _astrom(jd1, jd2, site, dut1)
             ri, di = erfa.atciq(ra, dec, 0.0, 0.0, 0.0, 0.0, astrom)
@@ -342,8 +359,7 @@ def sky_position(az, el, utc, *, site: Site = FAST_SITE, dut1: float = 0.0):
     return np.mod(rc, 2.0 * np.pi), dc
 
 
-def meridian_transit(ra, dec, near, *, site: Site = FAST_SITE,
-                     dut1: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def meridian_transit(ra, dec, near, *, site: Site = FAST_SITE, dut1: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """UTC (jd1, jd2) of the upper meridian transit (observed hour angle 0) nearest ``near``.
 
     Newton's method on the hour angle from ``observed_azel``'s chain, whose rate is the Earth
@@ -382,8 +398,7 @@ def horizon_rates(t, az, el, radius: float = FOCAL_SURFACE_RADIUS) -> HorizonRat
     az = _finite("azimuth", az, "rad")
     el = _finite("elevation", el, "rad")
     if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
-        raise PlanningError(f"times must be 1-D and increasing with at least 2 samples, "
-                            f"got shape {t.shape}")
+        raise PlanningError(f"times must be 1-D and increasing with at least 2 samples, got shape {t.shape}")
     az_rate = np.gradient(np.unwrap(az, axis=-1), t, axis=-1)
     el_rate = np.gradient(el, t, axis=-1)
     s = source_direction(az, el)
@@ -400,8 +415,7 @@ def sidereal_rates(az, el, *, site: Site = FAST_SITE) -> tuple[np.ndarray, np.nd
     az = _finite("azimuth", az, "rad")
     el = _finite("elevation", el, "rad")
     w, lat = EARTH_ROTATION_RATE, site.latitude
-    return (w * (math.sin(lat) - math.cos(lat) * np.cos(az) * np.tan(el)),
-            w * math.cos(lat) * np.sin(az))
+    return (w * (math.sin(lat) - math.cos(lat) * np.cos(az) * np.tan(el)), w * math.cos(lat) * np.sin(az))
 
 
 # ----------------------------------------------------------------------------- paths
@@ -453,8 +467,9 @@ def _sample_times(duration: float, step: float, boundaries=()) -> np.ndarray:
     grid points within 1e-6 step of a boundary are dropped."""
     ratio = duration / step * (1.0 + 1e-12)
     if not ratio + 1 + len(boundaries) <= MAX_SAMPLES:
-        raise PlanningError(f"duration {duration!r} s at step {step!r} s gives {ratio:.4g} samples; "
-                            f"the limit is {MAX_SAMPLES}")
+        raise PlanningError(
+            f"duration {duration!r} s at step {step!r} s gives {ratio:.4g} samples; the limit is {MAX_SAMPLES}"
+        )
     bounds = np.unique(np.concatenate([[0.0, duration], np.asarray(boundaries, dtype=float)]))
     grid = step * np.arange(math.floor(ratio) + 1)
     i = np.clip(np.searchsorted(bounds, grid), 1, bounds.size - 1)
@@ -471,7 +486,8 @@ def _check_zenith(what: str, za: np.ndarray, t: np.ndarray, jd1, jd2, limit) -> 
         raise ZenithLimitError(
             f"{what} reaches zenith angle {math.degrees(za[i]):.3f} deg at "
             f"{jd_to_iso(jd1[i], jd2[i])} UTC ({t[i]:.1f} s after the start), beyond the FAST "
-            f"limit {math.degrees(limit):.1f} deg")
+            f"limit {math.degrees(limit):.1f} deg"
+        )
 
 
 def _limit(za_limit):
@@ -483,9 +499,18 @@ def _limit(za_limit):
     return v
 
 
-def track(ra: float, dec: float, start, duration: float, *, step: float = 1.0,
-          za_limit: float | None = MAX_ZENITH_ANGLE, site: Site = FAST_SITE,
-          exact: bool = False, dut1: float = 0.0) -> SkyPath:
+def track(
+    ra: float,
+    dec: float,
+    start,
+    duration: float,
+    *,
+    step: float = 1.0,
+    za_limit: float | None = MAX_ZENITH_ANGLE,
+    site: Site = FAST_SITE,
+    exact: bool = False,
+    dut1: float = 0.0,
+) -> SkyPath:
     """Tracking: the beam follows the fixed ICRS (ra, dec), rad, from ``start`` (UTC, see
     ``utc_jd``) for ``duration`` s, sampled every ``step`` s (and at the end).
 
@@ -500,16 +525,41 @@ def track(ra: float, dec: float, start, duration: float, *, step: float = 1.0,
     t = _sample_times(duration, step)
     jd1, jd2 = utc_jd(start, t)
     az, el = observed_azel(ra, dec, (jd1, jd2), site=site, exact=exact, dut1=dut1)
-    _check_zenith(f"the source at RA {math.degrees(ra):.4f} deg, Dec {math.degrees(dec):.4f} deg",
-                  np.pi / 2 - el, t, jd1, jd2, limit)
+    _check_zenith(
+        f"the source at RA {math.degrees(ra):.4f} deg, Dec {math.degrees(dec):.4f} deg",
+        np.pi / 2 - el,
+        t,
+        jd1,
+        jd2,
+        limit,
+    )
     n = t.size
-    return SkyPath(t, jd1, jd2, np.full(n, ra % (2 * np.pi)), np.full(n, dec), az, el,
-                   np.ones(n, bool), np.zeros(n, int), np.array([0.0]), np.array([duration]))
+    return SkyPath(
+        t,
+        jd1,
+        jd2,
+        np.full(n, ra % (2 * np.pi)),
+        np.full(n, dec),
+        az,
+        el,
+        np.ones(n, bool),
+        np.zeros(n, int),
+        np.array([0.0]),
+        np.array([duration]),
+    )
 
 
-def drift_scan(az: float, el: float, start, duration: float, *, step: float = 1.0,
-               za_limit: float | None = MAX_ZENITH_ANGLE, site: Site = FAST_SITE,
-               dut1: float = 0.0) -> SkyPath:
+def drift_scan(
+    az: float,
+    el: float,
+    start,
+    duration: float,
+    *,
+    step: float = 1.0,
+    za_limit: float | None = MAX_ZENITH_ANGLE,
+    site: Site = FAST_SITE,
+    dut1: float = 0.0,
+) -> SkyPath:
     """Drift scan: the feed parked at (az, el), rad, while the sky drifts through the beam.
 
     Returns the constant az/el and the ICRS (ra, dec) the beam sees at each sample (RA grows at
@@ -525,11 +575,28 @@ def drift_scan(az: float, el: float, start, duration: float, *, step: float = 1.
     t = _sample_times(duration, step)
     jd1, jd2 = utc_jd(start, t)
     n = t.size
-    _check_zenith(f"the parked beam at az {math.degrees(az):.4f} deg, el {math.degrees(el):.4f} deg",
-                  np.full(n, np.pi / 2 - el), t, jd1, jd2, limit)
+    _check_zenith(
+        f"the parked beam at az {math.degrees(az):.4f} deg, el {math.degrees(el):.4f} deg",
+        np.full(n, np.pi / 2 - el),
+        t,
+        jd1,
+        jd2,
+        limit,
+    )
     ra, dec = sky_position(np.full(n, az), np.full(n, el), (jd1, jd2), site=site, dut1=dut1)
-    return SkyPath(t, jd1, jd2, ra, dec, np.full(n, az), np.full(n, el), np.ones(n, bool),
-                   np.zeros(n, int), np.array([0.0]), np.array([duration]))
+    return SkyPath(
+        t,
+        jd1,
+        jd2,
+        ra,
+        dec,
+        np.full(n, az),
+        np.full(n, el),
+        np.ones(n, bool),
+        np.zeros(n, int),
+        np.array([0.0]),
+        np.array([duration]),
+    )
 
 
 LEG_AXES = ("dec", "ra")
@@ -577,22 +644,20 @@ class MotionScan:
         _positive("transition time t2", self.t2, "s", allow_zero=True)
         if self.n_legs > 1:
             if self.leg_spacing == 0.0:
-                raise PlanningError(f"leg spacing {self.leg_spacing!r} rad must be nonzero "
-                                    f"for {self.n_legs} legs")
+                raise PlanningError(f"leg spacing {self.leg_spacing!r} rad must be nonzero for {self.n_legs} legs")
             if self.t2 == 0.0:
-                raise PlanningError(f"transition time t2 {self.t2!r} s must be > 0 "
-                                    f"for {self.n_legs} legs")
+                raise PlanningError(f"transition time t2 {self.t2!r} s must be > 0 for {self.n_legs} legs")
         half = 0.5 * (self.n_legs - 1) * abs(self.leg_spacing)
         if self.legs_along == "dec":
             extent = abs(self.dec) + 0.5 * self.leg_length
             if self.n_legs > 1 and abs(self.dec) >= math.pi / 2:
-                raise PlanningError(f"declination {math.degrees(self.dec):.4f} deg: legs cannot be "
-                                    "spaced in RA at a pole")
+                raise PlanningError(
+                    f"declination {math.degrees(self.dec):.4f} deg: legs cannot be spaced in RA at a pole"
+                )
         else:
             extent = abs(self.dec) + half
         if extent > math.pi / 2 or (self.legs_along == "ra" and extent >= math.pi / 2):
-            raise PlanningError(f"the raster reaches declination {math.degrees(extent):.4f} deg, "
-                                "beyond +/-90 deg")
+            raise PlanningError(f"the raster reaches declination {math.degrees(extent):.4f} deg, beyond +/-90 deg")
 
     @property
     def paper_name(self) -> str:
@@ -652,8 +717,16 @@ class MotionScan:
             dec = np.where(on_leg, dec, (1 - f) * dec_a + f * dec_b)
         return np.mod(ra, 2.0 * np.pi), dec, on_leg, k
 
-    def path(self, start, *, step: float = 1.0, za_limit: float | None = MAX_ZENITH_ANGLE,
-             site: Site = FAST_SITE, exact: bool = False, dut1: float = 0.0) -> SkyPath:
+    def path(
+        self,
+        start,
+        *,
+        step: float = 1.0,
+        za_limit: float | None = MAX_ZENITH_ANGLE,
+        site: Site = FAST_SITE,
+        exact: bool = False,
+        dut1: float = 0.0,
+    ) -> SkyPath:
         """The scan from ``start`` (UTC) sampled every ``step`` s and at every leg start and
         end; LimitError at the first sample beyond ``za_limit`` (40 deg; None: no check)."""
         step = _positive("step", step, "s")
@@ -662,9 +735,15 @@ class MotionScan:
         ra, dec, on_leg, leg = self.sky(t)
         jd1, jd2 = utc_jd(start, t)
         az, el = observed_azel(ra, dec, (jd1, jd2), site=site, exact=exact, dut1=dut1)
-        _check_zenith(f"the {self.paper_name.split(' (')[0]} centred at RA "
-                      f"{math.degrees(self.ra):.4f} deg, Dec {math.degrees(self.dec):.4f} deg",
-                      np.pi / 2 - el, t, jd1, jd2, limit)
+        _check_zenith(
+            f"the {self.paper_name.split(' (')[0]} centred at RA "
+            f"{math.degrees(self.ra):.4f} deg, Dec {math.degrees(self.dec):.4f} deg",
+            np.pi / 2 - el,
+            t,
+            jd1,
+            jd2,
+            limit,
+        )
         return SkyPath(t, jd1, jd2, ra, dec, az, el, on_leg, leg, self.leg_start, self.leg_end)
 
 

@@ -40,8 +40,8 @@ The generator (paper, "Trajectory")
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 
@@ -121,18 +121,18 @@ class HexapodLimits:
         for name in ("pose_lower", "pose_upper"):
             value = np.array(getattr(self, name), dtype=float)
             if value.shape != (6,):
-                raise PlanningError(f"{name} must have 6 components (x, y, z, rx, ry, rz), got "
-                                    f"shape {value.shape}")
-            check_values(value, lambda i, name=name: f"{name} {POSE_LABELS[i[0]]}",
-                         lambda i: _pose_unit(i[-1]))
+                raise PlanningError(f"{name} must have 6 components (x, y, z, rx, ry, rz), got shape {value.shape}")
+            check_values(value, lambda i, name=name: f"{name} {POSE_LABELS[i[0]]}", lambda i: _pose_unit(i[-1]))
             value.setflags(write=False)
             object.__setattr__(self, name, value)
         crossed = np.flatnonzero(self.pose_lower > self.pose_upper)
         if crossed.size:
             axis = int(crossed[0])
-            raise PlanningError(f"pose_lower {POSE_LABELS[axis]} = {self.pose_lower[axis]:.6g} "
-                                f"{_pose_unit(axis)} is above pose_upper "
-                                f"{POSE_LABELS[axis]} = {self.pose_upper[axis]:.6g}")
+            raise PlanningError(
+                f"pose_lower {POSE_LABELS[axis]} = {self.pose_lower[axis]:.6g} "
+                f"{_pose_unit(axis)} is above pose_upper "
+                f"{POSE_LABELS[axis]} = {self.pose_upper[axis]:.6g}"
+            )
         for name in ("stroke", "strut_speed", "strut_accel", "linear_speed", "angular_speed"):
             check_positive(getattr(self, name), f"limit {name}")
 
@@ -145,30 +145,38 @@ class HexapodLimits:
 # REFERENCE.md, "Rubin hexapod": ts_mthexapod constants.py, camera hexapod (um -> m). The
 # "±/∓" pairs are expanded in order, which puts the pivots around the circle in sequence.
 RUBIN_CAMERA = HexapodGeometry(
-    base_pivots=np.array([
-        [227_600, 653_800, -525_000],
-        [-227_600, 653_800, -525_000],
-        [-680_000, -129_700, -525_000],
-        [-452_300, -524_000, -525_000],
-        [452_300, -524_000, -525_000],
-        [680_000, -129_700, -525_000],
-    ]) * _UM,
-    platform_pivots=np.array([
-        [472_800, 512_200, -121_400],
-        [-472_800, 512_200, -121_400],
-        [-680_000, 153_300, -121_400],
-        [-207_200, -665_500, -121_400],
-        [207_200, -665_500, -121_400],
-        [680_000, 153_300, -121_400],
-    ]) * _UM,
+    base_pivots=np.array(
+        [
+            [227_600, 653_800, -525_000],
+            [-227_600, 653_800, -525_000],
+            [-680_000, -129_700, -525_000],
+            [-452_300, -524_000, -525_000],
+            [452_300, -524_000, -525_000],
+            [680_000, -129_700, -525_000],
+        ]
+    )
+    * _UM,
+    platform_pivots=np.array(
+        [
+            [472_800, 512_200, -121_400],
+            [-472_800, 512_200, -121_400],
+            [-680_000, 153_300, -121_400],
+            [-207_200, -665_500, -121_400],
+            [207_200, -665_500, -121_400],
+            [680_000, 153_300, -121_400],
+        ]
+    )
+    * _UM,
     rotation_pivot=np.array([0.0, 0.0, -2_758_400 * _UM]),
 )
 
 RUBIN_LIMITS = HexapodLimits(
-    pose_lower=np.array([-11_400 * _UM, -11_400 * _UM, -13_100 * _UM,
-                         np.radians(-0.36), np.radians(-0.36), np.radians(-0.10)]),
-    pose_upper=np.array([11_400 * _UM, 11_400 * _UM, 13_100 * _UM,
-                         np.radians(0.36), np.radians(0.36), np.radians(0.10)]),
+    pose_lower=np.array(
+        [-11_400 * _UM, -11_400 * _UM, -13_100 * _UM, np.radians(-0.36), np.radians(-0.36), np.radians(-0.10)]
+    ),
+    pose_upper=np.array(
+        [11_400 * _UM, 11_400 * _UM, 13_100 * _UM, np.radians(0.36), np.radians(0.36), np.radians(0.10)]
+    ),
     stroke=14_100 * _UM,
     strut_speed=500 * _UM,
     strut_accel=500 * _UM,
@@ -214,12 +222,13 @@ def _as_poses(pose, what: str = "pose") -> np.ndarray:
     except (TypeError, ValueError):
         raise PlanningError(f"{what} {pose!r} must be numbers") from None
     if pose.shape[-1:] != (6,):
-        raise PlanningError(f"{what} must have 6 components (x, y, z, rx, ry, rz), got shape "
-                            f"{pose.shape}")
+        raise PlanningError(f"{what} must have 6 components (x, y, z, rx, ry, rz), got shape {pose.shape}")
     flat = pose.reshape(-1, 6)
-    check_values(flat, lambda i: f"{what} {POSE_LABELS[i[1]]}"
-                 + (f" of row {i[0]}" if pose.ndim > 1 else ""),
-                 lambda i: _pose_unit(i[1]))
+    check_values(
+        flat,
+        lambda i: f"{what} {POSE_LABELS[i[1]]}" + (f" of row {i[0]}" if pose.ndim > 1 else ""),
+        lambda i: _pose_unit(i[1]),
+    )
     return pose
 
 
@@ -285,8 +294,9 @@ def jacobian(pose, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
     pose = _as_poses(pose)
     flat = pose.reshape(-1, 6)
     position, rotation = platform_frame(flat, geometry)
-    (lx, ly, lz), (ax, ay, az) = leg_vector_components(geometry.base_pivots, geometry.platform_local,
-                                                       position, rotation)
+    (lx, ly, lz), (ax, ay, az) = leg_vector_components(
+        geometry.base_pivots, geometry.platform_local, position, rotation
+    )
     length = component_norm(lx, ly, lz)
     ux, uy, uz = lx / length, ly / length, lz / length
     # Column by column (contiguous writes); the result is the transposed view.
@@ -301,8 +311,9 @@ def jacobian(pose, geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
     return columns.swapaxes(-1, -2).reshape(pose.shape[:-1] + (columns.shape[-1], 6))
 
 
-def forward_kinematics(lengths, geometry: HexapodGeometry = RUBIN_CAMERA, initial=None,
-                       tolerance: float = 1e-12, max_iterations: int = 20):
+def forward_kinematics(
+    lengths, geometry: HexapodGeometry = RUBIN_CAMERA, initial=None, tolerance: float = 1e-12, max_iterations: int = 20
+):
     """Forward kinematics by Newton's method on the 6x6 Jacobian.
 
     Args:
@@ -333,9 +344,7 @@ def forward_kinematics(lengths, geometry: HexapodGeometry = RUBIN_CAMERA, initia
         try:
             step = np.linalg.solve(jacobian(pose, geometry), residual[..., None])[..., 0]
         except np.linalg.LinAlgError:
-            raise KinematicsError(
-                f"forward kinematics met a singular Jacobian at iteration {iteration}"
-            ) from None
+            raise KinematicsError(f"forward kinematics met a singular Jacobian at iteration {iteration}") from None
         pose = pose - step
         residual = strut_lengths(pose, geometry) - lengths
         if not np.all(np.isfinite(residual)):
@@ -379,7 +388,7 @@ def stroke_messages(positions: np.ndarray, what: str, limits: HexapodLimits = RU
     change_mm = (positions[np.arange(positions.shape[0]), strut] * 1e3).tolist()
     heads = [f"{what} {label} length change " for label in STRUT_LABELS]
     tail = f" mm is beyond the stroke limit +/-{limits.stroke * 1e3:.4g} mm"
-    return [f"{heads[s]}{v:.4f}{tail}" for s, v in zip(strut.tolist(), change_mm)]
+    return [f"{heads[s]}{v:.4f}{tail}" for s, v in zip(strut.tolist(), change_mm, strict=True)]
 
 
 def check_stroke(positions, limits: HexapodLimits = RUBIN_LIMITS, what: str = "target") -> None:
@@ -391,8 +400,9 @@ def check_stroke(positions, limits: HexapodLimits = RUBIN_LIMITS, what: str = "t
         raise LimitError(stroke_messages(flat[rows[:1]], what, limits)[0] + where)
 
 
-def random_poses(n: int, rng: np.random.Generator, geometry: HexapodGeometry = RUBIN_CAMERA,
-                 limits: HexapodLimits = RUBIN_LIMITS) -> np.ndarray:
+def random_poses(
+    n: int, rng: np.random.Generator, geometry: HexapodGeometry = RUBIN_CAMERA, limits: HexapodLimits = RUBIN_LIMITS
+) -> np.ndarray:
     """(n, 6) poses drawn uniformly inside the pose limits and the strut stroke (rejection)."""
     found, total = [], 0
     while total < n:
@@ -432,14 +442,16 @@ def hexapod_space_min_time(displacement, limits: HexapodLimits = RUBIN_LIMITS) -
     d'_theta,axial = |drz| / 2; each t' = 2 d' / v'_max (a triangle profile); t'_min the max.
     """
     d = np.asarray(displacement, dtype=float)
-    half = np.stack([
-        np.hypot(d[..., 0], d[..., 1]) / 2.0,
-        np.abs(d[..., 2]) / 2.0,
-        np.hypot(d[..., 3], d[..., 4]) / 2.0,
-        np.abs(d[..., 5]) / 2.0,
-    ], axis=-1)
-    speeds = np.array([limits.linear_speed, limits.linear_speed,
-                       limits.angular_speed, limits.angular_speed])
+    half = np.stack(
+        [
+            np.hypot(d[..., 0], d[..., 1]) / 2.0,
+            np.abs(d[..., 2]) / 2.0,
+            np.hypot(d[..., 3], d[..., 4]) / 2.0,
+            np.abs(d[..., 5]) / 2.0,
+        ],
+        axis=-1,
+    )
+    speeds = np.array([limits.linear_speed, limits.linear_speed, limits.angular_speed, limits.angular_speed])
     return np.max(2.0 * half / speeds, axis=-1)
 
 
@@ -447,8 +459,9 @@ def hexapod_space_min_time(displacement, limits: HexapodLimits = RUBIN_LIMITS) -
 HEXAPOD_SPEED_LABELS = ("radial", "axial", "radial-angular", "axial-angular")
 
 
-def hexapod_speed_ratios(pose, strut_velocity, limits: HexapodLimits = RUBIN_LIMITS,
-                         geometry: HexapodGeometry = RUBIN_CAMERA) -> np.ndarray:
+def hexapod_speed_ratios(
+    pose, strut_velocity, limits: HexapodLimits = RUBIN_LIMITS, geometry: HexapodGeometry = RUBIN_CAMERA
+) -> np.ndarray:
     """(..., 4) the pose's hexapod-space speeds over their limits v'_max (paper, step 1).
 
     The pose rate is J(pose)^-1 times the strut speeds (``jacobian``: x, y, z and the rates of
@@ -461,12 +474,15 @@ def hexapod_speed_ratios(pose, strut_velocity, limits: HexapodLimits = RUBIN_LIM
       strut_velocity: (..., 6) strut speeds there, m/s.
     """
     rate = np.linalg.solve(jacobian(pose, geometry), np.asarray(strut_velocity, dtype=float)[..., None])[..., 0]
-    return np.stack([
-        np.hypot(rate[..., 0], rate[..., 1]) / limits.linear_speed,
-        np.abs(rate[..., 2]) / limits.linear_speed,
-        np.hypot(rate[..., 3], rate[..., 4]) / limits.angular_speed,
-        np.abs(rate[..., 5]) / limits.angular_speed,
-    ], axis=-1)
+    return np.stack(
+        [
+            np.hypot(rate[..., 0], rate[..., 1]) / limits.linear_speed,
+            np.abs(rate[..., 2]) / limits.linear_speed,
+            np.hypot(rate[..., 3], rate[..., 4]) / limits.angular_speed,
+            np.abs(rate[..., 5]) / limits.angular_speed,
+        ],
+        axis=-1,
+    )
 
 
 def strut_min_time(half_distance, limits: HexapodLimits = RUBIN_LIMITS) -> np.ndarray:
@@ -490,8 +506,14 @@ def long_move_closed_form(half_distance, half_time, strut_speed: float) -> np.nd
     return strut_speed / (2.0 * (t - d / strut_speed))
 
 
-def long_move_iteration(half_distance, half_time, strut_speed: float, strut_accel: float,
-                        tolerance: float = 1e-15, max_iterations: int = 200):
+def long_move_iteration(
+    half_distance,
+    half_time,
+    strut_speed: float,
+    strut_accel: float,
+    tolerance: float = 1e-15,
+    max_iterations: int = 200,
+):
     """a_cmd of the long-move case by the paper's self-consistent iteration.
 
     The paper solves t_accel = v_max / a, T = t_vmax / 2 + t_accel and
@@ -541,8 +563,9 @@ class StrutProfiles:
     short: np.ndarray
 
 
-def solve_profiles(half_distance, half_time, limits: HexapodLimits = RUBIN_LIMITS,
-                   method: str = "iteration") -> StrutProfiles:
+def solve_profiles(
+    half_distance, half_time, limits: HexapodLimits = RUBIN_LIMITS, method: str = "iteration"
+) -> StrutProfiles:
     """Step 4 of the generator: a_cmd, t_accel, t_vmax of every strut for its half time.
 
     ``method`` "iteration" (the paper's) or "closed" (the closed form); they agree (tested).
@@ -556,8 +579,7 @@ def solve_profiles(half_distance, half_time, limits: HexapodLimits = RUBIN_LIMIT
     short = v_avg <= v / 2.0
     a_short = 2.0 * v_avg / safe_t
     if method == "iteration":
-        a_long, _ = long_move_iteration(np.where(short, 0.75 * v * safe_t, d), safe_t, v,
-                                        limits.strut_accel)
+        a_long, _ = long_move_iteration(np.where(short, 0.75 * v * safe_t, d), safe_t, v, limits.strut_accel)
     elif method == "closed":
         a_long = long_move_closed_form(np.where(short, 0.75 * v * safe_t, d), safe_t, v)
     else:
@@ -571,8 +593,14 @@ def solve_profiles(half_distance, half_time, limits: HexapodLimits = RUBIN_LIMIT
     return StrutProfiles(d, t, accel, t_accel, t_vmax, short & moving)
 
 
-def realize_on_ticks(distance, total_time, synchronous: bool, limits: HexapodLimits = RUBIN_LIMITS,
-                     dt: float = CONTROL_DT, max_extra_ticks: int = 1000):
+def realize_on_ticks(
+    distance,
+    total_time,
+    synchronous: bool,
+    limits: HexapodLimits = RUBIN_LIMITS,
+    dt: float = CONTROL_DT,
+    max_extra_ticks: int = 1000,
+):
     """Step 5: the tick-grid profile of every strut (vectorized over moves).
 
     Args:
@@ -656,8 +684,7 @@ class StrutMove:
         """(n, 6) the acceleration commanded in each tick, m/s^2 (the paper's output)."""
         n = int(self.n_ticks.max())
         k = np.arange(n)[:, None]
-        sign = np.where(k < self.n_accel, 1.0,
-                        np.where(k >= self.n_ticks - self.n_accel, -1.0, 0.0))
+        sign = np.where(k < self.n_accel, 1.0, np.where(k >= self.n_ticks - self.n_accel, -1.0, 0.0))
         sign = np.where(k < self.n_ticks, sign, 0.0)
         return sign * self.accel * self.direction
 
@@ -688,11 +715,14 @@ class StrutMove:
         accelerating = tau < t1
         braking = (tau >= t2) & (tau < t_end)
         done = tau >= t_end
-        dist = np.where(accelerating, 0.5 * a * tau**2,
-                        np.where(braking | done, D - 0.5 * a * np.clip(t_end - tau, 0, None)**2,
-                                 0.5 * a * t1**2 + a * t1 * (tau - t1)))
-        vel = np.where(accelerating, a * tau,
-                       np.where(braking, a * (t_end - tau), np.where(done, 0.0, a * t1)))
+        dist = np.where(
+            accelerating,
+            0.5 * a * tau**2,
+            np.where(
+                braking | done, D - 0.5 * a * np.clip(t_end - tau, 0, None) ** 2, 0.5 * a * t1**2 + a * t1 * (tau - t1)
+            ),
+        )
+        vel = np.where(accelerating, a * tau, np.where(braking, a * (t_end - tau), np.where(done, 0.0, a * t1)))
         acc = np.where(accelerating & (t[:, None] >= 0), a, np.where(braking, -a, 0.0))
         position = np.where(done, self.target, self.start + s * dist)
         return TrajectorySample(t, position, s * vel, s * acc)
@@ -724,19 +754,35 @@ class StrutMoves:
 
     def move(self, k: int) -> StrutMove:
         p = self.profiles
-        prof = StrutProfiles(*(np.asarray(getattr(p, f))[k] for f in
-                               ("half_distance", "half_time", "accel", "t_accel", "t_vmax", "short")))
+        prof = StrutProfiles(
+            *(
+                np.asarray(getattr(p, f))[k]
+                for f in ("half_distance", "half_time", "accel", "t_accel", "t_vmax", "short")
+            )
+        )
         return StrutMove(
-            self.start[k], self.target[k], self.n_ticks[k], self.n_accel[k], self.accel[k],
-            self.dt, prof, self.synchronous,
+            self.start[k],
+            self.target[k],
+            self.n_ticks[k],
+            self.n_accel[k],
+            self.accel[k],
+            self.dt,
+            prof,
+            self.synchronous,
             None if self.start_pose is None else self.start_pose[k],
             None if self.target_pose is None else self.target_pose[k],
         )
 
 
-def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = True,
-                     limits: HexapodLimits = RUBIN_LIMITS, dt: float = CONTROL_DT,
-                     method: str = "closed") -> StrutMoves:
+def plan_strut_moves(
+    start,
+    target,
+    pose_displacement=None,
+    synchronous: bool = True,
+    limits: HexapodLimits = RUBIN_LIMITS,
+    dt: float = CONTROL_DT,
+    method: str = "closed",
+) -> StrutMoves:
     """The generator on strut positions: (N, 6) current and target strut positions, m.
 
     Args:
@@ -756,11 +802,15 @@ def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = 
     if pose_displacement is not None:
         pose_displacement = np.atleast_2d(np.asarray(pose_displacement, dtype=float))
         if pose_displacement.shape != start.shape:
-            raise PlanningError(f"pose displacement {pose_displacement.shape} must be "
-                                f"{start.shape}, one per move")
+            raise PlanningError(f"pose displacement {pose_displacement.shape} must be {start.shape}, one per move")
     for name, value in (("start", start), ("target", target)):
-        check_values(value, lambda i, name=name: f"{name} {STRUT_LABELS[i[1]]} position"
-                     + (f" of row {i[0]}" if value.shape[0] > 1 else ""), "m")
+        check_values(
+            value,
+            lambda i, name=name, value=value: (
+                f"{name} {STRUT_LABELS[i[1]]} position" + (f" of row {i[0]}" if value.shape[0] > 1 else "")
+            ),
+            "m",
+        )
         check_stroke(value, limits, what=name)
     check_positive(dt, "tick", "s")
     distance = np.abs(target - start)
@@ -774,18 +824,25 @@ def plan_strut_moves(start, target, pose_displacement=None, synchronous: bool = 
         half_time = np.broadcast_to(half_time.max(axis=-1, keepdims=True), half.shape)
     longest = 2.0 * float(np.max(half_time, initial=0.0))
     if longest / dt > MAX_TICKS:
-        raise PlanningError(f"tick {dt!r} s is too short: the longest move ({longest:.6g} s) "
-                            f"would take {longest / dt:.3g} ticks, more than the {MAX_TICKS:g} "
-                            f"a plan holds")
+        raise PlanningError(
+            f"tick {dt!r} s is too short: the longest move ({longest:.6g} s) "
+            f"would take {longest / dt:.3g} ticks, more than the {MAX_TICKS:g} "
+            f"a plan holds"
+        )
     profiles = solve_profiles(half, half_time, limits, method=method)
-    n_ticks, n_accel, accel = realize_on_ticks(distance, 2.0 * np.asarray(half_time),
-                                               synchronous, limits, dt)
+    n_ticks, n_accel, accel = realize_on_ticks(distance, 2.0 * np.asarray(half_time), synchronous, limits, dt)
     return StrutMoves(start, target, n_ticks, n_accel, accel, dt, profiles, t_hex, synchronous)
 
 
-def plan_moves(start_pose, target_pose, synchronous: bool = True,
-               geometry: HexapodGeometry = RUBIN_CAMERA, limits: HexapodLimits = RUBIN_LIMITS,
-               dt: float = CONTROL_DT, method: str = "closed") -> StrutMoves:
+def plan_moves(
+    start_pose,
+    target_pose,
+    synchronous: bool = True,
+    geometry: HexapodGeometry = RUBIN_CAMERA,
+    limits: HexapodLimits = RUBIN_LIMITS,
+    dt: float = CONTROL_DT,
+    method: str = "closed",
+) -> StrutMoves:
     """Plan N pose-to-pose moves at once: inverse kinematics, limits, the generator.
 
     Args:
@@ -797,27 +854,37 @@ def plan_moves(start_pose, target_pose, synchronous: bool = True,
     start_pose = np.atleast_2d(_as_poses(start_pose, "start pose"))
     target_pose = np.atleast_2d(_as_poses(target_pose, "target pose"))
     if start_pose.ndim != 2 or target_pose.ndim != 2:
-        raise PlanningError(f"poses must be (6,) or (N, 6), got {start_pose.shape} and "
-                            f"{target_pose.shape}")
-    if start_pose.shape[0] != target_pose.shape[0] and 1 not in (start_pose.shape[0],
-                                                                 target_pose.shape[0]):
-        raise PlanningError(f"{start_pose.shape[0]} start poses and {target_pose.shape[0]} "
-                            "target poses: give one of each per move (or one start for all)")
+        raise PlanningError(f"poses must be (6,) or (N, 6), got {start_pose.shape} and {target_pose.shape}")
+    if start_pose.shape[0] != target_pose.shape[0] and 1 not in (start_pose.shape[0], target_pose.shape[0]):
+        raise PlanningError(
+            f"{start_pose.shape[0]} start poses and {target_pose.shape[0]} "
+            "target poses: give one of each per move (or one start for all)"
+        )
     start_pose, target_pose = np.broadcast_arrays(start_pose, target_pose)
     check_pose_limits(start_pose, limits, "start")
     check_pose_limits(target_pose, limits, "target")
-    moves = plan_strut_moves(strut_positions(start_pose, geometry),
-                             strut_positions(target_pose, geometry),
-                             target_pose - start_pose, synchronous, limits, dt, method)
+    moves = plan_strut_moves(
+        strut_positions(start_pose, geometry),
+        strut_positions(target_pose, geometry),
+        target_pose - start_pose,
+        synchronous,
+        limits,
+        dt,
+        method,
+    )
     return StrutMoves(**{**moves.__dict__, "start_pose": start_pose, "target_pose": target_pose})
 
 
-def plan_move(start_pose, target_pose, synchronous: bool = True,
-              geometry: HexapodGeometry = RUBIN_CAMERA, limits: HexapodLimits = RUBIN_LIMITS,
-              dt: float = CONTROL_DT) -> StrutMove:
+def plan_move(
+    start_pose,
+    target_pose,
+    synchronous: bool = True,
+    geometry: HexapodGeometry = RUBIN_CAMERA,
+    limits: HexapodLimits = RUBIN_LIMITS,
+    dt: float = CONTROL_DT,
+) -> StrutMove:
     """One pose-to-pose move (the paper's iteration for the long-move acceleration)."""
-    return plan_moves(start_pose, target_pose, synchronous, geometry, limits, dt,
-                      method="iteration").move(0)
+    return plan_moves(start_pose, target_pose, synchronous, geometry, limits, dt, method="iteration").move(0)
 
 
 @dataclass(frozen=True)
@@ -847,8 +914,9 @@ class PaperMovePlanner:
     says, the long-move acceleration by the paper's iteration."""
 
     def plan(self, problem: MoveProblem) -> StrutMove:
-        return plan_move(problem.start_pose, problem.target_pose, problem.synchronous,
-                         problem.geometry, problem.limits, problem.dt)
+        return plan_move(
+            problem.start_pose, problem.target_pose, problem.synchronous, problem.geometry, problem.limits, problem.dt
+        )
 
 
 def own_move_times(problem: MoveProblem) -> np.ndarray:

@@ -15,8 +15,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from planbench.models import SerialChainSpec, loader_spec
-from planbench.planners.loader.bspline import CubicBSplineTrajectory
 from planbench.planners.errors import PlanningError
+from planbench.planners.loader.bspline import CubicBSplineTrajectory
 from planbench.planners.trajectory import check_values
 
 #: Table 1 as printed: rows P2, M1, M2, M3, M4, P3; columns theta1 (mm), theta2..theta6 (deg).
@@ -85,16 +85,27 @@ class CubicBSplinePlanner:
     ``limit_tolerance``)."""
 
     def plan(self, problem: LoaderProblem) -> CubicBSplineTrajectory:
-        return CubicBSplineTrajectory(problem.key_times, problem.key_points, labels=list(problem.labels),
-                                      lower=problem.lower, upper=problem.upper, margin=JOINT_LIMIT_TOLERANCE)
+        return CubicBSplineTrajectory(
+            problem.key_times,
+            problem.key_points,
+            labels=list(problem.labels),
+            lower=problem.lower,
+            upper=problem.upper,
+            margin=JOINT_LIMIT_TOLERANCE,
+        )
 
 
 def supply_plan(spec: SerialChainSpec | None = None) -> CubicBSplineTrajectory:
     """The supply stage of the paper: P2 -> M1 ... M4 -> P3 through the cubic B-spline."""
     spec = spec or loader_spec()
     return CubicBSplineTrajectory(
-        TABLE1_TIMES, table1_to_si(TABLE1), labels=spec.names, lower=spec.lower, upper=spec.upper,
-        margin=JOINT_LIMIT_TOLERANCE)
+        TABLE1_TIMES,
+        table1_to_si(TABLE1),
+        labels=spec.names,
+        lower=spec.lower,
+        upper=spec.upper,
+        margin=JOINT_LIMIT_TOLERANCE,
+    )
 
 
 def direct_plan(spec: SerialChainSpec | None = None) -> CubicBSplineTrajectory:
@@ -106,8 +117,13 @@ def direct_plan(spec: SerialChainSpec | None = None) -> CubicBSplineTrajectory:
     spec = spec or loader_spec()
     q = table1_to_si(TABLE1)
     return CubicBSplineTrajectory(
-        TABLE1_TIMES[[0, -1]], q[[0, -1]], labels=spec.names, lower=spec.lower, upper=spec.upper,
-        margin=JOINT_LIMIT_TOLERANCE)
+        TABLE1_TIMES[[0, -1]],
+        q[[0, -1]],
+        labels=spec.names,
+        lower=spec.lower,
+        upper=spec.upper,
+        margin=JOINT_LIMIT_TOLERANCE,
+    )
 
 
 def _scipy_quat(wxyz: np.ndarray) -> Rotation:

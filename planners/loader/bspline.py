@@ -63,25 +63,27 @@ would give infinite accelerations).
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy import linalg
 
 from planbench.planners.errors import LimitError, PlanningError
-from planbench.planners.trajectory import (MAX_MAGNITUDE, TrajectorySample, check_values, fmt_number,
-                                 sample_times)
+from planbench.planners.trajectory import MAX_MAGNITUDE, TrajectorySample, check_values, fmt_number, sample_times
 
 # Eq. (10): power-basis coefficients of the uniform cubic B-spline, rows for u^3, u^2, u, 1.
-BASIS = np.array(
-    [
-        [-1.0, 3.0, -3.0, 1.0],
-        [3.0, -6.0, 3.0, 0.0],
-        [-3.0, 0.0, 3.0, 0.0],
-        [1.0, 4.0, 1.0, 0.0],
-    ]
-) / 6.0
+BASIS = (
+    np.array(
+        [
+            [-1.0, 3.0, -3.0, 1.0],
+            [3.0, -6.0, 3.0, 0.0],
+            [-3.0, 0.0, 3.0, 0.0],
+            [1.0, 4.0, 1.0, 0.0],
+        ]
+    )
+    / 6.0
+)
 
 _UNIFORM_RTOL = 1e-9
 # Round-off allowed between key points, in units of eps * max |control point| of the joint
@@ -159,8 +161,7 @@ class CubicBSplineTrajectory:
             times = np.asarray(times, dtype=float)
             key_points = np.asarray(key_points, dtype=float)
         except (TypeError, ValueError):
-            raise PlanningError(f"key times {times!r} and key points {key_points!r} must be "
-                                "numbers") from None
+            raise PlanningError(f"key times {times!r} and key points {key_points!r} must be numbers") from None
         if key_points.ndim == 1:
             key_points = key_points[:, None]
         if times.ndim != 1:
@@ -182,8 +183,7 @@ class CubicBSplineTrajectory:
         if np.any(steps <= 0):
             k = int(np.argmax(steps <= 0))
             raise PlanningError(
-                f"key times must increase strictly: t[{k + 1}] = {times[k + 1]} s "
-                f"<= t[{k}] = {times[k]} s"
+                f"key times must increase strictly: t[{k + 1}] = {times[k + 1]} s <= t[{k}] = {times[k]} s"
             )
         h = (times[-1] - times[0]) / (times.size - 1)
         worst = int(np.argmax(np.abs(steps - h)))
@@ -203,9 +203,7 @@ class CubicBSplineTrajectory:
                 raise PlanningError(f"{name} limits {lim!r} are not numbers") from None
             if arr.shape != (m,):
                 raise PlanningError(f"{name} limits have shape {arr.shape}, expected ({m},)")
-            limits[name] = check_values(
-                arr, lambda i, name=name: f"{name} limit of joint {labels[i[0]]}"
-            )
+            limits[name] = check_values(arr, lambda i, name=name: f"{name} limit of joint {labels[i[0]]}")
         self._lower, self._upper = limits["lower"], limits["upper"]
         try:
             margin = np.broadcast_to(np.asarray(margin, dtype=float), (m,)).copy()
@@ -220,8 +218,7 @@ class CubicBSplineTrajectory:
             if crossed.size:
                 j = int(crossed[0])
                 raise PlanningError(
-                    f"joint {labels[j]}: lower limit {self._lower[j]:.6g} is above its upper "
-                    f"limit {self._upper[j]:.6g}"
+                    f"joint {labels[j]}: lower limit {self._lower[j]:.6g} is above its upper limit {self._upper[j]:.6g}"
                 )
         self._check_limits(key_points, labels, times, what="key point")
 
@@ -238,7 +235,8 @@ class CubicBSplineTrajectory:
         self._check_key_step()
         finfo = np.finfo(float)
         self._tolerance = self._margin + LIMIT_TOLERANCE_ULPS * (
-            finfo.eps * np.max(np.abs(self.control_points), axis=0) + finfo.smallest_subnormal)
+            finfo.eps * np.max(np.abs(self.control_points), axis=0) + finfo.smallest_subnormal
+        )
         self._check_overshoot()
 
     # -- the Trajectory contract -------------------------------------------------------------
@@ -379,9 +377,12 @@ class CubicBSplineTrajectory:
             if bad.size:
                 k, j = bad[0]
                 value, limit = _distinct(values[k, j], lim[j])
-                what = (f"tolerance {self._margin[j]:.3g} and the spline's round-off "
-                        f"{self._tolerance[j] - self._margin[j]:.2g}" if self._margin[j]
-                        else f"round-off tolerance {self._tolerance[j]:.3g}")
+                what = (
+                    f"tolerance {self._margin[j]:.3g} and the spline's round-off "
+                    f"{self._tolerance[j] - self._margin[j]:.2g}"
+                    if self._margin[j]
+                    else f"round-off tolerance {self._tolerance[j]:.3g}"
+                )
                 raise LimitError(
                     f"spline between key points at t = {times[k, j]:.4g} s: joint "
                     f"{self._labels[j]} = {value} overshoots its {name} limit "

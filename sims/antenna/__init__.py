@@ -33,21 +33,66 @@ Modules:
 
 from __future__ import annotations
 
-from planbench.scenarios import Mechanism
-from planbench.antenna.params import (CONTROL_DT, DECK_JOINTS, IMU_ATTITUDE_NOISE_DEG, IMU_ATTITUDE_NOISE_TIME_S,
-                                 IMU_GYRO_NOISE_DEG_S, IMU_LATENCY_MAX_S, IMU_LATENCY_S, IMU_RATE_HZ, IMU_RATE_MIN_HZ,
-                                 DRIVES, JOINTS, MAST_JOINTS, MAX_SAILED_M, MIN_SATELLITE_ELEVATION_DEG, MOVING_BODIES, PAPER_DURATION_S,
-                                 REFERENCE_DT, SATELLITE_LON_DEG, SEA_DURATION_S, SEA_HEADING_DEG, SEA_HS_M, SEA_TP_S,
-                                 SHIP_LAT_DEG, SHIP_LON_DEG, AntennaPaperParams, AntennaParams, AntennaPlant,
-                                 AntennaSeaParams, ImuModel, log_bytes_per_tick, satellite_of)
+from planbench.antenna.controller import AntennaController
+from planbench.antenna.params import (
+    CONTROL_DT,
+    DECK_JOINTS,
+    DRIVES,
+    IMU_ATTITUDE_NOISE_DEG,
+    IMU_ATTITUDE_NOISE_TIME_S,
+    IMU_GYRO_NOISE_DEG_S,
+    IMU_LATENCY_MAX_S,
+    IMU_LATENCY_S,
+    IMU_RATE_HZ,
+    IMU_RATE_MIN_HZ,
+    JOINTS,
+    MAST_JOINTS,
+    MAX_SAILED_M,
+    MIN_SATELLITE_ELEVATION_DEG,
+    MOVING_BODIES,
+    PAPER_DURATION_S,
+    REFERENCE_DT,
+    SATELLITE_LON_DEG,
+    SEA_DURATION_S,
+    SEA_HEADING_DEG,
+    SEA_HS_M,
+    SEA_TP_S,
+    SHIP_LAT_DEG,
+    SHIP_LON_DEG,
+    AntennaPaperParams,
+    AntennaParams,
+    AntennaPlant,
+    AntennaSeaParams,
+    ImuModel,
+    log_bytes_per_tick,
+    satellite_of,
+)
 from planbench.antenna.physics import AntennaPhysics
 from planbench.antenna.sensors import AntennaImu
-from planbench.antenna.controller import AntennaController
-from planbench.antenna.task import (ATTITUDE_FRO_LIMIT, POINTING_MAX_PAPER_DEG, POINTING_MAX_SEA_DEG, POINTING_RMS_DEG,
-                               POLARIZATION_MAX_DEG, SCENARIOS, AntennaEvaluation, AntennaOptions, ShipMotionDrive,
-                               ShipMotionTrajectory, build, compare_methods, environment_reward, ideal_path,
-                               joint_kinds, motion_of, plan, pointing_errors, start_angles, tracked_start,
-                               write_method_comparison)
+from planbench.antenna.task import (
+    ATTITUDE_FRO_LIMIT,
+    POINTING_MAX_PAPER_DEG,
+    POINTING_MAX_SEA_DEG,
+    POINTING_RMS_DEG,
+    POLARIZATION_MAX_DEG,
+    SCENARIOS,
+    AntennaEvaluation,
+    AntennaOptions,
+    ShipMotionDrive,
+    ShipMotionTrajectory,
+    build,
+    compare_methods,
+    environment_reward,
+    ideal_path,
+    joint_kinds,
+    motion_of,
+    plan,
+    pointing_errors,
+    start_angles,
+    tracked_start,
+    write_method_comparison,
+)
+from planbench.scenarios import Mechanism
 
 MECHANISM = Mechanism("antenna", SCENARIOS, environment_reward, benchmark_runs=5)
 

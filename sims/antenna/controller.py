@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from planbench.planners import antenna as ant
 from planbench.antenna.params import JOINTS, _exp_so3
+from planbench.planners import antenna as ant
 
 
 class AntennaController:
@@ -123,7 +123,6 @@ class AntennaController:
         # The set-point for the end of the tick: the ramp plus kv/kp times the feed-forward.
         target = self._targets[min(max(tick + 1 - self.tick_from, 0), self._last_row)]
         if self._in_place:
-            np.divide(np.subtract(target, observation["setpoints"], out=self._difference), self.dt,
-                      out=self.command)
+            np.divide(np.subtract(target, observation["setpoints"], out=self._difference), self.dt, out=self.command)
         else:
             self.command[self.actuators] = (target - observation["setpoints"]) / self.dt

@@ -12,11 +12,11 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 
 from planbench import models
+from planbench.antenna.params import DECK_JOINTS, JOINTS, MAST_JOINTS, AntennaPlant, _model
+from planbench.antenna.ship_motion import world_from_ship
+from planbench.drives import drive_coordinates
 from planbench.planners import antenna as ant
 from planbench.planners.rotations import rot_x, rot_y
-from planbench.antenna.params import DECK_JOINTS, JOINTS, MAST_JOINTS, AntennaPlant, _model
-from planbench.drives import drive_coordinates
-from planbench.antenna.ship_motion import world_from_ship
 
 
 class AntennaPhysics(dm_mujoco.Physics):
@@ -25,7 +25,7 @@ class AntennaPhysics(dm_mujoco.Physics):
     drives = "ideal"
 
     @classmethod
-    def load(cls, plant: "AntennaPlant | None" = None, drives: str = "ideal") -> "AntennaPhysics":
+    def load(cls, plant: AntennaPlant | None = None, drives: str = "ideal") -> AntennaPhysics:
         """The scene at its home keyframe with the pedestal's ``drives`` (``DRIVES``);
         ``plant`` (None or nominal: the model as it is) perturbs the compiled model
         (``AntennaPlant.model``)."""
@@ -83,8 +83,7 @@ class AntennaPhysics(dm_mujoco.Physics):
 
     def drive_gains(self, names=JOINTS):
         """(kp, kv) of the named drives: kp (setpoint - q) - kv qdot."""
-        return (self._actuator_param(names, "actuator_gainprm", 0),
-                -self._actuator_param(names, "actuator_biasprm", 2))
+        return (self._actuator_param(names, "actuator_gainprm", 0), -self._actuator_param(names, "actuator_biasprm", 2))
 
     def torque_limit(self, names=JOINTS) -> np.ndarray:
         return self._actuator_param(names, "actuator_forcerange", 1)
@@ -96,7 +95,7 @@ class AntennaPhysics(dm_mujoco.Physics):
     def sensor(self, name: str) -> np.ndarray:
         model = self.model.ptr
         s = model.sensor(name)
-        return self.data.ptr.sensordata[s.adr[0]: s.adr[0] + s.dim[0]]
+        return self.data.ptr.sensordata[s.adr[0] : s.adr[0] + s.dim[0]]
 
     def sensor_slice(self, name: str) -> slice:
         s = self.model.ptr.sensor(name)

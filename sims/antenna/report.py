@@ -18,20 +18,18 @@ def antenna_report(ts: dict, t: np.ndarray, checks, path, pointing_limit_deg: fl
     ax.legend(fontsize=8)
     ax = axes[0, 1]
     for j, name in enumerate(names):
-        line, = ax.plot(t, np.rad2deg(ts["theta_actual"][:, j]), label=name)
+        (line,) = ax.plot(t, np.rad2deg(ts["theta_actual"][:, j]), label=name)
         ax.plot(t, np.rad2deg(ts["theta_planned"][:, j]), "--", color=line.get_color(), lw=0.8)
-    ax.set(title="joint angles (solid: simulated, dashed: planned for the true motion)",
-           xlabel="t [s]", ylabel="deg")
+    ax.set(title="joint angles (solid: simulated, dashed: planned for the true motion)", xlabel="t [s]", ylabel="deg")
     ax.legend(fontsize=8)
     ax = axes[1, 0]
     ratio_t = np.abs(ts["torque_demanded"]) / ts["torque_limit"]
     ratio_v = np.abs(ts["theta_rate"]) / ts["rate_limit"]
     for j, name in enumerate(names):
-        line, = ax.plot(t, ratio_t[:, j], lw=0.8, label=f"{name} torque")
+        (line,) = ax.plot(t, ratio_t[:, j], lw=0.8, label=f"{name} torque")
         ax.plot(t, ratio_v[:, j], ":", color=line.get_color(), lw=0.8)
     ax.axhline(1.0, color="r", lw=0.8)
-    ax.set(title="|torque| / limit (solid), |rate| / rated speed (dotted)", xlabel="t [s]",
-           ylabel="ratio")
+    ax.set(title="|torque| / limit (solid), |rate| / rated speed (dotted)", xlabel="t [s]", ylabel="ratio")
     ax.legend(fontsize=8)
     ax = axes[1, 1]
     ax.plot(t, ts["pointing_error_deg"], lw=0.8, label="pointing")
@@ -50,10 +48,9 @@ def antenna_methods_plot(paths: dict, path) -> None:
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
     ax = axes[0, 0]
     for j, name in enumerate(names):
-        line, = ax.plot(crr.t, np.rad2deg(crr.theta[:, j]), label=name)
+        (line,) = ax.plot(crr.t, np.rad2deg(crr.theta[:, j]), label=name)
         ax.plot(pinv.t, np.rad2deg(pinv.theta[:, j]), "--", color=line.get_color(), lw=0.8)
-    ax.set(title="joint angles: CRR (solid, Fig. 5), pinv integration (dashed, Fig. 3)",
-           xlabel="t [s]", ylabel="deg")
+    ax.set(title="joint angles: CRR (solid, Fig. 5), pinv integration (dashed, Fig. 3)", xlabel="t [s]", ylabel="deg")
     ax.legend(fontsize=8)
     ax = axes[0, 1]
     rates = np.rad2deg(crr.rates())
@@ -62,8 +59,12 @@ def antenna_methods_plot(paths: dict, path) -> None:
     ax.set(title="CRR joint rates from position differences (Fig. 8)", xlabel="t [s]", ylabel="deg/s")
     ax.legend(fontsize=8)
     ax = axes[1, 0]
-    labels = {"pinv": "pinv integration (Fig. 4)", "crr": "CRR, eq. (6) (Fig. 7)",
-              "crr_log": "CRR, exact angular velocity", "crr_full": "CRR + full correction"}
+    labels = {
+        "pinv": "pinv integration (Fig. 4)",
+        "crr": "CRR, eq. (6) (Fig. 7)",
+        "crr_log": "CRR, exact angular velocity",
+        "crr_full": "CRR + full correction",
+    }
     for key, p in paths.items():
         ax.semilogy(p.t[1:], np.maximum(p.error_fro[1:], 1e-17), lw=0.8, label=labels.get(key, key))
     ax.axhline(1e-6, color="r", lw=0.8)

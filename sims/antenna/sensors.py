@@ -11,9 +11,9 @@ from collections import deque
 import mujoco
 import numpy as np
 
-from planbench.task import JointEncoders, Sensors, SensorSpec
 from planbench.antenna.params import AXIS_ENCODER, AntennaPlant, ImuModel, _exp_so3
 from planbench.antenna.physics import AntennaPhysics
+from planbench.task import JointEncoders, Sensors, SensorSpec
 
 
 class AntennaImu(Sensors):
@@ -48,8 +48,7 @@ class AntennaImu(Sensors):
         its drives' set-points, rad and rad/s.
     """
 
-    def __init__(self, physics: "AntennaPhysics", imu: ImuModel, control_dt: float,
-                 errors: "AntennaPlant | None" = None):
+    def __init__(self, physics: AntennaPhysics, imu: ImuModel, control_dt: float, errors: AntennaPlant | None = None):
         super().__init__()
         self.imu = imu
         self.dt = control_dt
@@ -57,21 +56,39 @@ class AntennaImu(Sensors):
         # The true sensor's error (None: the datasheet's sensor): the attitude bias, a
         # rotation in the IMU frame.
         self.bias_rotation = None if errors is None else errors.bias_rotation()
-        self.encoders = JointEncoders(physics.antenna_qpos, physics.antenna_dofs,
-                                      physics.model.ptr.actuator_actadr[physics.antenna_actuators],
-                                      "antenna joint encoders theta1 ... theta4", "rad", control_dt,
-                                      resolution=AXIS_ENCODER if physics.drives == "as-built" else 0.0)
+        self.encoders = JointEncoders(
+            physics.antenna_qpos,
+            physics.antenna_dofs,
+            physics.model.ptr.actuator_actadr[physics.antenna_actuators],
+            "antenna joint encoders theta1 ... theta4",
+            "rad",
+            control_dt,
+            resolution=AXIS_ENCODER if physics.drives == "as-built" else 0.0,
+        )
         self.specs = [
-            SensorSpec("imu_attitude", "deck attitude of the pedestal IMU (world from IMU)", "rotation matrix",
-                       imu.rate_hz, imu.latency_s,
-                       f"Gauss-Markov, {imu.attitude_noise_deg:g} deg 1-sigma per axis, correlation time "
-                       f"{imu.attitude_noise_time_s:g} s"),
-            SensorSpec("imu_gyro", "angular rate of the pedestal IMU, IMU frame", "rad/s", imu.rate_hz,
-                       imu.latency_s, f"white, {imu.gyro_noise_deg_s:g} deg/s 1-sigma per axis"),
+            SensorSpec(
+                "imu_attitude",
+                "deck attitude of the pedestal IMU (world from IMU)",
+                "rotation matrix",
+                imu.rate_hz,
+                imu.latency_s,
+                f"Gauss-Markov, {imu.attitude_noise_deg:g} deg 1-sigma per axis, correlation time "
+                f"{imu.attitude_noise_time_s:g} s",
+            ),
+            SensorSpec(
+                "imu_gyro",
+                "angular rate of the pedestal IMU, IMU frame",
+                "rad/s",
+                imu.rate_hz,
+                imu.latency_s,
+                f"white, {imu.gyro_noise_deg_s:g} deg/s 1-sigma per axis",
+            ),
         ] + self.encoders.specs
         if errors is not None and any(errors.imu_bias):
             # summary.json says the sensor has an error; the controller is not told its value.
-            self.specs[0] = dataclasses.replace(self.specs[0], bias="unknown constant attitude error (plant uncertainty)")
+            self.specs[0] = dataclasses.replace(
+                self.specs[0], bias="unknown constant attitude error (plant uncertainty)"
+            )
 
     def reset(self, physics, times: np.ndarray, seed: int) -> dict:
         imu = self.imu
@@ -93,8 +110,7 @@ class AntennaImu(Sensors):
         self._data = physics.data.ptr
         self.queue = deque()
         obs = dict(self.encoders.reset(physics, times, seed))
-        obs.update(imu_attitude=np.eye(3), imu_gyro=np.zeros(3), imu_time=np.zeros(1),
-                   imu_count=np.zeros(1, dtype=int))
+        obs.update(imu_attitude=np.eye(3), imu_gyro=np.zeros(3), imu_time=np.zeros(1), imu_count=np.zeros(1, dtype=int))
         self.observation = obs
         self._measure(0, lag=0.0)  # mj_forward just evaluated the sensors at t = 0
         if self.queue[0][0] <= 0:  # no latency: it has arrived
@@ -117,7 +133,7 @@ class AntennaImu(Sensors):
             if att:
                 rest[:, :3] = 0.0 + self.att_drive * z[:, :3]
             if gyro:
-                rest[:, 3:] = 0.0 + self.gyro_sigma * z[:, width - 3:]
+                rest[:, 3:] = 0.0 + self.gyro_sigma * z[:, width - 3 :]
         self._noise, self._next_noise = noise, 0
 
     def _measure(self, tick: int, lag: float | None = None) -> None:

@@ -82,8 +82,9 @@ def check_wave_height(hs: float) -> float:
     """hs (m) if it is a significant wave height in (0, SEA_HS_MAX_M], else a ShipMotionError."""
     hs = _positive("significant wave height hs", hs, " m")
     if hs > SEA_HS_MAX_M:
-        raise ShipMotionError(f"significant wave height hs = {hs:g} m is above {SEA_HS_MAX_M:g} m "
-                              "(the highest measured is 19.0 m, WMO)")
+        raise ShipMotionError(
+            f"significant wave height hs = {hs:g} m is above {SEA_HS_MAX_M:g} m (the highest measured is 19.0 m, WMO)"
+        )
     return hs
 
 
@@ -92,8 +93,9 @@ def check_peak_period(tp: float) -> float:
     tp = _positive("peak period tp", tp, " s")
     lo, hi = SEA_TP_RANGE_S
     if not lo <= tp <= hi:
-        raise ShipMotionError(f"peak period tp = {tp:g} s is outside [{lo:g}, {hi:g}] s, the periods "
-                              "of wind seas and swell (Munk 1950)")
+        raise ShipMotionError(
+            f"peak period tp = {tp:g} s is outside [{lo:g}, {hi:g}] s, the periods of wind seas and swell (Munk 1950)"
+        )
     return tp
 
 
@@ -109,7 +111,8 @@ def check_sea_state(hs: float, tp: float) -> tuple[float, float]:
         raise ShipMotionError(
             f"sea state hs = {hs:g} m, tp = {tp:g} s is steeper than waves can be: 2 pi Hs / (g Tp^2) "
             f"= 1/{1.0 / steepness:.3g} > 1/{1.0 / limit:.3g} (DNV-RP-C205's limit at tp = {tp:g} s; "
-            f"hs <= {hs_max:.3g} m)")
+            f"hs <= {hs_max:.3g} m)"
+        )
     return hs, tp
 
 
@@ -150,8 +153,7 @@ def world_from_ship(heading, pitch, roll) -> np.ndarray:
     ``Rotation.from_euler("ZXY", [psi, phi, gamma])`` (tested). The paper's bTe (eq. 1) is its
     transpose.
     """
-    psi, phi, gam = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float))
-                                          for a in (heading, pitch, roll)))
+    psi, phi, gam = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in (heading, pitch, roll)))
     cp, sp = np.cos(psi), np.sin(psi)
     cf, sf = np.cos(phi), np.sin(phi)
     cg, sg = np.cos(gam), np.sin(gam)
@@ -169,8 +171,7 @@ def world_from_ship(heading, pitch, roll) -> np.ndarray:
     return out
 
 
-def body_angular_velocity(heading, pitch, roll, heading_rate, pitch_rate,
-                          roll_rate) -> np.ndarray:
+def body_angular_velocity(heading, pitch, roll, heading_rate, pitch_rate, roll_rate) -> np.ndarray:
     """Angular velocity of the ship in its own frame (what a deck gyro reads), rad/s, (n, 3).
 
     omega_b = Ry(gamma)^T Rx(phi)^T [0, 0, psi'] + Ry(gamma)^T [phi', 0, 0] + [0, gamma', 0],
@@ -179,8 +180,11 @@ def body_angular_velocity(heading, pitch, roll, heading_rate, pitch_rate,
     Arguments in rad and rad/s, scalars or (n,).
     """
     _, phi, gam, dpsi, dphi, dgam = np.broadcast_arrays(
-        *(np.atleast_1d(np.asarray(a, dtype=float))
-          for a in (heading, pitch, roll, heading_rate, pitch_rate, roll_rate)))
+        *(
+            np.atleast_1d(np.asarray(a, dtype=float))
+            for a in (heading, pitch, roll, heading_rate, pitch_rate, roll_rate)
+        )
+    )
     cf, sf = np.cos(phi), np.sin(phi)
     cg, sg = np.cos(gam), np.sin(gam)
     # Rx(phi)^T [0, 0, psi'] = psi' [0, sin phi, cos phi]; then Ry(gamma)^T adds phi' x.
@@ -212,12 +216,12 @@ class ShipState:
         n = np.shape(self.t)[0] if np.ndim(self.t) == 1 else -1
         for name in ("heave", "heading", "pitch", "roll"):
             if np.shape(getattr(self, name)) != (n,):
-                raise ShipMotionError(f"ShipState.{name} has shape {np.shape(getattr(self, name))}"
-                                      f", must be ({n},) like t")
+                raise ShipMotionError(
+                    f"ShipState.{name} has shape {np.shape(getattr(self, name))}, must be ({n},) like t"
+                )
         for name in ("rate", "accel"):
             if np.shape(getattr(self, name)) != (n, 4):
-                raise ShipMotionError(f"ShipState.{name} has shape {np.shape(getattr(self, name))}"
-                                      f", must be ({n}, 4)")
+                raise ShipMotionError(f"ShipState.{name} has shape {np.shape(getattr(self, name))}, must be ({n}, 4)")
 
     def __len__(self) -> int:
         return len(self.t)
@@ -238,14 +242,19 @@ class ShipState:
 
     def body_angular_velocity(self) -> np.ndarray:
         """Deck gyro reading at every sample, rad/s, (n, 3); see ``body_angular_velocity``."""
-        return body_angular_velocity(self.heading, self.pitch, self.roll,
-                                     self.rate[:, HEADING], self.rate[:, PITCH],
-                                     self.rate[:, ROLL])
+        return body_angular_velocity(
+            self.heading, self.pitch, self.roll, self.rate[:, HEADING], self.rate[:, PITCH], self.rate[:, ROLL]
+        )
 
     def with_degrees(self) -> dict[str, np.ndarray]:
         """Angles in degrees and heave in m, for reports and plots (the edges of the code)."""
-        return {"t": self.t, "heave_m": self.heave, "heading_deg": np.degrees(self.heading),
-                "pitch_deg": np.degrees(self.pitch), "roll_deg": np.degrees(self.roll)}
+        return {
+            "t": self.t,
+            "heave_m": self.heave,
+            "heading_deg": np.degrees(self.heading),
+            "pitch_deg": np.degrees(self.pitch),
+            "roll_deg": np.degrees(self.roll),
+        }
 
 
 # --------------------------------------------------------------------------------------------
@@ -271,9 +280,14 @@ class PaperShipMotion:
     ROLL_AMPLITUDE = math.radians(45.0)
     ROLL_PERIOD_SAMPLES = 1000.0
 
-    def __init__(self, sample_time: float = 0.01, amplitudes_deg: dict | None = None,
-                 periods_s: dict | None = None, turn_rate_deg_s: float | None = None,
-                 course_deg: float = 0.0):
+    def __init__(
+        self,
+        sample_time: float = 0.01,
+        amplitudes_deg: dict | None = None,
+        periods_s: dict | None = None,
+        turn_rate_deg_s: float | None = None,
+        course_deg: float = 0.0,
+    ):
         """``amplitudes_deg`` and ``periods_s`` ({"heading", "pitch", "roll"}: deg, s) and
         ``turn_rate_deg_s`` replace the paper's values (None: eq. 15-16 as printed, at
         ``sample_time`` per sample); ``course_deg`` is added to the heading (the paper's psi
@@ -282,14 +296,22 @@ class PaperShipMotion:
         amplitudes = {"heading": self.HEADING_AMPLITUDE, "pitch": self.PITCH_AMPLITUDE, "roll": self.ROLL_AMPLITUDE}
         for name, value in (amplitudes_deg or {}).items():
             amplitudes[name] = math.radians(_finite(f"{name} amplitude", value, " deg"))
-        periods = {name: samples * self.sample_time for name, samples in
-                   (("heading", self.HEADING_PERIOD_SAMPLES), ("pitch", self.PITCH_PERIOD_SAMPLES),
-                    ("roll", self.ROLL_PERIOD_SAMPLES))}
+        periods = {
+            name: samples * self.sample_time
+            for name, samples in (
+                ("heading", self.HEADING_PERIOD_SAMPLES),
+                ("pitch", self.PITCH_PERIOD_SAMPLES),
+                ("roll", self.ROLL_PERIOD_SAMPLES),
+            )
+        }
         for name, value in (periods_s or {}).items():
             periods[name] = _positive(f"{name} period", value, " s")
         self.amplitudes, self._periods = amplitudes, periods
-        self._turn_rate = (self.TURN_PER_SAMPLE / self.sample_time if turn_rate_deg_s is None
-                           else math.radians(_finite("turn rate", turn_rate_deg_s, " deg/s")))
+        self._turn_rate = (
+            self.TURN_PER_SAMPLE / self.sample_time
+            if turn_rate_deg_s is None
+            else math.radians(_finite("turn rate", turn_rate_deg_s, " deg/s"))
+        )
         self.course = math.radians(_finite("course", course_deg, " deg"))
 
     @property
@@ -318,8 +340,9 @@ class PaperShipMotion:
         if self.course:
             angles[0] = angles[0] + self.course
         rate[:, HEADING] += self.turn_rate
-        return ShipState(t=t, heave=np.zeros(t.size), heading=angles[0], pitch=angles[1],
-                         roll=angles[2], rate=rate, accel=accel)
+        return ShipState(
+            t=t, heave=np.zeros(t.size), heading=angles[0], pitch=angles[1], roll=angles[2], rate=rate, accel=accel
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -353,11 +376,15 @@ def jonswap_normalization(gamma: float) -> float:
     gamma = float(gamma)
     if not math.isfinite(gamma) or gamma < 1.0:
         raise ShipMotionError(f"JONSWAP peak enhancement gamma = {gamma!r} must be >= 1")
+
     def f(u):
         return float(_jonswap_shape(u, gamma))
+
     # Split at the peak (sigma changes there); below 0.3 the shape is < 1e-50.
-    total = sum(integrate.quad(f, a, b, epsabs=0.0, epsrel=1e-12, limit=200)[0]
-                for a, b in ((0.3, 1.0), (1.0, 3.0), (3.0, np.inf)))
+    total = sum(
+        integrate.quad(f, a, b, epsabs=0.0, epsrel=1e-12, limit=200)[0]
+        for a, b in ((0.3, 1.0), (1.0, 3.0), (3.0, np.inf))
+    )
     return 1.0 / total
 
 
@@ -450,19 +477,19 @@ class VesselRAO:
     yaw_coefficient: float = 0.4
 
     def __post_init__(self):
-        for name, unit in (("length", " m"), ("beam", " m"), ("draft", " m"),
-                           ("roll_period", " s")):
+        for name, unit in (("length", " m"), ("beam", " m"), ("draft", " m"), ("roll_period", " s")):
             _positive(f"vessel {name}", getattr(self, name), unit)
         # (name, lower limit, whether the lower limit itself is allowed, upper limit)
-        for name, lo, closed, hi in (("block_coefficient", 0.0, False, 1.0),
-                                     ("roll_damping", 0.0, False, 1.0),
-                                     ("wave_slope_coefficient", 0.0, False, 1.5),
-                                     ("yaw_coefficient", 0.0, True, 1.0)):
+        for name, lo, closed, hi in (
+            ("block_coefficient", 0.0, False, 1.0),
+            ("roll_damping", 0.0, False, 1.0),
+            ("wave_slope_coefficient", 0.0, False, 1.5),
+            ("yaw_coefficient", 0.0, True, 1.0),
+        ):
             value = _finite(f"vessel {name}", getattr(self, name))
             if not ((lo <= value if closed else lo < value) and value <= hi):
                 bracket = "[" if closed else "("
-                raise ShipMotionError(
-                    f"vessel {name} = {value:g} must be in {bracket}{lo:g}, {hi:g}]")
+                raise ShipMotionError(f"vessel {name} = {value:g} must be in {bracket}{lo:g}, {hi:g}]")
 
     @property
     def roll_frequency(self) -> float:
@@ -623,10 +650,20 @@ class SeaStateMotion:
         tail, too short to move a ship).
     """
 
-    def __init__(self, hs: float, tp: float, heading_deg: float, rng: np.random.Generator,
-                 gamma: float = 3.3, vessel: VesselRAO | None = None, speed: float = 0.0,
-                 course_deg: float = 0.0, n_components: int = 400,
-                 omega_min: float | None = None, omega_max: float | None = None):
+    def __init__(
+        self,
+        hs: float,
+        tp: float,
+        heading_deg: float,
+        rng: np.random.Generator,
+        gamma: float = 3.3,
+        vessel: VesselRAO | None = None,
+        speed: float = 0.0,
+        course_deg: float = 0.0,
+        n_components: int = 400,
+        omega_min: float | None = None,
+        omega_max: float | None = None,
+    ):
         self.hs, self.tp, self.gamma = _check_sea(hs, tp, gamma)
         #: Wave heading beta relative to the bow, rad.
         self.wave_heading = math.radians(_finite("wave heading heading_deg", heading_deg, " deg"))
@@ -637,8 +674,7 @@ class SeaStateMotion:
             raise ShipMotionError(f"ship speed = {self.speed:g} m/s must be >= 0")
         if not isinstance(rng, np.random.Generator):
             raise TypeError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
-        if isinstance(n_components, bool) or int(n_components) != n_components \
-                or n_components < 1:
+        if isinstance(n_components, bool) or int(n_components) != n_components or n_components < 1:
             raise ShipMotionError(f"n_components = {n_components!r} must be an integer >= 1")
         self.vessel = VesselRAO() if vessel is None else vessel
         wp = 2.0 * np.pi / self.tp
@@ -654,8 +690,7 @@ class SeaStateMotion:
         #: Phases phi_k, rad.
         self.phase = rng.uniform(0.0, 2.0 * np.pi, n)
         #: Wave amplitudes a_k = sqrt(2 S(w_k) dw), m.
-        self.amplitude = np.sqrt(2.0 * jonswap_spectrum(self.omega, self.hs, self.tp, self.gamma)
-                                 * self.d_omega)
+        self.amplitude = np.sqrt(2.0 * jonswap_spectrum(self.omega, self.hs, self.tp, self.gamma) * self.d_omega)
         #: Encounter frequencies, rad/s.
         self.omega_e = encounter_frequency(self.omega, self.wave_heading, self.speed)
         #: Complex RAOs at the components, (n, 4) in ``AXES`` order.
@@ -665,7 +700,7 @@ class SeaStateMotion:
         # bring down factors of w_e. Columns: [positions, rates, accelerations] x 4 axes.
         c = self.amplitude[:, None] * self.rao
         we = self.omega_e[:, None]
-        self._cos_weights = np.hstack([c.real, -we * c.imag, -we**2 * c.real])
+        self._cos_weights = np.hstack([c.real, -we * c.imag, -(we**2) * c.real])
         self._sin_weights = np.hstack([-c.imag, -we * c.real, we**2 * c.imag])
 
     @property
@@ -704,12 +739,12 @@ class SeaStateMotion:
             for start in range(0, t.size, rows):
                 m = min(rows, t.size - start)
                 first = np.exp(1j * (t[start] * self.omega_e + self.phase))
-                out[start:start + m] = ((table[:m] * first) @ weights).real
+                out[start : start + m] = ((table[:m] * first) @ weights).real
             return out
         for start in range(0, t.size, rows):
-            arg = np.multiply.outer(t[start:start + rows], self.omega_e)
+            arg = np.multiply.outer(t[start : start + rows], self.omega_e)
             arg += self.phase
-            out[start:start + rows] = np.cos(arg) @ cos_weights + np.sin(arg) @ sin_weights
+            out[start : start + rows] = np.cos(arg) @ cos_weights + np.sin(arg) @ sin_weights
         return out
 
     def sample(self, t) -> ShipState:
@@ -717,9 +752,15 @@ class SeaStateMotion:
         t = _times(t)
         out = self._sum(t, self._cos_weights, self._sin_weights)
         pos, rate, accel = out[:, :4], out[:, 4:8], out[:, 8:]
-        return ShipState(t=t, heave=pos[:, HEAVE].copy(),
-                         heading=self.course + pos[:, HEADING], pitch=pos[:, PITCH].copy(),
-                         roll=pos[:, ROLL].copy(), rate=rate.copy(), accel=accel.copy())
+        return ShipState(
+            t=t,
+            heave=pos[:, HEAVE].copy(),
+            heading=self.course + pos[:, HEADING],
+            pitch=pos[:, PITCH].copy(),
+            roll=pos[:, ROLL].copy(),
+            rate=rate.copy(),
+            accel=accel.copy(),
+        )
 
     def wave_elevation(self, t) -> np.ndarray:
         """Wave elevation at the ship's origin, m, (n,): sum_k a_k cos(w_e,k t + phi_k).

@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 from tqdm import tqdm
 
-from planbench.campaign import engines, report, spec as spec_module, store as store_module, worker
+from planbench.campaign import engines, report, worker
+from planbench.campaign import spec as spec_module
+from planbench.campaign import store as store_module
 
 #: Runs per task of a planner-only campaign (one vectorized judge_plans call each).
 PLAN_CHUNK = 5_000
@@ -36,7 +38,9 @@ class Outcome:
     skipped: int
     table: object
     worst: list
-    engine_wall_s: float = 0.0  # from the first chunk sent to the last row written (what is left of the workers' start included)
+    engine_wall_s: float = (
+        0.0  # from the first chunk sent to the last row written (what is left of the workers' start included)
+    )
     campaign_wall_s: float = 0.0  # from the call to the last row written: the spec's reading and checks, the
     #                               workers' whole start, every run (the report not)
 
@@ -48,10 +52,17 @@ def context_of(spec) -> worker.Context:
         mechanism = scenarios.mechanism_of(spec.scenario.name).name
     except ValueError:  # a scenario outside the registry: the workers look it up there as well
         mechanism = None
-    return worker.Context(spec.scenario.name, spec.base_params.to_dict(),
-                          None if spec.base_plant is None else spec.base_plant.to_dict(),
-                          dict(spec.plugins), spec.mode, spec.save, tuple(a.column for a in spec.axes),
-                          spec.timeout, mechanism)
+    return worker.Context(
+        spec.scenario.name,
+        spec.base_params.to_dict(),
+        None if spec.base_plant is None else spec.base_plant.to_dict(),
+        dict(spec.plugins),
+        spec.mode,
+        spec.save,
+        tuple(a.column for a in spec.axes),
+        spec.timeout,
+        mechanism,
+    )
 
 
 def check_plugins(spec) -> None:
@@ -73,15 +84,17 @@ def check_plugins(spec) -> None:
         supervise.run_supervised(make_all, limit)
     except supervise.Fault as fault:
         names = ", ".join(f"{role} = {s!r}" for role, s in spec.plugins.items())
-        raise PluginError(f"{spec.path.name}: making its plug-ins ({names}) ended in {fault.ended.phase} "
-                          f"without completing: {fault.ended.how}") from None
+        raise PluginError(
+            f"{spec.path.name}: making its plug-ins ({names}) ended in {fault.ended.phase} "
+            f"without completing: {fault.ended.how}"
+        ) from None
 
 
 def tasks_of(spec, runs) -> list[worker.RunTask]:
     out = []
     for run in runs:
         params, plant = spec.overrides(run)
-        values = tuple(float(v) if a.leaf.kind == "float" else v for a, v in zip(spec.axes, run.values))
+        values = tuple(float(v) if a.leaf.kind == "float" else v for a, v in zip(spec.axes, run.values, strict=True))
         out.append(worker.RunTask(run.index, run.point, run.sample, run.replicate, run.seed, values, params, plant))
     return out
 
@@ -89,8 +102,9 @@ def tasks_of(spec, runs) -> list[worker.RunTask]:
 def columnar(spec) -> bool:
     """Whether the campaign's chunks go to the workers as columns (``worker.ColumnTask``):
     a planner-only campaign of a scenario with a columnar judge that takes its axes."""
-    return worker.columns_supported(spec.scenario, spec.base_params, tuple(a.column for a in spec.axes),
-                                    spec.plugins, spec.mode)
+    return worker.columns_supported(
+        spec.scenario, spec.base_params, tuple(a.column for a in spec.axes), spec.plugins, spec.mode
+    )
 
 
 def column_chunks(spec, done, chunk_size: int):
@@ -121,8 +135,7 @@ def check_runs(spec, runs, quiet: bool, total: int | None = None) -> None:
     """Every run's parameters validated (a ParamError naming the first bad run)."""
     if columnar(spec):
         return check_columns(spec, quiet)
-    for run in tqdm(runs, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False,
-                    total=total):
+    for run in tqdm(runs, desc="checking parameters", unit="run", disable=quiet, delay=2.0, leave=False, total=total):
         spec.resolve(run)
 
 
@@ -140,18 +153,33 @@ def check_columns(spec, quiet: bool) -> None:
         for task in column_chunks(spec, None, PLAN_CHUNK):
             c = task.columns
             messages, unsure, _ = spec.scenario.plan_columns.validate(
-                spec.base_params, paths, [c[a.column] for a in spec.axes], len(task))
+                spec.base_params, paths, [c[a.column] for a in spec.axes], len(task)
+            )
             for i in np.flatnonzero(unsure | np.array([m is not None for m in messages], dtype=bool)):
-                run = Run(int(c["run"][i]), int(c["point"][i]), int(c["sample"][i]), int(c["replicate"][i]),
-                          int(c["seed"][i]), tuple(worker._plain(c[a.column][i]) for a in spec.axes))
+                run = Run(
+                    int(c["run"][i]),
+                    int(c["point"][i]),
+                    int(c["sample"][i]),
+                    int(c["replicate"][i]),
+                    int(c["seed"][i]),
+                    tuple(worker._plain(c[a.column][i]) for a in spec.axes),
+                )
                 spec.resolve(run)
             bar.update(len(task))
     finally:
         bar.close()
 
 
-def sweep(spec_path, out, engine="local", workers: int | None = None, address: str | None = None,
-          rerun_worst: int = 0, quiet: bool = False, echo=print) -> Outcome:
+def sweep(
+    spec_path,
+    out,
+    engine="local",
+    workers: int | None = None,
+    address: str | None = None,
+    rerun_worst: int = 0,
+    quiet: bool = False,
+    echo=print,
+) -> Outcome:
     """Run (or resume) the campaign of ``spec_path`` into ``out``; see the module's steps.
     ``engine``: "local", "ray", or an engine the caller holds (``engines.LocalEngine`` in a
     ``with`` block: its workers serve this campaign and the next)."""
@@ -187,22 +215,29 @@ def _sweep(spec, context, target, runner_engine, rerun_worst, quiet, echo, campa
         target.open(spec, spec.path.read_text())
         done = target.done_array()  # the part files read once
         pending = spec.size - done.size
-        chunk_size = 1 if spec.mode == "simulate" else max(1, min(PLAN_CHUNK, math.ceil(
-            pending / (4 * (runner_engine.workers or 1)))))
+        chunk_size = (
+            1
+            if spec.mode == "simulate"
+            else max(1, min(PLAN_CHUNK, math.ceil(pending / (4 * (runner_engine.workers or 1)))))
+        )
         # Chunks are made as the engine asks for them: a campaign of 10^6 runs is never held whole.
         if columnar(spec):
             chunks = column_chunks(spec, done if done.size else None, chunk_size)
         else:
             done_set = set(done.tolist())
-            chunks = (tasks_of(spec, runs) for runs in spec_module.iter_chunks(
-                (r for r in spec.iter_runs() if r.index not in done_set), chunk_size))
+            chunks = (
+                tasks_of(spec, runs)
+                for runs in spec_module.iter_chunks(
+                    (r for r in spec.iter_runs() if r.index not in done_set), chunk_size
+                )
+            )
         if done.size and not quiet:
             echo(f"resuming {target}: {done.size} of {spec.size} runs done, {pending} to go")
         failed = errors = 0
         bar = tqdm(total=spec.size, initial=done.size, unit="run", disable=quiet, desc="campaign", smoothing=0.1)
         start = time.perf_counter()
         try:
-            for chunk, result in runner_engine.run(context, chunks):
+            for _, result in runner_engine.run(context, chunks):
                 for index, files in result["files"].items():
                     target.write_run_files(index, files, spec.scenario.name)
                 rows = result["table"] if "table" in result else result["rows"]
@@ -241,14 +276,25 @@ def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
         params, plant = spec.resolve(by_index[index])
         folder = target.path / "worst" / f"{rank:02d}-run-{index:06d}"
         directory = outputs.OutputDir(folder, option="--rerun-worst")
-        _, result = pipeline.execute(spec.scenario, params, plant, plugins=spec.plugins, out=directory,
-                                     video=folder / f"{spec.scenario.name}.mp4", quiet=quiet)
+        _, result = pipeline.execute(
+            spec.scenario,
+            params,
+            plant,
+            plugins=spec.plugins,
+            out=directory,
+            video=folder / f"{spec.scenario.name}.mp4",
+            quiet=quiet,
+        )
         row = rows[index]
-        differ = [c.name for c in result.checks
-                  if not np.array_equal(np.float64(c.value), np.float64(row.get(f"check.{c.name}", np.nan)),
-                                        equal_nan=True)]
+        differ = [
+            c.name
+            for c in result.checks
+            if not np.array_equal(np.float64(c.value), np.float64(row.get(f"check.{c.name}", np.nan)), equal_nan=True)
+        ]
         note = "" if not differ else f" (differs from the campaign's row in {', '.join(differ)})"
-        echo(f"worst #{rank}: run {index} ({spec.describe(by_index[index])}): "
-             f"{'passed' if result.passed else 'FAILED'} -> {folder}{note}")
+        echo(
+            f"worst #{rank}: run {index} ({spec.describe(by_index[index])}): "
+            f"{'passed' if result.passed else 'FAILED'} -> {folder}{note}"
+        )
         out.append((index, folder, differ))
     return out

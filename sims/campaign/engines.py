@@ -28,8 +28,10 @@ def _lost(context, chunk, why: str) -> dict:
     """Rows of a chunk whose worker died: status "error" with the reason."""
     if isinstance(chunk, worker.ColumnTask):
         return worker.lost_columns(context, chunk, why)
-    rows = [{**worker.row_of(context, task), "status": "error", "passed": None, "error": why, "wall_s": 0.0,
-             "sim_s": None} for task in chunk]
+    rows = [
+        {**worker.row_of(context, task), "status": "error", "passed": None, "error": why, "wall_s": 0.0, "sim_s": None}
+        for task in chunk
+    ]
     return {"rows": rows, "checks": {}, "files": {}}
 
 
@@ -144,8 +146,12 @@ class LocalEngine:
         self.close()
 
     def _new_pool(self, context: worker.Context | None):
-        return cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                      initializer=_init_worker, initargs=(os.getpid(), context))
+        return cf.ProcessPoolExecutor(
+            max_workers=self.workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_init_worker,
+            initargs=(os.getpid(), context),
+        )
 
     def start(self, context: worker.Context | None = None) -> None:
         """Spawn the workers now: they start (import planbench, MuJoCo and the scenario's
@@ -198,7 +204,7 @@ class LocalEngine:
             broken, unsent = [], []
             futures = {}
 
-            def submit(batch):
+            def submit(batch, pool=pool, futures=futures, unsent=unsent):  # (this round's pool)
                 # A pool can break between two submits (a worker died meanwhile); a chunk it
                 # refuses never ran, so it goes back to the queue without counting as a death.
                 # Submitting spawns workers: with SIGINT, SIGTERM and SIGHUP held back, an
@@ -243,8 +249,14 @@ class LocalEngine:
             retry.extendleft(reversed(unsent))
             for chunk in sorted(broken, key=_first_run, reverse=True):
                 if _first_run(chunk) in broke_once:
-                    yield chunk, _lost(context, chunk, "its worker process died twice running it (out of memory, "
-                                       "or a crash in native code)")
+                    yield (
+                        chunk,
+                        _lost(
+                            context,
+                            chunk,
+                            "its worker process died twice running it (out of memory, or a crash in native code)",
+                        ),
+                    )
                 else:
                     broke_once.add(_first_run(chunk))
                     retry.appendleft(chunk)
@@ -297,8 +309,9 @@ class RayEngine:
         try:
             # One BLAS thread, as in every planbench process (sims/__init__.py): the same
             # numbers as the local engine's, bit for bit.
-            threads = {v: os.environ.get(v, "1") for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
-                                                            "MKL_NUM_THREADS")}
+            threads = {
+                v: os.environ.get(v, "1") for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+            }
             remote = ray.remote(num_cpus=1, max_retries=0, runtime_env={"env_vars": threads})(worker.run_chunk)
             context_ref = ray.put(context)
             source = iter(chunks)
@@ -348,12 +361,16 @@ def _check_reachable(address: str, timeout: float | None = None) -> None:
         with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
             return
     except ConnectionRefusedError:  # a definite answer: nothing listens there
-        raise ParamError(f"--address {address}: nothing listens there (connection refused); start the "
-                         "cluster (ray start --head) or check the address") from None
+        raise ParamError(
+            f"--address {address}: nothing listens there (connection refused); start the "
+            "cluster (ray start --head) or check the address"
+        ) from None
     except OSError as e:  # a timeout, an unknown host, no route
-        raise ParamError(f"--address {address}: no Ray cluster answered within {timeout:g} s "
-                         f"({e.strerror or e or 'timed out'}); start it (ray start --head) or check the "
-                         "address") from None
+        raise ParamError(
+            f"--address {address}: no Ray cluster answered within {timeout:g} s "
+            f"({e.strerror or e or 'timed out'}); start it (ray start --head) or check the "
+            "address"
+        ) from None
 
 
 def _ray_connect(ray, address: str, options: dict) -> None:
@@ -371,8 +388,10 @@ def _ray_connect(ray, address: str, options: dict) -> None:
             try:
                 ray.init(address=address, **options)
             except Exception as e:  # noqa: BLE001  (ConnectionError, RuntimeError: Ray's own)
-                raise ParamError(f"--address {address}: no Ray cluster there ({type(e).__name__}: "
-                                 f"{str(e).splitlines()[0] if str(e) else 'no reason given'})") from None
+                raise ParamError(
+                    f"--address {address}: no Ray cluster there ({type(e).__name__}: "
+                    f"{str(e).splitlines()[0] if str(e) else 'no reason given'})"
+                ) from None
             finally:
                 os.dup2(saved, 2)
     finally:

@@ -37,8 +37,9 @@ def _floats(column) -> np.ndarray:
     import pyarrow.compute as pc
 
     kind = column.type
-    if not (pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind)
-            or pa.types.is_null(kind)):
+    if not (
+        pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind) or pa.types.is_null(kind)
+    ):
         raise TypeError(f"a column of {kind} is not numbers")
     return pc.fill_null(pc.cast(column, pa.float64()), np.nan).to_numpy(zero_copy_only=False).astype(float)
 
@@ -51,8 +52,11 @@ def _column(table: pa.Table, name: str) -> np.ndarray:
 
 
 def _status(table: pa.Table) -> np.ndarray:
-    return table.column("status").to_numpy(zero_copy_only=False).astype(object) if table.num_rows \
+    return (
+        table.column("status").to_numpy(zero_copy_only=False).astype(object)
+        if table.num_rows
         else np.array([], dtype=object)
+    )
 
 
 def _percentiles(values: np.ndarray) -> dict:
@@ -64,7 +68,7 @@ def _percentiles(values: np.ndarray) -> dict:
 
 
 def check_names(table: pa.Table) -> list[str]:
-    return [c[len("check."):] for c in table.column_names if c.startswith("check.")]
+    return [c[len("check.") :] for c in table.column_names if c.startswith("check.")]
 
 
 def summarize(spec, table: pa.Table, checks_meta: dict) -> dict:
@@ -81,35 +85,62 @@ def summarize(spec, table: pa.Table, checks_meta: dict) -> dict:
         n = int(np.sum(mask & counted))
         passed = int(np.sum(mask & (status == "passed")))
         low, high = wilson(passed, n)
-        out = {"runs": int(np.sum(mask)), "counted": n, "passed": passed,
-               "failed": int(np.sum(mask & (status == "failed"))), "errors": int(np.sum(mask & (status == "error"))),
-               "invalid": int(np.sum(mask & (status == "invalid"))),
-               "pass_rate": passed / n if n else None, "pass_rate_ci95": [low, high], "checks": {}}
+        out = {
+            "runs": int(np.sum(mask)),
+            "counted": n,
+            "passed": passed,
+            "failed": int(np.sum(mask & (status == "failed"))),
+            "errors": int(np.sum(mask & (status == "error"))),
+            "invalid": int(np.sum(mask & (status == "invalid"))),
+            "pass_rate": passed / n if n else None,
+            "pass_rate_ci95": [low, high],
+            "checks": {},
+        }
         for name in names:
             v = verdicts[name][mask & counted]
             judged = v[np.isfinite(v)]
-            out["checks"][name] = {**_percentiles(values[name][mask & counted]),
-                                   "pass_rate": float(judged.mean()) if judged.size else None}
+            out["checks"][name] = {
+                **_percentiles(values[name][mask & counted]),
+                "pass_rate": float(judged.mean()) if judged.size else None,
+            }
         return out
 
     points = []
     for p in range(spec.points):
-        entry = {"point": p, "grid": {a.column: _plain(v) for a, v in zip(spec.grid, spec.grid_values(p))}}
+        entry = {"point": p, "grid": {a.column: _plain(v) for a, v in zip(spec.grid, spec.grid_values(p), strict=True)}}
         entry.update(block(point == p))
         points.append(entry)
     checks = {}
     for name in names:
         finite = limits[name][np.isfinite(limits[name])]
-        checks[name] = {**checks_meta.get(name, {}),
-                        "limit": float(np.median(finite)) if finite.size else None,
-                        "limits_differ": bool(finite.size and np.ptp(finite) > 0)}
+        checks[name] = {
+            **checks_meta.get(name, {}),
+            "limit": float(np.median(finite)) if finite.size else None,
+            "limits_differ": bool(finite.size and np.ptp(finite) > 0),
+        }
     return {
-        "scenario": spec.scenario.name, "mode": spec.mode, "spec": str(spec.path), "fingerprint": spec.fingerprint,
-        "runs": spec.size, "rows": table.num_rows, "points": spec.points, "samples": spec.samples,
-        "seeds_per_point": spec.replicates, "campaign_seed": spec.seed,
-        "axes": [{"column": a.column, "kind": "grid" if a.values is not None else "random",
-                  **({"values": [_plain(v) for v in a.values]} if a.values is not None else
-                     {"distribution": a.distribution.name, **a.distribution.args})} for a in spec.axes],
+        "scenario": spec.scenario.name,
+        "mode": spec.mode,
+        "spec": str(spec.path),
+        "fingerprint": spec.fingerprint,
+        "runs": spec.size,
+        "rows": table.num_rows,
+        "points": spec.points,
+        "samples": spec.samples,
+        "seeds_per_point": spec.replicates,
+        "campaign_seed": spec.seed,
+        "axes": [
+            {
+                "column": a.column,
+                "kind": "grid" if a.values is not None else "random",
+                **(
+                    {"values": [_plain(v) for v in a.values]}
+                    if a.values is not None
+                    else {"distribution": a.distribution.name, **a.distribution.args}
+                ),
+            }
+            for a in spec.axes
+        ],
         "checks": checks,
         "overall": block(np.ones(table.num_rows, bool)),
         "by_point": points,
@@ -131,19 +162,25 @@ def format_summary(summary: dict) -> str:
     lines = [f"{'point':>5} {head} {'runs':>6} {'passed':>6} {'failed':>6} {'errors':>6} {'pass rate [95 % CI]':>24}"]
     for p in summary["by_point"]:
         cells = " ".join(f"{_cell(p['grid'][c]):>14}" for c in grid_columns)
-        lines.append(f"{p['point']:>5} {cells} {p['counted']:>6} {p['passed']:>6} {p['failed']:>6} {p['errors']:>6} "
-                     f"{_rate(p):>24}")
+        lines.append(
+            f"{p['point']:>5} {cells} {p['counted']:>6} {p['passed']:>6} {p['failed']:>6} {p['errors']:>6} "
+            f"{_rate(p):>24}"
+        )
     o = summary["overall"]
-    lines.append(f"{'all':>5} {' ' * len(head)} {o['counted']:>6} {o['passed']:>6} {o['failed']:>6} {o['errors']:>6} "
-                 f"{_rate(o):>24}" + (f"   ({o['invalid']} invalid, not counted)" if o["invalid"] else ""))
+    lines.append(
+        f"{'all':>5} {' ' * len(head)} {o['counted']:>6} {o['passed']:>6} {o['failed']:>6} {o['errors']:>6} "
+        f"{_rate(o):>24}" + (f"   ({o['invalid']} invalid, not counted)" if o["invalid"] else "")
+    )
     lines.append("")
     lines.append(f"{'check':<24} {'unit':<7} {'limit':>10} {'median':>11} {'5 %':>11} {'95 %':>11} {'pass rate':>9}")
     for name, meta in summary["checks"].items():
         c = o["checks"][name]
         limit = "" if meta.get("limit") is None else f"{meta.get('comparison', '')}{meta['limit']:.4g}"
         rate = "" if c["pass_rate"] is None else f"{100 * c['pass_rate']:.1f} %"
-        lines.append(f"{name:<24} {meta.get('unit', ''):<7} {limit:>10} {_num(c['median']):>11} {_num(c['p5']):>11} "
-                     f"{_num(c['p95']):>11} {rate:>9}")
+        lines.append(
+            f"{name:<24} {meta.get('unit', ''):<7} {limit:>10} {_num(c['median']):>11} {_num(c['p5']):>11} "
+            f"{_num(c['p95']):>11} {rate:>9}"
+        )
     return "\n".join(lines)
 
 
@@ -233,7 +270,7 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
     fig.subplots_adjust(left=0.8 / (4.2 * n), right=1 - 0.1 / (4.2 * n), bottom=0.28, top=0.88, wspace=0.08)
     for name, meta in summary["checks"].items():
         value = _column(table, f"check.{name}")
-        for ax_plot, axis in zip(plots[0], axes or [None]):
+        for ax_plot, axis in zip(plots[0], axes or [None], strict=True):
             if axis is None:
                 x, labels = _column(table, "run"), None
                 xlabel = "run"
@@ -242,8 +279,15 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
                     axis_values[axis.column] = _axis_values(table, axis.column)
                 x, labels = axis_values[axis.column]
                 xlabel = axis.column + (f" ({axis.unit})" if axis.unit else "")
-            ax_plot.plot(x[sel], value[sel], ".", alpha=0.35 if sel.size > 200 else 0.7, ms=3, color="tab:blue",
-                         label="runs" + (f" (every {stride}th)" if stride > 1 else ""))
+            ax_plot.plot(
+                x[sel],
+                value[sel],
+                ".",
+                alpha=0.35 if sel.size > 200 else 0.7,
+                ms=3,
+                color="tab:blue",
+                label="runs" + (f" (every {stride}th)" if stride > 1 else ""),
+            )
             if axis is not None and axis.values is not None:
                 centres = np.unique(x[keep & np.isfinite(x)])
                 med, lo, hi = [], [], []
@@ -254,11 +298,23 @@ def plot_checks(spec, table: pa.Table, summary: dict, folder) -> list:
                     lo.append(np.percentile(v, 5) if v.size else np.nan)
                     hi.append(np.percentile(v, 95) if v.size else np.nan)
                 med, lo, hi = map(np.array, (med, lo, hi))
-                ax_plot.errorbar(centres, med, yerr=[med - lo, hi - med], fmt="o-", color="k", ms=4, capsize=3,
-                                 label="median, 5-95 %")
+                ax_plot.errorbar(
+                    centres,
+                    med,
+                    yerr=[med - lo, hi - med],
+                    fmt="o-",
+                    color="k",
+                    ms=4,
+                    capsize=3,
+                    label="median, 5-95 %",
+                )
             if meta.get("limit") is not None:
-                ax_plot.axhline(meta["limit"], color="tab:red", ls="--", label=f"limit {meta.get('comparison', '')} "
-                                f"{meta['limit']:.4g}")
+                ax_plot.axhline(
+                    meta["limit"],
+                    color="tab:red",
+                    ls="--",
+                    label=f"limit {meta.get('comparison', '')} {meta['limit']:.4g}",
+                )
             if labels is not None:
                 ax_plot.set_xticks(range(len(labels)), labels, rotation=30, fontsize=7)
             elif axis is not None and axis.values is not None:
@@ -315,17 +371,25 @@ def plot_page(spec, table: pa.Table, summary: dict, path) -> None:
     top.set_ylabel("pass rate (%), 95 % Wilson")
     top.grid(alpha=0.3)
     o = summary["overall"]
-    top.set_title(f"{summary['scenario']} ({summary['mode']}): {o['counted']} runs, {o['passed']} passed, "
-                  f"{o['failed']} failed, {o['errors']} errors" + (f", {o['invalid']} invalid" if o["invalid"] else "")
-                  + f"; {summary['points']} points x {summary['samples']} samples x {summary['seeds_per_point']} seeds",
-                  fontsize=9)
+    top.set_title(
+        f"{summary['scenario']} ({summary['mode']}): {o['counted']} runs, {o['passed']} passed, "
+        f"{o['failed']} failed, {o['errors']} errors"
+        + (f", {o['invalid']} invalid" if o["invalid"] else "")
+        + f"; {summary['points']} points x {summary['samples']} samples x {summary['seeds_per_point']} seeds",
+        fontsize=9,
+    )
     for i, name in enumerate(shown):
         ax = fig.add_subplot(grid[1 + i // cols, i % cols])
         meta = summary["checks"][name]
-        med = np.array([np.nan if p["checks"].get(name, {}).get("median") is None else p["checks"][name]["median"]
-                        for p in points])
-        p5 = np.array([np.nan if p["checks"].get(name, {}).get("p5") is None else p["checks"][name]["p5"] for p in points])
-        p95 = np.array([np.nan if p["checks"].get(name, {}).get("p95") is None else p["checks"][name]["p95"] for p in points])
+        med = np.array(
+            [np.nan if p["checks"].get(name, {}).get("median") is None else p["checks"][name]["median"] for p in points]
+        )
+        p5 = np.array(
+            [np.nan if p["checks"].get(name, {}).get("p5") is None else p["checks"][name]["p5"] for p in points]
+        )
+        p95 = np.array(
+            [np.nan if p["checks"].get(name, {}).get("p95") is None else p["checks"][name]["p95"] for p in points]
+        )
         ax.errorbar(x, med, yerr=[med - p5, p95 - med], fmt="o-", ms=3, capsize=3, lw=1)
         if meta.get("limit") is not None:
             ax.axhline(meta["limit"], color="tab:red", ls="--", lw=1)

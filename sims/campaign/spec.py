@@ -50,8 +50,22 @@ from scipy import stats
 
 from planbench.params import ParamError, Params, _bound, field_types
 
-SPEC_KEYS = ("scenario", "planner", "controller", "mode", "seed", "seeds", "samples", "invalid", "save",
-             "timeout", "parameters", "plant", "grid", "random")
+SPEC_KEYS = (
+    "scenario",
+    "planner",
+    "controller",
+    "mode",
+    "seed",
+    "seeds",
+    "samples",
+    "invalid",
+    "save",
+    "timeout",
+    "parameters",
+    "plant",
+    "grid",
+    "random",
+)
 MODES = ("simulate", "plan")
 SAVE_CHOICES = ("timeseries", "video")
 DISTRIBUTIONS = {
@@ -138,12 +152,15 @@ def set_path(data: dict, path: tuple, value, key: str) -> None:
         try:
             node = node[step]
         except (IndexError, KeyError, TypeError):
-            raise ParamError(f"axis {key!r}: {_render(path[:depth + 1])} does not exist in the base "
-                             "parameters (give it in [parameters] first)") from None
+            raise ParamError(
+                f"axis {key!r}: {_render(path[: depth + 1])} does not exist in the base "
+                "parameters (give it in [parameters] first)"
+            ) from None
     last = path[-1]
     if isinstance(last, int) and (not isinstance(node, list) or last >= len(node)):
-        raise ParamError(f"axis {key!r}: {_render(path)} does not exist in the base parameters "
-                         "(give it in [parameters] first)")
+        raise ParamError(
+            f"axis {key!r}: {_render(path)} does not exist in the base parameters (give it in [parameters] first)"
+        )
     node[last] = value
 
 
@@ -177,8 +194,9 @@ class Distribution:
         low, high = self.support
         if math.isinf(low) and math.isinf(high):
             return stats.norm(loc=a["mean"], scale=a["std"])
-        return stats.truncnorm((low - a["mean"]) / a["std"], (high - a["mean"]) / a["std"],
-                               loc=a["mean"], scale=a["std"])
+        return stats.truncnorm(
+            (low - a["mean"]) / a["std"], (high - a["mean"]) / a["std"], loc=a["mean"], scale=a["std"]
+        )
 
     def draw(self, n: int, rng: np.random.Generator) -> np.ndarray:
         values = self.frozen().rvs(size=n, random_state=rng)
@@ -191,8 +209,9 @@ class Distribution:
 
 def _distribution(key: str, table) -> Distribution:
     if not isinstance(table, dict):
-        raise ParamError(f"random.{key} must be a table such as {{ distribution = \"uniform\", low = 0, high = 1 }}, "
-                         f"got {table!r}")
+        raise ParamError(
+            f'random.{key} must be a table such as {{ distribution = "uniform", low = 0, high = 1 }}, got {table!r}'
+        )
     name = table.get("distribution")
     if name not in DISTRIBUTIONS:
         raise ParamError(f"random.{key}.distribution = {name!r} is not one of {', '.join(DISTRIBUTIONS)}")
@@ -200,7 +219,9 @@ def _distribution(key: str, table) -> Distribution:
     allowed = set(required) | ({"low", "high"} if name == "normal" else set()) | {"distribution"}
     unknown = [k for k in table if k not in allowed]
     if unknown:
-        raise ParamError(f"random.{key}: unknown key {unknown[0]!r}; {name} takes {', '.join(sorted(allowed - {'distribution'}))}")
+        raise ParamError(
+            f"random.{key}: unknown key {unknown[0]!r}; {name} takes {', '.join(sorted(allowed - {'distribution'}))}"
+        )
     args = {}
     for k in [*required, *(("low", "high") if name == "normal" else ())]:
         if k not in table:
@@ -301,9 +322,12 @@ class CampaignSpec:
 
     def draws(self) -> list[np.ndarray]:
         """Every random axis's ``samples`` draws (the same for every grid point)."""
-        return [axis.distribution.draw(self.samples,
-                                       np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(1, i))))
-                for i, axis in enumerate(self.random)]
+        return [
+            axis.distribution.draw(
+                self.samples, np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(1, i)))
+            )
+            for i, axis in enumerate(self.random)
+        ]
 
     def run_seed(self, sample: int, replicate: int) -> int:
         if self.seeds:
@@ -315,8 +339,11 @@ class CampaignSpec:
         """Every run, in order of its index, one at a time (a campaign of 10^6 runs is never
         held in memory whole)."""
         draws = self.draws()
-        seeds = [[self.run_seed(s, r) for r in range(self.replicates)] for s in range(self.samples)] \
-            if self.samples * self.replicates <= 100_000 else None
+        seeds = (
+            [[self.run_seed(s, r) for r in range(self.replicates)] for s in range(self.samples)]
+            if self.samples * self.replicates <= 100_000
+            else None
+        )
         index = 0
         for point in range(self.points):
             grid = self.grid_values(point)
@@ -383,14 +410,20 @@ class CampaignSpec:
         """The run's validated parameters and plant (a ParamError names the axis values)."""
         params, plant = self.overrides(run)
         try:
-            return (type(self.base_params).from_mapping(params, base=self.base_params),
-                    self.scenario.resolve_plant(plant) if self.base_plant is None else
-                    type(self.base_plant).from_mapping(plant, base=self.base_plant, prefix="plant."))
+            return (
+                type(self.base_params).from_mapping(params, base=self.base_params),
+                self.scenario.resolve_plant(plant)
+                if self.base_plant is None
+                else type(self.base_plant).from_mapping(plant, base=self.base_plant, prefix="plant."),
+            )
         except ParamError as e:
             raise ParamError(f"run {run.index} ({self.describe(run)}): {e}") from None
 
     def describe(self, run: Run) -> str:
-        return ", ".join(f"{a.column} = {_show(v)}" for a, v in zip(self.axes, run.values, strict=True)) + f", seed {run.seed}"
+        return (
+            ", ".join(f"{a.column} = {_show(v)}" for a, v in zip(self.axes, run.values, strict=True))
+            + f", seed {run.seed}"
+        )
 
 
 def _show(value) -> str:
@@ -426,8 +459,9 @@ def load(path, get_scenario=None, known_names=None) -> CampaignSpec:
     except tomllib.TOMLDecodeError as e:
         raise ParamError(f"{path}: not TOML: {e}") from None
     except RecursionError:
-        raise ParamError(f"{path}: TOML nested too deep to read (arrays or tables within one another, "
-                         "thousands of levels)") from None
+        raise ParamError(
+            f"{path}: TOML nested too deep to read (arrays or tables within one another, thousands of levels)"
+        ) from None
     try:
         return _parse(path, data, get_scenario, known_names, scenario_files)
     except ParamError as e:
@@ -464,8 +498,10 @@ def _parse(path: Path, data: dict, get_scenario, known_names, scenario_files) ->
     if mode not in MODES:
         raise ParamError(f"mode = {mode!r} is not one of {', '.join(MODES)}")
     if mode == "plan" and getattr(scenario, "judge_plans", None) is None:
-        raise ParamError(f"mode = \"plan\": {scenario.name} has no planner-only checks "
-                         "(the hexapod's and the loader's scenarios have)")
+        raise ParamError(
+            f'mode = "plan": {scenario.name} has no planner-only checks '
+            "(the hexapod's and the loader's scenarios have)"
+        )
     if mode == "plan" and "controller" in plugins:
         raise ParamError("mode = \"plan\" runs no controller; remove 'controller'")
     seed = _int(data, "seed", 0, 0, 2**63 - 1)
@@ -488,10 +524,15 @@ def _parse(path: Path, data: dict, get_scenario, known_names, scenario_files) ->
         raise ParamError("save: a planner-only campaign writes no per-run outputs")
     timeout = data.get("timeout")
     if timeout is not None:
-        if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not math.isfinite(timeout) \
-                or timeout <= 0:
-            raise ParamError(f"timeout = {timeout!r} must be a finite number of seconds > 0 (each run's "
-                             "wall-time limit)")
+        if (
+            isinstance(timeout, bool)
+            or not isinstance(timeout, (int, float))
+            or not math.isfinite(timeout)
+            or timeout <= 0
+        ):
+            raise ParamError(
+                f"timeout = {timeout!r} must be a finite number of seconds > 0 (each run's wall-time limit)"
+            )
         timeout = float(timeout)
     try:
         if "parameters" in data:
@@ -515,14 +556,39 @@ def _parse(path: Path, data: dict, get_scenario, known_names, scenario_files) ->
         raise ParamError(f"samples = {samples} draws of nothing: [random] is empty")
     if "seed" in {a.key for a in grid + random if not a.plant}:
         raise ParamError("seed is the campaign's: use seeds = N (or a list) instead of an axis of seed")
-    spec = CampaignSpec(path, scenario, base_params, base_plant, plugins, mode, seed, seeds, replicates,
-                        samples, invalid, tuple(save), grid, random, "", data, timeout)
+    spec = CampaignSpec(
+        path,
+        scenario,
+        base_params,
+        base_plant,
+        plugins,
+        mode,
+        seed,
+        seeds,
+        replicates,
+        samples,
+        invalid,
+        tuple(save),
+        grid,
+        random,
+        "",
+        data,
+        timeout,
+    )
     if spec.size > MAX_RUNS:
-        raise ParamError(f"{spec.size} runs ({spec.points} points x {samples} samples x {replicates} seeds) "
-                         f"is more than {MAX_RUNS}")
-    canonical = json.dumps({"spec": data, "scenario_file": fingerprint_extra,
-                            "base": base_params.to_dict(), "plant": None if base_plant is None else base_plant.to_dict()},
-                           sort_keys=True, default=str)
+        raise ParamError(
+            f"{spec.size} runs ({spec.points} points x {samples} samples x {replicates} seeds) is more than {MAX_RUNS}"
+        )
+    canonical = json.dumps(
+        {
+            "spec": data,
+            "scenario_file": fingerprint_extra,
+            "base": base_params.to_dict(),
+            "plant": None if base_plant is None else base_plant.to_dict(),
+        },
+        sort_keys=True,
+        default=str,
+    )
     spec.fingerprint = hashlib.sha256(canonical.encode()).hexdigest()
     _check_axes(spec)
     return spec
@@ -553,14 +619,17 @@ def _check_overlap(grid: list[Axis], random: list[Axis]) -> None:
     other."""
     axes = [("grid", a) for a in grid] + [("random", a) for a in random]
     for i, (section_a, a) in enumerate(axes):
-        for section_b, b in axes[i + 1:]:
+        for section_b, b in axes[i + 1 :]:
             if a.plant != b.plant:
                 continue
             short, long = (a, b) if len(a.path) <= len(b.path) else (b, a)
-            if long.path[:len(short.path)] == short.path:
+            if long.path[: len(short.path)] == short.path:
                 where = "[grid] and [random]" if section_a != section_b else f"[{section_a}]"
-                what = (f"axis {a.column!r} is in both {where}" if section_a != section_b and a.path == b.path
-                        else f"axes {a.column!r} and {b.column!r} of {where} set the same value")
+                what = (
+                    f"axis {a.column!r} is in both {where}"
+                    if section_a != section_b and a.path == b.path
+                    else f"axes {a.column!r} and {b.column!r} of {where} set the same value"
+                )
                 raise ParamError(f"{what}; a value may have one axis only")
 
 
@@ -580,14 +649,17 @@ def _axis(section: str, key: str, value, plant: bool, cls) -> Axis:
     declared, column = leaf.declared, leaf.column
     low, high = _bound(declared.low, column), _bound(declared.high, column)
     s_low, s_high = distribution.support
-    outside = (low is not None and (s_low < low or (declared.low_open and s_low <= low))) or \
-              (high is not None and (s_high > high or (declared.high_open and s_high >= high)))
+    outside = (low is not None and (s_low < low or (declared.low_open and s_low <= low))) or (
+        high is not None and (s_high > high or (declared.high_open and s_high >= high))
+    )
     if outside:
         from planbench.params import range_text
 
         hint = " (truncate it with low and high)" if distribution.name == "normal" else ""
-        raise ParamError(f"random.{shown} = {distribution.text()} reaches [{s_low:g}, {s_high:g}], outside "
-                         f"{shown}'s range {range_text(declared, column)}{hint}")
+        raise ParamError(
+            f"random.{shown} = {distribution.text()} reaches [{s_low:g}, {s_high:g}], outside "
+            f"{shown}'s range {range_text(declared, column)}{hint}"
+        )
     return Axis(key, plant, path, leaf, distribution=distribution)
 
 
@@ -672,8 +744,11 @@ def run_seeds(seed: int, samples: np.ndarray, replicates: np.ndarray) -> np.ndar
     n = samples.shape[0]
     run = _words(seed)
     run += [0] * max(0, _POOL - len(run))
-    entropy = [np.full(n, w, np.uint64) for w in run] + [np.full(n, 2, np.uint64),
-                                                          samples.astype(np.uint64), replicates.astype(np.uint64)]
+    entropy = [np.full(n, w, np.uint64) for w in run] + [
+        np.full(n, 2, np.uint64),
+        samples.astype(np.uint64),
+        replicates.astype(np.uint64),
+    ]
     const = [_INIT_A]
 
     def hashmix(value):

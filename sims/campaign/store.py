@@ -71,22 +71,26 @@ class CampaignDir(outputs._Target):
         real = Path(os.path.realpath(path))
         cwd = Path(os.path.realpath(os.getcwd()))
         if real == Path(real.anchor) or real == Path(os.path.realpath(Path.home())) or cwd.is_relative_to(real):
-            raise OutputError(f"{self.what} {path} is the root, the home or the current directory (or holds it); "
-                              "choose a new directory")
+            raise OutputError(
+                f"{self.what} {path} is the root, the home or the current directory (or holds it); "
+                "choose a new directory"
+            )
         # A run's files lie in DIR/runs/NNNNNN/ (staged beside it first), the longest deepest.
-        outputs._check_lengths(self.what, path, len(f"{RUNS}/000000/") + len(outputs.STAGING_PREFIX) + 8 + 1
-                               + outputs._LONGEST_INNER)
+        outputs._check_lengths(
+            self.what, path, len(f"{RUNS}/000000/") + len(outputs.STAGING_PREFIX) + 8 + 1 + outputs._LONGEST_INNER
+        )
         if os.path.islink(path):
             raise OutputError(f"{self.what} {path} is a symbolic link; give the directory itself")
         if os.path.lexists(path):
             if not path.is_dir():
                 raise OutputError(f"{self.what} {path} exists and is not a directory")
             if not (path / STATE).is_file() and any(path.iterdir()):
-                raise OutputError(f"{self.what} {path} is not empty and is not a planbench campaign (no {STATE}); "
-                                  f"choose another {option}")
+                raise OutputError(
+                    f"{self.what} {path} is not empty and is not a planbench campaign (no {STATE}); "
+                    f"choose another {option}"
+                )
             if not os.access(path, os.W_OK | os.X_OK):
                 raise OutputError(f"{self.what} {path} is not writable")
-
 
     @property
     def table_dir(self) -> Path:
@@ -103,19 +107,35 @@ class CampaignDir(outputs._Target):
         state = self.state()
         if state is not None:
             if state.get("fingerprint") != spec.fingerprint:
-                raise OutputError(f"{self.what} {self.path} holds a campaign of another spec (or of a changed "
-                                  f"scenario file); its spec is {self.path / 'spec.toml'}. Resume it with that spec, "
-                                  f"or choose another {self.option}")
+                raise OutputError(
+                    f"{self.what} {self.path} holds a campaign of another spec (or of a changed "
+                    f"scenario file); its spec is {self.path / 'spec.toml'}. Resume it with that spec, "
+                    f"or choose another {self.option}"
+                )
             self._remove_temporaries()
             return
         self.path.mkdir(exist_ok=True)
         (self.path / TABLE).mkdir(exist_ok=True)
         (self.path / RUNS).mkdir(exist_ok=True)
         write_atomic(self.path / "spec.toml", spec_text.encode())
-        write_atomic(self.path / STATE, (json.dumps({
-            "written_by": "planbench", "fingerprint": spec.fingerprint, "scenario": spec.scenario.name,
-            "mode": spec.mode, "runs": spec.size, "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-            "versions": outputs.software_versions()}, indent=1) + "\n").encode())
+        write_atomic(
+            self.path / STATE,
+            (
+                json.dumps(
+                    {
+                        "written_by": "planbench",
+                        "fingerprint": spec.fingerprint,
+                        "scenario": spec.scenario.name,
+                        "mode": spec.mode,
+                        "runs": spec.size,
+                        "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                        "versions": outputs.software_versions(),
+                    },
+                    indent=1,
+                )
+                + "\n"
+            ).encode(),
+        )
 
     def _remove_temporaries(self) -> None:
         """Half-written parts of a killed campaign (only planbench's own temporary names)."""

@@ -17,11 +17,12 @@ from __future__ import annotations
 import contextlib
 import json
 import signal
-import threading
 import tempfile
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
+
 
 @dataclass(frozen=True)
 class Context:
@@ -69,13 +70,17 @@ _cache: dict = {}
 
 def _base(context: Context):
     """(scenario, base params, base plant, made plug-ins), built once per worker and context."""
-    key = json.dumps([context.scenario, context.base_params, context.base_plant, context.plugins], sort_keys=True,
-                     default=str)
+    key = json.dumps(
+        [context.scenario, context.base_params, context.base_plant, context.plugins], sort_keys=True, default=str
+    )
     if key not in _cache:
         from planbench import plugins, scenarios
 
-        scenario = (scenarios.get(context.scenario) if context.mechanism is None
-                    else scenarios.get_of(context.mechanism, context.scenario))
+        scenario = (
+            scenarios.get(context.scenario)
+            if context.mechanism is None
+            else scenarios.get_of(context.mechanism, context.scenario)
+        )
         params = type(scenario.params).from_mapping(context.base_params)
         plant = None if context.base_plant is None else type(scenario.plant).from_mapping(context.base_plant)
         _cache.clear()
@@ -95,9 +100,14 @@ def _exception_text(e: BaseException) -> str:
 
 
 def row_of(context: Context, task: RunTask) -> dict:
-    row = {"run": task.index, "point": task.point, "sample": task.sample, "replicate": task.replicate,
-           "seed": task.seed}
-    for column, value in zip(context.axes, task.values):
+    row = {
+        "run": task.index,
+        "point": task.point,
+        "sample": task.sample,
+        "replicate": task.replicate,
+        "seed": task.seed,
+    }
+    for column, value in zip(context.axes, task.values, strict=True):
         row[column] = value if isinstance(value, (bool, int, float, str)) else json.dumps(value)
     return row
 
@@ -123,8 +133,11 @@ def run_chunk(context: Context, tasks) -> dict:
         row = row_of(context, task)
         try:
             params = type(base_params).from_mapping(task.params, base=base_params)
-            plant = base_plant if base_plant is None else type(base_plant).from_mapping(task.plant, base=base_plant,
-                                                                                       prefix="plant.")
+            plant = (
+                base_plant
+                if base_plant is None
+                else type(base_plant).from_mapping(task.plant, base=base_plant, prefix="plant.")
+            )
         except ValueError as e:
             row.update(status="invalid", passed=None, error=_exception_text(e), wall_s=0.0, sim_s=None)
             rows.append(row)
@@ -154,7 +167,7 @@ def _judge(scenario, resolved, plugin_specs, plugins, meta) -> None:
             row.update(status="error", passed=None, error=_exception_text(e), wall_s=0.0, sim_s=None)
         return
     wall = (time.perf_counter() - start) / len(resolved)
-    for (_, row, _, _), run_checks in zip(resolved, checks):
+    for (_, row, _, _), run_checks in zip(resolved, checks, strict=True):
         _checks_into(row, run_checks, meta)
         passed = all(c.passed for c in run_checks)
         row.update(status="passed" if passed else "failed", passed=passed, error=None, wall_s=wall, sim_s=None)
@@ -209,30 +222,51 @@ def _simulate(scenario, context, params, plant, plugin_specs, row, meta) -> dict
                 video = out / f"{scenario.name}.mp4" if "video" in context.save else None
             with _watchdog(limit):
                 # The run's own time is limited; writing its files (planbench's) is not.
-                _, result = pipeline.execute(scenario, params, plant, plugins=plugin_specs, out=out, video=video,
-                                             on_built=follow_duration,
-                                             on_judged=lambda _: signal.setitimer(signal.ITIMER_REAL, 0))
+                _, result = pipeline.execute(
+                    scenario,
+                    params,
+                    plant,
+                    plugins=plugin_specs,
+                    out=out,
+                    video=video,
+                    on_built=follow_duration,
+                    on_judged=lambda _: signal.setitimer(signal.ITIMER_REAL, 0),
+                )
             if out is not None:
                 # A campaign keeps a run's summary, timeseries, report and video, not its log
                 # (the per-tick state: timeseries.npz has it at the rate saved).
-                files = {p.name: p.read_bytes() for p in out.iterdir()
-                         if p.is_file() and p.name not in (outputs.MANIFEST, LOG_FILE)}
+                files = {
+                    p.name: p.read_bytes()
+                    for p in out.iterdir()
+                    if p.is_file() and p.name not in (outputs.MANIFEST, LOG_FILE)
+                }
                 summary = json.loads(files["summary.json"])
                 if summary.pop("log", None) is not None:
                     files["summary.json"] = (json.dumps(summary, indent=2) + "\n").encode()
             else:
                 files = {"summary.json": (json.dumps(outputs.summary_dict(result), indent=2) + "\n").encode()}
     except RunTimeout:
-        row.update(status="error", passed=None, error=f"timed out: the run passed its wall-time limit of "
-                   f"{limit:g} s in {board.read_phase()}", wall_s=time.perf_counter() - start, sim_s=None)
+        row.update(
+            status="error",
+            passed=None,
+            error=f"timed out: the run passed its wall-time limit of {limit:g} s in {board.read_phase()}",
+            wall_s=time.perf_counter() - start,
+            sim_s=None,
+        )
         return {}
     except (Exception, SystemExit) as e:  # noqa: BLE001  (a run that raises is a row with its error)
-        row.update(status="error", passed=None, error=_exception_text(e), wall_s=time.perf_counter() - start,
-                   sim_s=None)
+        row.update(
+            status="error", passed=None, error=_exception_text(e), wall_s=time.perf_counter() - start, sim_s=None
+        )
         return {}
     _checks_into(row, result.checks, meta)
-    row.update(status="passed" if result.passed else "failed", passed=result.passed, error=None,
-               wall_s=time.perf_counter() - start, sim_s=result.sim_time_s)
+    row.update(
+        status="passed" if result.passed else "failed",
+        passed=result.passed,
+        error=None,
+        wall_s=time.perf_counter() - start,
+        sim_s=result.sim_time_s,
+    )
     return files
 
 
@@ -266,8 +300,7 @@ def _head_arrays(context: Context, columns: dict, n: int) -> dict:
     import numpy as np
     import pyarrow as pa
 
-    out = {k: pa.array(np.asarray(columns[k], dtype=np.int64)) for k in ("run", "point", "sample", "replicate",
-                                                                         "seed")}
+    out = {k: pa.array(np.asarray(columns[k], dtype=np.int64)) for k in ("run", "point", "sample", "replicate", "seed")}
     for column in context.axes:
         values = columns[column]
         if isinstance(values, np.ndarray):
@@ -281,8 +314,13 @@ def _status_arrays(status: list, passed: list, errors: list, wall) -> dict:
     import pyarrow as pa
 
     n = len(status)
-    return {"status": pa.array(status), "passed": pa.array(passed), "error": pa.array(errors),
-            "wall_s": pa.array(wall, pa.float64()), "sim_s": pa.nulls(n)}
+    return {
+        "status": pa.array(status),
+        "passed": pa.array(passed),
+        "error": pa.array(errors),
+        "wall_s": pa.array(wall, pa.float64()),
+        "sim_s": pa.nulls(n),
+    }
 
 
 def lost_columns(context: Context, task: ColumnTask, why: str) -> dict:
@@ -290,8 +328,10 @@ def lost_columns(context: Context, task: ColumnTask, why: str) -> dict:
     import pyarrow as pa
 
     n = len(task)
-    arrays = {**_head_arrays(context, task.columns, n),
-              **_status_arrays(["error"] * n, [None] * n, [why] * n, [0.0] * n)}
+    arrays = {
+        **_head_arrays(context, task.columns, n),
+        **_status_arrays(["error"] * n, [None] * n, [why] * n, [0.0] * n),
+    }
     return {"table": pa.Table.from_pydict(arrays), "checks": {}, "files": {}}
 
 
@@ -315,7 +355,7 @@ def _overrides(base: dict, paths, values, seed: int) -> dict:
     from planbench.campaign.spec import set_path
 
     out = {"seed": seed}
-    for path, value in zip(paths, values):
+    for path, value in zip(paths, values, strict=True):
         if len(path) == 1:
             out[path[0]] = value
             continue
@@ -376,14 +416,13 @@ def run_columns(context: Context, task: ColumnTask) -> dict:
         else:
             wall[index] = (time.perf_counter() - start) / index.size
             ok = np.ones(index.size, dtype=bool)
-            for name, unit, comparison, limit, value, present, good in checks:
+            for name, unit, comparison, _limit, _value, present, good in checks:
                 ok &= ~present | good
                 meta.setdefault(name, {"unit": unit, "comparison": comparison})
             status[index] = np.where(ok, "passed", "failed")
             passed[index] = ok.tolist()
-    arrays = {**_head_arrays(context, columns, n),
-              **_status_arrays(status.tolist(), passed.tolist(), errors, wall)}
-    for name, unit, comparison, limit, value, present, good in checks:
+    arrays = {**_head_arrays(context, columns, n), **_status_arrays(status.tolist(), passed.tolist(), errors, wall)}
+    for name, _unit, _comparison, limit, value, present, good in checks:
         mask = np.ones(n, dtype=bool)
         mask[index[present]] = False
         full = np.zeros(n)

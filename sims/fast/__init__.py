@@ -26,18 +26,64 @@ speeds, s for the times, deg/h for V_dec and V_asc (eq. 15-16 print "h/s" for V_
 slope 0.751 mm/s per unit is r x 1 deg/h = 0.786 mm/s times cos 17 deg, so deg/h is meant).
 """
 
-from planbench.fast.controller import ControllerOptions, FastController, ab_gravity_torque, parked_command, winch_feedforward
+from planbench.fast.controller import (
+    ControllerOptions,
+    FastController,
+    ab_gravity_torque,
+    parked_command,
+    winch_feedforward,
+)
 from planbench.fast.loads import CableLoads, ChainCableLoads
 from planbench.fast.measurement import FusedSensors, IdealSensors, SensorOptions, make_sensors
-from planbench.fast.params import (DEC_SCAN, DEFAULT_CABLE_SEGMENTS, DEFAULT_WIND_M_S, OBSERVING_NIGHT, PER_TICK_FLOATS,
-                              RA_SCAN, SOURCES, WIND_AZIMUTH_DEG, FastParams, FastPlant, FastScanParams,
-                              FastSourceParams, FastSwitchParams, FastTrackingParams, log_bytes_per_tick)
+from planbench.fast.params import (
+    DEC_SCAN,
+    DEFAULT_CABLE_SEGMENTS,
+    DEFAULT_WIND_M_S,
+    OBSERVING_NIGHT,
+    PER_TICK_FLOATS,
+    RA_SCAN,
+    SOURCES,
+    WIND_AZIMUTH_DEG,
+    FastParams,
+    FastPlant,
+    FastScanParams,
+    FastSourceParams,
+    FastSwitchParams,
+    FastTrackingParams,
+    log_bytes_per_tick,
+)
 from planbench.fast.physics import CONTROL_DT, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, FastPhysics, max_cable_segments
-from planbench.fast.task import (CABIN_RMS_LIMIT_MM, FEED_MAX_LIMIT_MM, FEED_RMS_LIMIT_MM, LONG_RUN_S, OBSERVING_PREFIXES,
-                            OUTPUT_RATE_HZ, PARK, PLANS, SCENARIOS, TRACK_STEP_S, FastEvaluation, build, build_scenario, dec_scan_plan, environment_reward, goal_plan, observation_plan,
-                            observing_mask, output_stride, perturbed_start, plan_kinds, problem, ra_scan_plan,
-                            scan_plan, source_name, source_switch_plan, static_equilibrium, tracking_plan,
-                            write_figures)
+from planbench.fast.task import (
+    CABIN_RMS_LIMIT_MM,
+    FEED_MAX_LIMIT_MM,
+    FEED_RMS_LIMIT_MM,
+    LONG_RUN_S,
+    OBSERVING_PREFIXES,
+    OUTPUT_RATE_HZ,
+    PARK,
+    PLANS,
+    SCENARIOS,
+    TRACK_STEP_S,
+    FastEvaluation,
+    build,
+    build_scenario,
+    dec_scan_plan,
+    environment_reward,
+    goal_plan,
+    observation_plan,
+    observing_mask,
+    output_stride,
+    perturbed_start,
+    plan_kinds,
+    problem,
+    ra_scan_plan,
+    scan_plan,
+    source_name,
+    source_switch_plan,
+    static_equilibrium,
+    tracking_plan,
+    write_figures,
+)
 from planbench.scenarios import Mechanism
 
 MECHANISM = Mechanism("fast", SCENARIOS, environment_reward, plans=PLANS, benchmark_runs=2)

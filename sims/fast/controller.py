@@ -20,12 +20,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planbench.fast.physics import PHYSICS_DT, FastPhysics, index_view, unstretched_length
+from planbench.params import ParamError, Params, param
 from planbench.planners import fast
 from planbench.planners.fast import plan as fast_plan
 from planbench.planners.legs import leg_lengths, structure_matrix
 from planbench.planners.rotations import rot_y, rot_z, skew, vee
-from planbench.fast.physics import PHYSICS_DT, FastPhysics, index_view, unstretched_length
-from planbench.params import ParamError, Params, param
 
 
 @dataclass(frozen=True)
@@ -48,27 +48,59 @@ class ControllerOptions(Params):
     """
 
     stewart: bool = param(True, "the Stewart stabilizer corrects the feed (false: its legs hold nominal)")
-    stewart_bandwidth_hz: float = param(3.0, "bandwidth of the stabilizer's pose estimator", "Hz", low=0.0,
-                                        low_open=True, high=0.5 / PHYSICS_DT, high_open=True,
-                                        reason="below half the control rate (checked against the run's at the "
-                                               "start)")
-    kp: float = param(0.0, "cable-loop proportional gain on the cabin pose error", "", low=0.0,
-                      reason="a gain, not a sign change")
+    stewart_bandwidth_hz: float = param(
+        3.0,
+        "bandwidth of the stabilizer's pose estimator",
+        "Hz",
+        low=0.0,
+        low_open=True,
+        high=0.5 / PHYSICS_DT,
+        high_open=True,
+        reason="below half the control rate (checked against the run's at the start)",
+    )
+    kp: float = param(
+        0.0, "cable-loop proportional gain on the cabin pose error", "", low=0.0, reason="a gain, not a sign change"
+    )
     kd: float = param(0.0, "cable-loop derivative gain", "s", low=0.0, reason="a gain, not a sign change")
-    ki: float = param(0.02, "cable-loop integral gain (the pose correction is kp e + kd de/dt + ki int e, mapped "
-                      "to cable lengths by the Jacobian)", "1/s", low=0.0, reason="a gain, not a sign change")
-    derivative_filter_s: float = param(0.05, "time constant of the first-order filter on de/dt", "s", low=0.0,
-                                       reason="a time constant")
-    ab_integral_s: float = param(1.0, "the A-B servo's integral time (removes what the gravity feed-forward "
-                                 "leaves)", "s", low=0.0, low_open=True, reason="an integral time")
-    platform_bandwidth_hz: float = param(2.0, "with the fused measurement system: bandwidth of the stabilizer's "
-                                         "integral loop on the platform's fused pose estimate", "Hz", low=0.0,
-                                         low_open=True, high=0.5 / PHYSICS_DT, high_open=True,
-                                         reason="below half the control rate (checked against the run's at "
-                                                "the start)")
-    leg_integral_s: float = param(0.2, "the Stewart legs' integral time on their encoder error (removes the servo "
-                                  "droop under the platform's weight, 0.2-0.7 mm at kp = 2e7 N/m)", "s", low=0.0,
-                                  low_open=True, reason="an integral time")
+    ki: float = param(
+        0.02,
+        "cable-loop integral gain (the pose correction is kp e + kd de/dt + ki int e, mapped "
+        "to cable lengths by the Jacobian)",
+        "1/s",
+        low=0.0,
+        reason="a gain, not a sign change",
+    )
+    derivative_filter_s: float = param(
+        0.05, "time constant of the first-order filter on de/dt", "s", low=0.0, reason="a time constant"
+    )
+    ab_integral_s: float = param(
+        1.0,
+        "the A-B servo's integral time (removes what the gravity feed-forward leaves)",
+        "s",
+        low=0.0,
+        low_open=True,
+        reason="an integral time",
+    )
+    platform_bandwidth_hz: float = param(
+        2.0,
+        "with the fused measurement system: bandwidth of the stabilizer's "
+        "integral loop on the platform's fused pose estimate",
+        "Hz",
+        low=0.0,
+        low_open=True,
+        high=0.5 / PHYSICS_DT,
+        high_open=True,
+        reason="below half the control rate (checked against the run's at the start)",
+    )
+    leg_integral_s: float = param(
+        0.2,
+        "the Stewart legs' integral time on their encoder error (removes the servo "
+        "droop under the platform's weight, 0.2-0.7 mm at kp = 2e7 N/m)",
+        "s",
+        low=0.0,
+        low_open=True,
+        reason="an integral time",
+    )
 
 
 def ab_gravity_torque(state, geometry: fast.FastGeometry = fast.FAST) -> np.ndarray:
@@ -100,7 +132,7 @@ def winch_feedforward(state, tower_tops: np.ndarray, geometry: fast.FastGeometry
     return unstretched_length(state.cable_length, state.tension, span)
 
 
-def parked_command(physics: "FastPhysics", state) -> np.ndarray:
+def parked_command(physics: FastPhysics, state) -> np.ndarray:
     """(nu,) the actuator commands that hold the feed support at rest at the first row of
     ``state`` (a FastPlanSample): the winches' lengths (``winch_feedforward``), the A-B
     set-points less their gravity droop, the legs still, the multi-beam angle. The task's
@@ -155,12 +187,13 @@ class FastController:
 
     def reset(self, context) -> None:
         o = self.options
-        g = fast.FAST
         control_dt = context.control_dt
         for name in ("stewart_bandwidth_hz", "platform_bandwidth_hz"):
             if getattr(o, name) >= 0.5 / control_dt:
-                raise ParamError(f"ControllerOptions.{name} = {getattr(o, name):g} Hz is not below half the "
-                                 f"control rate, {0.5 / control_dt:g} Hz")
+                raise ParamError(
+                    f"ControllerOptions.{name} = {getattr(o, name):g} Hz is not below half the "
+                    f"control rate, {0.5 / control_dt:g} Hz"
+                )
         nominal = context.nominal_physics()
         self.reference = context.reference
         self.tower_tops = nominal.tower_tops
@@ -202,7 +235,11 @@ class FastController:
             self._setup_fused(specs, control_dt)
         self.command = command = context.command
         # The tick's writes through views where the actuators are runs (FastPhysics' are).
-        self._cables, self._ab, self._legs = index_view(self.cable_ids), index_view(self.ab_ids), index_view(self.leg_ids)
+        self._cables, self._ab, self._legs = (
+            index_view(self.cable_ids),
+            index_view(self.ab_ids),
+            index_view(self.leg_ids),
+        )
         self._last_row = self.reference.t.shape[0] - 1
         self._count_key = "cabin_rtk_count" if fused else "cabin_pose_ts_count"
         self._load_plan(0)
@@ -219,8 +256,9 @@ class FastController:
         servo set-points (less the gravity droop), the legs' planned lengths (fused path)."""
         g = fast.FAST
         state = fast_plan.reference_state(self.reference.rows(start, stop))
-        r_platform = np.einsum("nij,njk->nik", state.cabin_rotation,
-                               fast.ab_rotation(state.theta_a, state.theta_b, g.alpha))
+        r_platform = np.einsum(
+            "nij,njk->nik", state.cabin_rotation, fast.ab_rotation(state.theta_a, state.theta_b, g.alpha)
+        )
         p_platform = state.feed - np.einsum("nij,j->ni", r_platform, g.r_s_feed)
         ab_reference = np.column_stack([state.theta_a, state.theta_b])
         legs_plan = None
@@ -229,10 +267,20 @@ class FastController:
             p_base = state.cabin_origin + np.einsum("nij,j->ni", state.cabin_rotation, g.ab_center)
             position = np.einsum("nji,nj->ni", r_base, p_platform - p_base)
             rotation = np.einsum("nji,njk->nik", r_base, r_platform)
-            legs_plan = leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
-                                    rotation) - self.nominal_legs
-        return PlanRows(start, state, winch_feedforward(state, self.tower_tops), r_platform, p_platform,
-                        ab_reference, ab_reference - ab_gravity_torque(state) / self._kp_ab, legs_plan)
+            legs_plan = (
+                leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position, rotation)
+                - self.nominal_legs
+            )
+        return PlanRows(
+            start,
+            state,
+            winch_feedforward(state, self.tower_tops),
+            r_platform,
+            p_platform,
+            ab_reference,
+            ab_reference - ab_gravity_torque(state) / self._kp_ab,
+            legs_plan,
+        )
 
     def _load_plan(self, tick: int) -> None:
         """Hold the plan's rows from PLAN_HISTORY_TICKS before ``tick`` to PLAN_BLOCK_TICKS
@@ -275,11 +323,13 @@ class FastController:
 
     def _setup_fused(self, specs, control_dt: float) -> None:
         """The fused path's gains (its plan, the legs' planned lengths: ``_plan_rows``): the
-        legs' Jacobian at the nominal pose, dl = J dx for a platform motion dx = (dp, dtheta) in the base frame (J = -A^T,
-        A the structure matrix, planbench.planners.legs), and the integral gain 2 pi f dt."""
+        legs' Jacobian at the nominal pose, dl = J dx for a platform motion dx = (dp, dtheta) in
+        the base frame (J = -A^T, A the structure matrix, planbench.planners.legs), and the
+        integral gain 2 pi f dt."""
         g = fast.FAST
-        self.platform_jacobian = -structure_matrix(fast.STEWART.base_anchors, fast.STEWART.platform_anchors,
-                                                   g.r_ab_s, np.eye(3)).T
+        self.platform_jacobian = -structure_matrix(
+            fast.STEWART.base_anchors, fast.STEWART.platform_anchors, g.r_ab_s, np.eye(3)
+        ).T
         self._platform_gain = 2 * math.pi * self.options.platform_bandwidth_hz * control_dt
         self.platform_correction = np.zeros(6)
         self.cabin_fix_dt = max(1, int(round(1.0 / (specs["cabin_rtk"].rate_hz * control_dt)))) * control_dt
@@ -289,8 +339,7 @@ class FastController:
         estimate, at each GPS/RTK fix's arrival: the estimate of the present tick."""
         s, row = self.state, tick - self.plan_start
         pos, rot = obs["cabin_estimate_position"], obs["cabin_estimate_rotation"]
-        self._pid(np.concatenate([s.cabin_origin[row] - pos, vee(s.cabin_rotation[row] @ rot.T)]),
-                  self.cabin_fix_dt)
+        self._pid(np.concatenate([s.cabin_origin[row] - pos, vee(s.cabin_rotation[row] @ rot.T)]), self.cabin_fix_dt)
 
     def _fused_stewart_legs(self, obs, nxt: int) -> np.ndarray:
         """Leg length changes (6,): the planned ones plus an integral of the platform's error
@@ -301,8 +350,10 @@ class FastController:
         error = np.concatenate([r_base.T @ (self.p_platform[nxt] - pos), r_base.T @ vee(self.r_platform[nxt] @ rot.T)])
         stroke = fast.STEWART.stroke
         # np.minimum / np.maximum: np.clip's values at a fifth of its call cost
-        self.platform_correction = np.minimum(np.maximum(self.platform_correction + self._platform_gain *
-                                                         (self.platform_jacobian @ error), -stroke), stroke)
+        self.platform_correction = np.minimum(
+            np.maximum(self.platform_correction + self._platform_gain * (self.platform_jacobian @ error), -stroke),
+            stroke,
+        )
         return self.legs_plan[nxt] + self.platform_correction
 
     def _fused_legs(self, obs, nxt: int) -> None:
@@ -312,8 +363,11 @@ class FastController:
         if self.options.stewart:
             setpoint = self._fused_stewart_legs(obs, nxt)
         else:
-            self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (-obs["leg_positions"]),
-                                        -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
+            self.leg_integral = np.clip(
+                self.leg_integral + self._leg_gain * (-obs["leg_positions"]),
+                -0.05 * fast.STEWART.stroke,
+                0.05 * fast.STEWART.stroke,
+            )
             setpoint = self.leg_integral
         self.command[self._legs] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
 
@@ -333,8 +387,9 @@ class FastController:
                 self._cable_feedback(obs)
             # Cable lengths for the pose correction dx: dL = -A^T dx (planbench.planners.legs), at the
             # planned pose (it moves by millimetres between two updates).
-            a = structure_matrix(fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[row],
-                                 s.cabin_rotation[row])
+            a = structure_matrix(
+                fast.FAST.tower_anchors, fast.FAST.cabin_anchors, s.cabin_origin[row], s.cabin_rotation[row]
+            )
             self.length_correction = -a.T @ self.correction
         command[self._cables] = self.l0_ff[nxt] + self.length_correction
         # A-B rotator: position servo with integral action on the encoder error.
@@ -346,8 +401,11 @@ class FastController:
         legs = self._stewart_legs(obs, nxt) if self.options.stewart else self._leg_target
         # Leg servos: integral action on the encoders toward the last commanded lengths,
         # bounded by 5 % of the stroke (anti-windup); off, the legs hold nominal the same way.
-        self.leg_integral = np.clip(self.leg_integral + self._leg_gain * (self._leg_target - obs["leg_positions"]),
-                                    -0.05 * fast.STEWART.stroke, 0.05 * fast.STEWART.stroke)
+        self.leg_integral = np.clip(
+            self.leg_integral + self._leg_gain * (self._leg_target - obs["leg_positions"]),
+            -0.05 * fast.STEWART.stroke,
+            0.05 * fast.STEWART.stroke,
+        )
         self._leg_target = legs
         setpoint = legs + self.leg_integral
         command[self._legs] = (setpoint - obs["leg_setpoints"]) / self.dt  # ramp over the tick
@@ -374,5 +432,9 @@ class FastController:
         # The platform's planned pose in the measured base (AB) frame, and its leg lengths;
         # beyond the stroke the actuators' ctrlrange clamps (the log keeps the demand).
         position = r_base.T @ (self.p_platform[nxt] - p_base)
-        return leg_lengths(fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position,
-                           r_base.T @ self.r_platform[nxt]) - self.nominal_legs
+        return (
+            leg_lengths(
+                fast.STEWART.base_anchors, fast.STEWART.platform_anchors, position, r_base.T @ self.r_platform[nxt]
+            )
+            - self.nominal_legs
+        )

@@ -16,16 +16,32 @@ import math
 import mujoco
 import numpy as np
 
+from planbench.fast.physics import (
+    CABIN_CENTRE,
+    CABIN_DIAMETER,
+    CABIN_DRAG_COEFFICIENT,
+    CABIN_HEIGHT,
+    CABLE_DAMPING_S,
+    CABLE_EA,
+    CONTROL_DT,
+    NODE_DAMPING_RATIO,
+    SEGMENT_OMEGA_DT_LIMIT,
+    STRING_MODE_HZ,
+    FastPhysics,
+    cable_drag_force,
+    catenary_tension,
+    chord_factor,
+    end_fraction,
+    index_view,
+    max_cable_segments,
+    moment_sum,
+    node_mass_factor,
+    tangent_stiffness,
+)
+from planbench.logfile import temporary_writer
 from planbench.planners import fast
 from planbench.planners.errors import LimitError
-from planbench.fast.physics import (CABIN_CENTRE, CABIN_DIAMETER, CABIN_DRAG_COEFFICIENT, CABIN_HEIGHT, CABLE_DAMPING_S,
-                               CABLE_EA, CONTROL_DT, NODE_DAMPING_RATIO, SEGMENT_OMEGA_DT_LIMIT, STRING_MODE_HZ, FastPhysics,
-                               cable_drag_force, catenary_tension, chord_factor, end_fraction, index_view,
-                               max_cable_segments,
-                               moment_sum, node_mass_factor, tangent_stiffness)
-from planbench.logfile import temporary_writer
 from planbench.wind import AIR_DENSITY, check_mean_speed, horizontal_direction, wind_speed_series
-
 
 #: The winches' rope speed and acceleration limits, m/s and m/s^2 (models/fast/README.md "Winches
 #: as built"): 25 % above the paper's source-switching speed of the cabin (0.4 m/s, which no
@@ -86,10 +102,10 @@ class Winches:
         dt, dv, max_speed = self.dt, self._dv, self.max_speed
         wanted = command.tolist()
         length, last, old = self._length, self._last_command, self._rate
-        rate = [(c - x) / dt for c, x in zip(wanted, length)]
+        rate = [(c - x) / dt for c, x in zip(wanted, length, strict=True)]
         self._last_command = wanted
-        if all(-max_speed <= r <= max_speed for r in rate) and \
-                all(-dv <= r - q <= dv for r, q in zip(rate, old)):
+        within = all(-max_speed <= r <= max_speed for r in rate)
+        if within and all(-dv <= r - q <= dv for r, q in zip(rate, old, strict=True)):
             self._length = wanted  # within the limits: the command, to the bit
             self._rate = rate
             return
@@ -98,7 +114,7 @@ class Winches:
         # a dt^2 (n + 1) (n / 2 + f) = |e|, n whole, 0 <= f < 1.
         step = dv * dt
         new_rate = []
-        for c, x, p, q in zip(wanted, length, last, old):
+        for c, x, p, q in zip(wanted, length, last, old, strict=True):
             error = c - x
             size = abs(error)
             ticks = size / step
@@ -116,7 +132,7 @@ class Winches:
             low, high = q - dv, q + dv
             r = low if low > r else r
             new_rate.append(high if high < r else r)
-        self._length = length = [x + r * dt for x, r in zip(length, new_rate)]
+        self._length = length = [x + r * dt for x, r in zip(length, new_rate, strict=True)]
         self._rate = new_rate
         command[:] = length
 
@@ -160,9 +176,17 @@ class CableLoads:
         ideal winches, whose ropes are the command.
     """
 
-    def __init__(self, wind_speed: float = 0.0, wind_azimuth_deg: float = 0.0, spectrum: str = "kaimal",
-                 turbulence_intensity: float | None = None, measured=None, ea: float = CABLE_EA,
-                 mass_per_length: float = fast.FAST.cable_mass_per_length, winches: Winches | None = None):
+    def __init__(
+        self,
+        wind_speed: float = 0.0,
+        wind_azimuth_deg: float = 0.0,
+        spectrum: str = "kaimal",
+        turbulence_intensity: float | None = None,
+        measured=None,
+        ea: float = CABLE_EA,
+        mass_per_length: float = fast.FAST.cable_mass_per_length,
+        winches: Winches | None = None,
+    ):
         self.winches = winches
         self.ea = float(ea)
         self.mass_per_length = float(mass_per_length)
@@ -181,8 +205,9 @@ class CableLoads:
 
     def reset(self, physics: FastPhysics, times: np.ndarray, rng: np.random.Generator) -> None:
         if self.measured is None:
-            self.speed = wind_speed_series(times, self.mean_speed, rng, self.spectrum,
-                                           turbulence_intensity=self.turbulence_intensity)
+            self.speed = wind_speed_series(
+                times, self.mean_speed, rng, self.spectrum, turbulence_intensity=self.turbulence_intensity
+            )
         else:
             self.speed, self._directions = self.measured.resample(times)
             if self._directions is not None:
@@ -203,8 +228,9 @@ class CableLoads:
             self.winches.reset(data.ctrl[self._cables], times[1] - times[0] if times.size > 1 else CONTROL_DT)
         mujoco.mj_forward(model, data)
         chord, span, _ = self._geometry()
-        self.tension = catenary_tension(chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60,
-                                        ea=self.ea, weight=self.weight)
+        self.tension = catenary_tension(
+            chord, data.ctrl[self._cables], span, np.full(6, 150e3), iterations=60, ea=self.ea, weight=self.weight
+        )
         self.apply(physics)
 
     def log(self, rows: int):
@@ -261,8 +287,9 @@ class CableLoads:
         r0, r1, r2, r3, r4, r5, r6, r7, r8 = data.xmat[cabin].tolist()
         dx, dy, dz = self.direction.tolist()
         cos_t = min(abs(r2 * dx + r5 * dy + r8 * dz), 1.0)  # the cabin's axis along the wind
-        area = CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + \
-            math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
+        area = (
+            CABIN_DIAMETER * CABIN_HEIGHT * math.sqrt(1.0 - cos_t * cos_t) + math.pi * CABIN_DIAMETER**2 / 4.0 * cos_t
+        )
         size = 0.5 * AIR_DENSITY * CABIN_DRAG_COEFFICIENT * area * abs(u) * u
         fx, fy, fz = size * dx, size * dy, size * dz
         # The shell's centre R c + x less the centre of mass, in floats (c = CABIN_CENTRE).
@@ -313,10 +340,12 @@ class ChainCableLoads(CableLoads):
         most = max_cable_segments(float(rest.min()) * n, float(model.opt.timestep), self.ea, self.mass_per_length)
         if n > most:
             omega = 2.0 * math.sqrt(self.ea / self.mass_per_length) / rest.min()
-            raise LimitError(f"cable segments {n}: the shortest segment ({rest.min():.1f} m) vibrates at "
-                             f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
-                             f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most "
-                             f"{most} segments")
+            raise LimitError(
+                f"cable segments {n}: the shortest segment ({rest.min():.1f} m) vibrates at "
+                f"{omega / (2 * math.pi):.0f} Hz, beyond the {1e3 * model.opt.timestep:g} ms "
+                f"timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}; use at most "
+                f"{most} segments"
+            )
         self._anchor_masses = np.array([model.body(f"anchor_mass{i + 1}").id for i in range(3)])
         self._node_dofs = model.body_dofadr[self._nodes][..., None] + np.arange(3)  # (6, n - 1, 3)
         self.settling_damping = np.zeros(self._node_dofs.shape)  # N s/m on the nodes (static_equilibrium's)
@@ -329,8 +358,8 @@ class ChainCableLoads(CableLoads):
         tendons = self._segments.ravel()
         first, count = int(tendons[0]), tendons.size
         if np.array_equal(tendons, np.arange(first, first + count)):
-            self._first_lengths = data.ten_length[first:first + count:n]
-            self._passive_rest = model.tendon_lengthspring[first:first + count].reshape(6, n, 2)[:, 1:]
+            self._first_lengths = data.ten_length[first : first + count : n]
+            self._passive_rest = model.tendon_lengthspring[first : first + count].reshape(6, n, 2)[:, 1:]
         else:
             self._first_lengths = self._passive_rest = None
         nodes = index_view(self._node_ids)
@@ -344,10 +373,14 @@ class ChainCableLoads(CableLoads):
         ropes, passive = index_view(physics.cable_ids), _run_view(np.arange(model.ntendon), self._segments)
         if isinstance(ropes, slice) and ropes.step == 1 and passive is not None:
             segments = slice(int(self._segments[0, 0]), int(self._segments[-1, -1]) + 1)
-            self._law_views = (model.actuator_gainprm[ropes, 0], model.actuator_biasprm[ropes, 0],
-                               model.actuator_biasprm[ropes, 1], model.actuator_biasprm[ropes, 2],
-                               model.tendon_stiffness[segments].reshape(6, n)[:, 1:],
-                               model.tendon_damping[segments].reshape(6, n)[:, 1:])
+            self._law_views = (
+                model.actuator_gainprm[ropes, 0],
+                model.actuator_biasprm[ropes, 0],
+                model.actuator_biasprm[ropes, 1],
+                model.actuator_biasprm[ropes, 2],
+                model.tendon_stiffness[segments].reshape(6, n)[:, 1:],
+                model.tendon_damping[segments].reshape(6, n)[:, 1:],
+            )
         self._node_mass_factor = node_mass_factor(n) * self.mass_per_length
         self._node_damping_factor = 2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ
         self._end_mass_factor = end_fraction(n, load=False) * self.mass_per_length
@@ -368,8 +401,11 @@ class ChainCableLoads(CableLoads):
         mass = self._node_mass_factor * rest  # (6,): node_mass_factor(n) mu l
         damping = (self._node_damping_factor * mass)[:, None, None] + self.settling_damping  # 2 zeta omega m
         ends = self._end_mass_factor * rest * n  # end_fraction(n, load=False) mu L0
-        if self._node_mass_view is not None and self._node_damping_view is not None and \
-                self._anchor_mass_view is not None:
+        if (
+            self._node_mass_view is not None
+            and self._node_damping_view is not None
+            and self._anchor_mass_view is not None
+        ):
             self._node_mass_view[...] = mass[:, None]
             self._node_damping_view[...] = damping
             self._anchor_mass_view[...] = ends[0::2] + ends[1::2]

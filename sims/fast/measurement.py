@@ -40,11 +40,12 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from planbench.planners.rotations import skew, vee
-from planbench.fast.physics import CONTROL_DT, PHYSICS_DT, index_view, moment_sum
+from planbench.fast.physics import CONTROL_DT, PHYSICS_DT, FastPhysics, index_view, moment_sum
 from planbench.logfile import temporary_writer
 from planbench.params import ParamError, Params, param
+from planbench.planners.rotations import skew
 from planbench.task import Sensors, SensorSpec
+
 
 @dataclass(frozen=True)
 class SensorOptions(Params):
@@ -56,75 +57,221 @@ class SensorOptions(Params):
     cabin-pose measurements (``IdealSensors``: ``pose_*`` and ``stewart_*``), kept to compare.
     """
 
-    system: str = param("fused", "the measurement system: fused (IMUs, total stations and GPS/RTK through Kalman "
-                        "filters, FAST's published errors) or ideal (the idealized cabin-pose measurements pose_* "
-                        "and stewart_*)", choices=("fused", "ideal"))
-    imu_gyro_noise: float = param(4.4e-5, "the SINS gyros' angle random walk, per axis (0.15 deg/sqrt(h), a "
-                                  "tactical-grade fibre-optic gyro; FAST's own is not public: assumed, with the "
-                                  "fix errors below, so that the fused attitudes are the published ones)",
-                                  "rad/sqrt(s)", low=0.0, high=1e-3, reason="up to a consumer MEMS gyro's")
-    imu_gyro_bias: float = param(4.85e-6, "their turn-on bias, 1 sigma per axis (1 deg/h; assumed as above)",
-                                 "rad/s", low=0.0, high=1e-3, reason="up to a consumer MEMS gyro's")
-    imu_gyro_bias_walk: float = param(1e-6, "their bias random walk (assumed)", "rad/s/sqrt(s)", low=0.0, high=1e-5,
-                                      reason="an assumed bound")
-    imu_accel_noise: float = param(1e-3, "the SINS accelerometers' white noise density, per axis (100 ug/sqrt(Hz), "
-                                   "tactical grade; assumed)", "m/s^2/sqrt(Hz)", low=0.0, high=0.1,
-                                   reason="up to a consumer MEMS accelerometer's")
-    imu_accel_bias: float = param(1e-2, "their turn-on bias, 1 sigma per axis (1 mg; assumed)", "m/s^2", low=0.0,
-                                  high=0.5, reason="up to a consumer MEMS accelerometer's")
-    imu_accel_bias_walk: float = param(1e-3, "their bias random walk (assumed: large enough that gravity does not pin "
-                                       "the tilt, as FAST's 'the inertial part alone diverges')", "m/s^2/sqrt(s)",
-                                       low=0.0, high=1e-2,
-                                       reason="an assumed bound")
-    ts_rate_hz: float = param(8.0, "the total stations' fixes of the feed platform's three prisms", "Hz", low=0.1,
-                              high=1.0 / PHYSICS_DT, reason="a fix at least every 10 s, at most one per control "
-                              "tick (checked against control_rate_hz; about 8 Hz at 500 m: REFERENCE.md)")
-    ts_latency_s: float = param(0.2, "their latency (150-240 ms measured: REFERENCE.md)", "s", low=0.0, high=1.0,
-                                reason="the filter keeps a second of its past for late fixes")
-    ts_noise_m: float = param(1e-3, "their white noise per prism and coordinate, 1 sigma (about 2 mm uncertainty "
-                              "at 150-300 m: SPIE 6280)", "m", low=0.0, high=0.1, reason="an assumed bound")
-    ts_common_m: float = param(0.8e-3, "their slowly varying error common to the three prisms (refraction, the "
-                               "stations' orientation), 1 sigma per coordinate (set so that the fused platform "
-                               "error is the published 2.99 mm)", "m", low=0.0, high=0.1, reason="an assumed bound")
-    ts_point_m: float = param(2.2e-3, "their slowly varying error of each prism alone, 1 sigma per coordinate "
-                              "(set, with the SINS above, so that the fused platform attitude is the published "
-                              "0.093 deg)", "m", low=0.0, high=0.1, reason="an assumed bound")
-    ts_drift_time_s: float = param(15.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
-                                   "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
-    rtk_rate_hz: float = param(10.0, "GPS/RTK fixes of the cabin's three roof antennas (a common RTK output rate; "
-                               "assumed)", "Hz", low=0.1, high=1.0 / PHYSICS_DT,
-                               reason="a fix at least every 10 s, at most one per control tick (checked against "
-                                      "control_rate_hz)")
-    rtk_latency_s: float = param(0.05, "their latency (assumed)", "s", low=0.0, high=1.0,
-                                 reason="the filter keeps a second of its past for late fixes")
-    rtk_noise_m: float = param(5e-3, "their white noise per antenna and coordinate, 1 sigma (assumed)", "m",
-                               low=0.0, high=0.5, reason="an assumed bound")
-    rtk_common_m: float = param(6.5e-3, "their slowly varying error common to the three antennas (base station, "
-                                "atmosphere), 1 sigma per coordinate (set so that the fused cabin error is the "
-                                "published 14.56 mm)", "m", low=0.0, high=0.5, reason="an assumed bound")
-    rtk_point_m: float = param(8.5e-3, "their slowly varying error of each antenna alone (multipath), 1 sigma per "
-                               "coordinate (set, with the SINS above, so that the fused cabin attitude is the "
-                               "published 0.095 deg)", "m", low=0.0, high=0.5, reason="an assumed bound")
-    rtk_drift_time_s: float = param(15.0, "the correlation time of those slow errors (first-order Gauss-Markov; "
-                                    "assumed)", "s", low=0.01, high=3600.0, reason="10 ms to an hour")
+    system: str = param(
+        "fused",
+        "the measurement system: fused (IMUs, total stations and GPS/RTK through Kalman "
+        "filters, FAST's published errors) or ideal (the idealized cabin-pose measurements pose_* "
+        "and stewart_*)",
+        choices=("fused", "ideal"),
+    )
+    imu_gyro_noise: float = param(
+        4.4e-5,
+        "the SINS gyros' angle random walk, per axis (0.15 deg/sqrt(h), a "
+        "tactical-grade fibre-optic gyro; FAST's own is not public: assumed, with the "
+        "fix errors below, so that the fused attitudes are the published ones)",
+        "rad/sqrt(s)",
+        low=0.0,
+        high=1e-3,
+        reason="up to a consumer MEMS gyro's",
+    )
+    imu_gyro_bias: float = param(
+        4.85e-6,
+        "their turn-on bias, 1 sigma per axis (1 deg/h; assumed as above)",
+        "rad/s",
+        low=0.0,
+        high=1e-3,
+        reason="up to a consumer MEMS gyro's",
+    )
+    imu_gyro_bias_walk: float = param(
+        1e-6, "their bias random walk (assumed)", "rad/s/sqrt(s)", low=0.0, high=1e-5, reason="an assumed bound"
+    )
+    imu_accel_noise: float = param(
+        1e-3,
+        "the SINS accelerometers' white noise density, per axis (100 ug/sqrt(Hz), tactical grade; assumed)",
+        "m/s^2/sqrt(Hz)",
+        low=0.0,
+        high=0.1,
+        reason="up to a consumer MEMS accelerometer's",
+    )
+    imu_accel_bias: float = param(
+        1e-2,
+        "their turn-on bias, 1 sigma per axis (1 mg; assumed)",
+        "m/s^2",
+        low=0.0,
+        high=0.5,
+        reason="up to a consumer MEMS accelerometer's",
+    )
+    imu_accel_bias_walk: float = param(
+        1e-3,
+        "their bias random walk (assumed: large enough that gravity does not pin "
+        "the tilt, as FAST's 'the inertial part alone diverges')",
+        "m/s^2/sqrt(s)",
+        low=0.0,
+        high=1e-2,
+        reason="an assumed bound",
+    )
+    ts_rate_hz: float = param(
+        8.0,
+        "the total stations' fixes of the feed platform's three prisms",
+        "Hz",
+        low=0.1,
+        high=1.0 / PHYSICS_DT,
+        reason="a fix at least every 10 s, at most one per control "
+        "tick (checked against control_rate_hz; about 8 Hz at 500 m: REFERENCE.md)",
+    )
+    ts_latency_s: float = param(
+        0.2,
+        "their latency (150-240 ms measured: REFERENCE.md)",
+        "s",
+        low=0.0,
+        high=1.0,
+        reason="the filter keeps a second of its past for late fixes",
+    )
+    ts_noise_m: float = param(
+        1e-3,
+        "their white noise per prism and coordinate, 1 sigma (about 2 mm uncertainty at 150-300 m: SPIE 6280)",
+        "m",
+        low=0.0,
+        high=0.1,
+        reason="an assumed bound",
+    )
+    ts_common_m: float = param(
+        0.8e-3,
+        "their slowly varying error common to the three prisms (refraction, the "
+        "stations' orientation), 1 sigma per coordinate (set so that the fused platform "
+        "error is the published 2.99 mm)",
+        "m",
+        low=0.0,
+        high=0.1,
+        reason="an assumed bound",
+    )
+    ts_point_m: float = param(
+        2.2e-3,
+        "their slowly varying error of each prism alone, 1 sigma per coordinate "
+        "(set, with the SINS above, so that the fused platform attitude is the published "
+        "0.093 deg)",
+        "m",
+        low=0.0,
+        high=0.1,
+        reason="an assumed bound",
+    )
+    ts_drift_time_s: float = param(
+        15.0,
+        "the correlation time of those slow errors (first-order Gauss-Markov; assumed)",
+        "s",
+        low=0.01,
+        high=3600.0,
+        reason="10 ms to an hour",
+    )
+    rtk_rate_hz: float = param(
+        10.0,
+        "GPS/RTK fixes of the cabin's three roof antennas (a common RTK output rate; assumed)",
+        "Hz",
+        low=0.1,
+        high=1.0 / PHYSICS_DT,
+        reason="a fix at least every 10 s, at most one per control tick (checked against control_rate_hz)",
+    )
+    rtk_latency_s: float = param(
+        0.05,
+        "their latency (assumed)",
+        "s",
+        low=0.0,
+        high=1.0,
+        reason="the filter keeps a second of its past for late fixes",
+    )
+    rtk_noise_m: float = param(
+        5e-3,
+        "their white noise per antenna and coordinate, 1 sigma (assumed)",
+        "m",
+        low=0.0,
+        high=0.5,
+        reason="an assumed bound",
+    )
+    rtk_common_m: float = param(
+        6.5e-3,
+        "their slowly varying error common to the three antennas (base station, "
+        "atmosphere), 1 sigma per coordinate (set so that the fused cabin error is the "
+        "published 14.56 mm)",
+        "m",
+        low=0.0,
+        high=0.5,
+        reason="an assumed bound",
+    )
+    rtk_point_m: float = param(
+        8.5e-3,
+        "their slowly varying error of each antenna alone (multipath), 1 sigma per "
+        "coordinate (set, with the SINS above, so that the fused cabin attitude is the "
+        "published 0.095 deg)",
+        "m",
+        low=0.0,
+        high=0.5,
+        reason="an assumed bound",
+    )
+    rtk_drift_time_s: float = param(
+        15.0,
+        "the correlation time of those slow errors (first-order Gauss-Markov; assumed)",
+        "s",
+        low=0.01,
+        high=3600.0,
+        reason="10 ms to an hour",
+    )
 
-    pose_rate_hz: float = param(10.0, "ideal system: rate of the cable loop's cabin pose fixes (total stations; "
-                                "10 Hz assumed)", "Hz", low=0.1, high=1.0 / PHYSICS_DT,
-                                reason="a fix at least every 10 s (assumed), at most one per control tick (checked "
-                                       "against control_rate_hz)")
-    pose_latency_s: float = param(0.15, "their latency (150 ms, the low end measured)", "s", low=0.0, high=10.0,
-                                  reason="total stations lag 150-240 ms (REFERENCE.md); 10 s is an assumed bound")
-    pose_noise_m: float = param(1e-3, "their white position noise per axis, 1 sigma (assumed: a total station's "
-                                "class at 150-300 m)", "m", low=0.0, high=1.0, reason="an assumed bound")
-    pose_noise_rad: float = param(20e-6, "their white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
-                                  high=0.1, reason="an assumed bound")
-    stewart_latency_s: float = param(0.01, "ideal system: latency of the 100 Hz pose measurement the stabilizer corrects with "
-                                     "(assumed: IMU-aided)", "s", low=0.0, high=10.0, reason="an assumed bound")
-    stewart_noise_m: float = param(0.5e-3, "its white position noise per axis, 1 sigma (assumed)", "m", low=0.0,
-                                   high=1.0, reason="an assumed bound")
-    stewart_noise_rad: float = param(10e-6, "its white attitude noise per axis, 1 sigma (assumed)", "rad", low=0.0,
-                                     high=0.1, reason="an assumed bound")
-
+    pose_rate_hz: float = param(
+        10.0,
+        "ideal system: rate of the cable loop's cabin pose fixes (total stations; 10 Hz assumed)",
+        "Hz",
+        low=0.1,
+        high=1.0 / PHYSICS_DT,
+        reason="a fix at least every 10 s (assumed), at most one per control tick (checked against control_rate_hz)",
+    )
+    pose_latency_s: float = param(
+        0.15,
+        "their latency (150 ms, the low end measured)",
+        "s",
+        low=0.0,
+        high=10.0,
+        reason="total stations lag 150-240 ms (REFERENCE.md); 10 s is an assumed bound",
+    )
+    pose_noise_m: float = param(
+        1e-3,
+        "their white position noise per axis, 1 sigma (assumed: a total station's class at 150-300 m)",
+        "m",
+        low=0.0,
+        high=1.0,
+        reason="an assumed bound",
+    )
+    pose_noise_rad: float = param(
+        20e-6,
+        "their white attitude noise per axis, 1 sigma (assumed)",
+        "rad",
+        low=0.0,
+        high=0.1,
+        reason="an assumed bound",
+    )
+    stewart_latency_s: float = param(
+        0.01,
+        "ideal system: latency of the 100 Hz pose measurement the stabilizer corrects with (assumed: IMU-aided)",
+        "s",
+        low=0.0,
+        high=10.0,
+        reason="an assumed bound",
+    )
+    stewart_noise_m: float = param(
+        0.5e-3,
+        "its white position noise per axis, 1 sigma (assumed)",
+        "m",
+        low=0.0,
+        high=1.0,
+        reason="an assumed bound",
+    )
+    stewart_noise_rad: float = param(
+        10e-6,
+        "its white attitude noise per axis, 1 sigma (assumed)",
+        "rad",
+        low=0.0,
+        high=0.1,
+        reason="an assumed bound",
+    )
 
     def check_rates(self, control_rate_hz: float) -> None:
         """A ParamError naming the first fix rate of this system above the control rate (a
@@ -132,15 +279,19 @@ class SensorOptions(Params):
         names = ("rtk_rate_hz", "ts_rate_hz") if self.system == "fused" else ("pose_rate_hz",)
         for name in names:
             if getattr(self, name) > control_rate_hz * (1.0 + 1e-9):
-                raise ParamError(f"sensors.{name} = {getattr(self, name):g} Hz is above the control rate "
-                                 f"control_rate_hz = {control_rate_hz:g} Hz: at most one fix per tick")
+                raise ParamError(
+                    f"sensors.{name} = {getattr(self, name):g} Hz is above the control rate "
+                    f"control_rate_hz = {control_rate_hz:g} Hz: at most one fix per tick"
+                )
 
 
 def encoder_specs(rate_hz: float) -> list[SensorSpec]:
     """The encoders both measurement systems read every tick, exactly."""
-    return [SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate_hz),
-            SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate_hz),
-            SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate_hz)]
+    return [
+        SensorSpec("ab_angles", "A-B rotator encoders (and the rotation they give)", "rad", rate_hz),
+        SensorSpec("leg_positions", "Stewart leg encoders (length change from nominal)", "m", rate_hz),
+        SensorSpec("leg_setpoints", "Stewart leg drives' set-points", "m", rate_hz),
+    ]
 
 
 class Encoders:
@@ -153,8 +304,11 @@ class Encoders:
     def __init__(self, physics, obs: dict):
         data = self._data = physics.data.ptr
         reads = []
-        for key, buffer, ids in (("ab_angles", "qpos", physics.ab_qpos), ("leg_positions", "qpos", physics.leg_qpos),
-                                 ("leg_setpoints", "act", physics.leg_act)):
+        for key, buffer, ids in (
+            ("ab_angles", "qpos", physics.ab_qpos),
+            ("leg_positions", "qpos", physics.leg_qpos),
+            ("leg_setpoints", "act", physics.leg_act),
+        ):
             index = index_view(ids)
             if isinstance(index, slice):
                 view = getattr(data, buffer)[index]
@@ -164,8 +318,11 @@ class Encoders:
                 reads.append((obs[key], buffer, index))
         self._reads = tuple(reads)
         # The B frame in the cabin frame, R_cabin^T R_B, from views of the live rotations.
-        self._ab_rotation_of = (data.xmat[physics.cabin_body].reshape(3, 3).T, data.xmat[physics.ab_b_body].reshape(3, 3),
-                                obs["ab_rotation"])
+        self._ab_rotation_of = (
+            data.xmat[physics.cabin_body].reshape(3, 3).T,
+            data.xmat[physics.ab_b_body].reshape(3, 3),
+            obs["ab_rotation"],
+        )
 
     def __call__(self) -> None:
         data = self._data
@@ -195,8 +352,7 @@ class IdealSensors(Sensors):
         their drives' set-points.
     """
 
-    def __init__(self, physics: "FastPhysics", options: SensorOptions = SensorOptions(),
-                 control_dt: float = CONTROL_DT):
+    def __init__(self, physics: FastPhysics, options: SensorOptions = SensorOptions(), control_dt: float = CONTROL_DT):
         super().__init__()
         o = self.options = options
         self.dt = control_dt
@@ -206,12 +362,22 @@ class IdealSensors(Sensors):
         rate = 1.0 / control_dt
         # The rates and latencies as simulated: whole numbers of ticks (as FusedSensors').
         self.specs = [
-            SensorSpec("cabin_pose_ts", "cabin pose by the total stations (position and attitude)", "m|rad",
-                       rate / self.every, self.pose_lag * control_dt,
-                       f"white, {1e3 * o.pose_noise_m:g} mm and {1e6 * o.pose_noise_rad:g} urad 1-sigma per axis"),
-            SensorSpec("cabin_pose", "cabin pose for the stabilizer (IMU-aided)", "m|rad", rate,
-                       self.stewart_lag * control_dt,
-                       f"white, {1e3 * o.stewart_noise_m:g} mm and {1e6 * o.stewart_noise_rad:g} urad 1-sigma per axis"),
+            SensorSpec(
+                "cabin_pose_ts",
+                "cabin pose by the total stations (position and attitude)",
+                "m|rad",
+                rate / self.every,
+                self.pose_lag * control_dt,
+                f"white, {1e3 * o.pose_noise_m:g} mm and {1e6 * o.pose_noise_rad:g} urad 1-sigma per axis",
+            ),
+            SensorSpec(
+                "cabin_pose",
+                "cabin pose for the stabilizer (IMU-aided)",
+                "m|rad",
+                rate,
+                self.stewart_lag * control_dt,
+                f"white, {1e3 * o.stewart_noise_m:g} mm and {1e6 * o.stewart_noise_rad:g} urad 1-sigma per axis",
+            ),
             *encoder_specs(rate),
         ]
 
@@ -224,15 +390,25 @@ class IdealSensors(Sensors):
         self.true_pos = np.empty((n, 3))
         self.true_rot = np.empty((n, 3, 3))
         # Noise of each measurement: position (n, 3) and a small rotation I + [w]x (n, 3, 3).
-        self.pose_noise = (rng.normal(0.0, o.pose_noise_m, (n, 3)),
-                           np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))))
-        self.stewart_noise = (rng.normal(0.0, o.stewart_noise_m, (n, 3)),
-                              np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))))
+        self.pose_noise = (
+            rng.normal(0.0, o.pose_noise_m, (n, 3)),
+            np.eye(3) + skew(rng.normal(0.0, o.pose_noise_rad, (n, 3))),
+        )
+        self.stewart_noise = (
+            rng.normal(0.0, o.stewart_noise_m, (n, 3)),
+            np.eye(3) + skew(rng.normal(0.0, o.stewart_noise_rad, (n, 3))),
+        )
         self.observation = obs = {
-            "cabin_pose_ts_position": np.zeros(3), "cabin_pose_ts_rotation": np.eye(3),
-            "cabin_pose_ts_time": np.zeros(1), "cabin_pose_ts_count": np.zeros(1, dtype=int),
-            "cabin_pose_position": np.zeros(3), "cabin_pose_rotation": np.eye(3), "cabin_pose_time": np.zeros(1),
-            "ab_angles": np.zeros(2), "ab_rotation": np.eye(3), "leg_positions": np.zeros(6),
+            "cabin_pose_ts_position": np.zeros(3),
+            "cabin_pose_ts_rotation": np.eye(3),
+            "cabin_pose_ts_time": np.zeros(1),
+            "cabin_pose_ts_count": np.zeros(1, dtype=int),
+            "cabin_pose_position": np.zeros(3),
+            "cabin_pose_rotation": np.eye(3),
+            "cabin_pose_time": np.zeros(1),
+            "ab_angles": np.zeros(2),
+            "ab_rotation": np.eye(3),
+            "leg_positions": np.zeros(6),
             "leg_setpoints": np.zeros(6),
         }
         self._encoders = Encoders(physics, obs)
@@ -251,15 +427,16 @@ class IdealSensors(Sensors):
         cabin = data.xmat[self._cabin].reshape(3, 3)
         self.true_rot[tick] = cabin
         if tick % self.every == 0:
-            j = self._measured(tick, self.pose_lag, self.pose_noise, obs["cabin_pose_ts_position"],
-                               obs["cabin_pose_ts_rotation"])
+            j = self._measured(
+                tick, self.pose_lag, self.pose_noise, obs["cabin_pose_ts_position"], obs["cabin_pose_ts_rotation"]
+            )
             obs["cabin_pose_ts_time"][0] = j * self.dt
             obs["cabin_pose_ts_count"][0] += 1
-        j = self._measured(tick, self.stewart_lag, self.stewart_noise, obs["cabin_pose_position"],
-                           obs["cabin_pose_rotation"])
+        j = self._measured(
+            tick, self.stewart_lag, self.stewart_noise, obs["cabin_pose_position"], obs["cabin_pose_rotation"]
+        )
         obs["cabin_pose_time"][0] = j * self.dt
         self._encoders()
-
 
 
 #: The Kalman filters' error state (true less estimated), world frame: position, velocity,
@@ -297,8 +474,9 @@ def error_model(dt: float, gravity: float):
 VARIANCE_FLOOR = 1e-18
 
 
-def steady_state_gain(phi: np.ndarray, g: np.ndarray, white: np.ndarray, walk: np.ndarray, every: int,
-                      measurement_var: np.ndarray) -> np.ndarray:
+def steady_state_gain(
+    phi: np.ndarray, g: np.ndarray, white: np.ndarray, walk: np.ndarray, every: int, measurement_var: np.ndarray
+) -> np.ndarray:
     """The steady-state Kalman gain (15, 6) of the error model (``error_model``) measured in
     position and attitude every ``every`` ticks.
 
@@ -358,8 +536,7 @@ class ImuErrors:
     def _advance(self, tick: int) -> None:
         end = self.start + self._rows.shape[0]
         if not end <= tick < self.n:
-            raise IndexError(f"IMU errors are made in tick order: tick {tick} after ticks up to {end - 1} "
-                             f"of {self.n}")
+            raise IndexError(f"IMU errors are made in tick order: tick {tick} after ticks up to {end - 1} of {self.n}")
         while True:  # (ticks skipped are made and dropped: the draws stay in order)
             m = min(IMU_BLOCK_TICKS, self.n - end)
             steps = self._walk_rng.normal(0.0, self.walk, (m, 2, 3))
@@ -428,17 +605,23 @@ class FusedPoses:
         self.history = history
         phi, g = error_model(dt, float(np.linalg.norm(self.gravity)))
         self.gains, self._inverse_inertia = [], []
-        for pts, noise in zip(self.points, noises):
+        for pts, noise in zip(self.points, noises, strict=True):
             position_var = noise["fix_white"] ** 2 / len(pts) + noise["fix_drift"] ** 2
             attitude_var = point_pose_noise(pts, noise["fix_white"]) ** 2
-            self.gains.append(steady_state_gain(
-                phi, g, np.repeat([noise["accel_white"], noise["gyro_white"]], 3),
-                np.repeat([noise["accel_walk"], noise["gyro_walk"]], 3), noise["every"],
-                np.repeat([position_var, attitude_var], 3)))
+            self.gains.append(
+                steady_state_gain(
+                    phi,
+                    g,
+                    np.repeat([noise["accel_white"], noise["gyro_white"]], 3),
+                    np.repeat([noise["accel_walk"], noise["gyro_walk"]], 3),
+                    noise["every"],
+                    np.repeat([position_var, attitude_var], 3),
+                )
+            )
             self._inverse_inertia.append(inverse_point_inertia(pts))
         # Per body, its points and its IMU about their centroid, body frame (per fix, else).
-        self._local_points = [p - c for p, c in zip(self.points, self.centroids)]
-        self._local_imu = [o - c for o, c in zip(self.imu_offsets, self.centroids)]
+        self._local_points = [p - c for p, c in zip(self.points, self.centroids, strict=True)]
+        self._local_imu = [o - c for o, c in zip(self.imu_offsets, self.centroids, strict=True)]
         # Phi^k for k = 0 .. history - 1, to carry a correction at a past tick to the present.
         powers = [np.eye(15)]
         for _ in range(history - 1):
@@ -447,8 +630,10 @@ class FusedPoses:
         # Per body, Phi^k K (history, 15, 6): a fix's innovation to the correction k ticks
         # after it, in one product; and the fix's constants as Python floats (``correct``).
         self._carry = [self._powers @ gain for gain in self.gains]
-        self._fit_constants = [(q.tolist(), j.ravel().tolist(), o.tolist())
-                               for q, j, o in zip(self._local_points, self._inverse_inertia, self._local_imu)]
+        self._fit_constants = [
+            (q.tolist(), j.ravel().tolist(), o.tolist())
+            for q, j, o in zip(self._local_points, self._inverse_inertia, self._local_imu, strict=True)
+        ]
 
     def reset(self, positions, rotations) -> None:
         """Start every body at a known pose (the operator's survey of the parked machine),
@@ -495,8 +680,9 @@ class FusedPoses:
         half = 0.5 * dt
         gx, gy, gz = self._gravity
         positions, velocities, rotations = self._position, self._velocity, self._rotation
-        for b, ((fx, fy, fz), (cx, cy, cz), (wx, wy, wz), (bx, by, bz)) in enumerate(zip(
-                specific_force, self._accel_bias, rate, self._gyro_bias)):
+        for b, ((fx, fy, fz), (cx, cy, cz), (wx, wy, wz), (bx, by, bz)) in enumerate(
+            zip(specific_force, self._accel_bias, rate, self._gyro_bias, strict=True)
+        ):
             r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotations[b]
             ux, uy, uz = fx - cx, fy - cy, fz - cz
             ax = (r0 * ux + r2 * uz) + r1 * uy + gx
@@ -507,9 +693,17 @@ class FusedPoses:
             positions[b] = [px + (vx + half * ax) * dt, py + (vy + half * ay) * dt, pz + (vz + half * az) * dt]
             velocities[b] = [vx + ax * dt, vy + ay * dt, vz + az * dt]
             w0, w1, w2 = (wx - bx) * dt, (wy - by) * dt, (wz - bz) * dt
-            rotations[b] = [r0 - (r2 * w1 - r1 * w2), r1 - (r0 * w2 - r2 * w0), r2 - (r1 * w0 - r0 * w1),
-                            r3 - (r5 * w1 - r4 * w2), r4 - (r3 * w2 - r5 * w0), r5 - (r4 * w0 - r3 * w1),
-                            r6 - (r8 * w1 - r7 * w2), r7 - (r6 * w2 - r8 * w0), r8 - (r7 * w0 - r6 * w1)]
+            rotations[b] = [
+                r0 - (r2 * w1 - r1 * w2),
+                r1 - (r0 * w2 - r2 * w0),
+                r2 - (r1 * w0 - r0 * w1),
+                r3 - (r5 * w1 - r4 * w2),
+                r4 - (r3 * w2 - r5 * w0),
+                r5 - (r4 * w0 - r3 * w1),
+                r6 - (r8 * w1 - r7 * w2),
+                r7 - (r6 * w2 - r8 * w0),
+                r8 - (r7 * w0 - r6 * w1),
+            ]
         self.tick += 1
 
     def sample(self, body: int) -> None:
@@ -544,7 +738,7 @@ class FusedPoses:
         count = len(measured)
         cx, cy, cz = cx / count, cy / count, cz / count
         ux = uy = uz = 0.0
-        for (mx, my, mz), (qx, qy, qz) in zip(measured, local):
+        for (mx, my, mz), (qx, qy, qz) in zip(measured, local, strict=True):
             px, py, pz = r0 * qx + r1 * qy + r2 * qz, r3 * qx + r4 * qy + r5 * qz, r6 * qx + r7 * qy + r8 * qz
             dx, dy, dz = mx - cx - px, my - cy - py, mz - cz - pz
             ux, uy, uz = ux + (py * dz - pz * dy), uy + (pz * dx - px * dz), uz + (px * dy - py * dx)
@@ -554,8 +748,16 @@ class FusedPoses:
         tx, ty, tz = r0 * vx + r1 * vy + r2 * vz, r3 * vx + r4 * vy + r5 * vz, r6 * vx + r7 * vy + r8 * vz
         # The IMU where the fix puts it: c + (I + [theta]x) R o, o the IMU about the centroid.
         ax, ay, az = r0 * ox + r1 * oy + r2 * oz, r3 * ox + r4 * oy + r5 * oz, r6 * ox + r7 * oy + r8 * oz
-        innovation = np.array([cx + ax + (ty * az - tz * ay) - sx, cy + ay + (tz * ax - tx * az) - sy,
-                               cz + az + (tx * ay - ty * ax) - sz, tx, ty, tz])
+        innovation = np.array(
+            [
+                cx + ax + (ty * az - tz * ay) - sx,
+                cy + ay + (tz * ax - tx * az) - sy,
+                cz + az + (tx * ay - ty * ax) - sz,
+                tx,
+                ty,
+                tz,
+            ]
+        )
         carry = self._carry[body]
         for k, (tick, (px, py, pz), later_rotation) in enumerate(samples):
             later = (carry[tick - at_tick] @ innovation).tolist()
@@ -572,8 +774,11 @@ class FusedPoses:
         r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation
         for biases, (bx, by, bz) in ((self._accel_bias, now[6:9]), (self._gyro_bias, now[12:15])):
             ex, ey, ez = biases[body]
-            biases[body] = [ex + (r0 * bx + r3 * by + r6 * bz), ey + (r1 * bx + r4 * by + r7 * bz),
-                            ez + (r2 * bx + r5 * by + r8 * bz)]
+            biases[body] = [
+                ex + (r0 * bx + r3 * by + r6 * bz),
+                ey + (r1 * bx + r4 * by + r7 * bz),
+                ez + (r2 * bx + r5 * by + r8 * bz),
+            ]
 
     def body_poses(self):
         """(origins (B, 3), rotations (B, 3, 3), velocities (B, 3)) of the bodies' frames, world."""
@@ -584,9 +789,15 @@ class FusedPoses:
         offset turned by the rotation (R o summed as ``propagate`` sums R v)."""
         out = []
         for (px, py, pz), (r0, r1, r2, r3, r4, r5, r6, r7, r8), (ox, oy, oz) in zip(
-                self._position, self._rotation, self._offsets):
-            out.append([px - ((r0 * ox + r2 * oz) + r1 * oy), py - ((r3 * ox + r5 * oz) + r4 * oy),
-                        pz - ((r6 * ox + r8 * oz) + r7 * oy)])
+            self._position, self._rotation, self._offsets, strict=True
+        ):
+            out.append(
+                [
+                    px - ((r0 * ox + r2 * oz) + r1 * oy),
+                    py - ((r3 * ox + r5 * oz) + r4 * oy),
+                    pz - ((r6 * ox + r8 * oz) + r7 * oy),
+                ]
+            )
         return out
 
 
@@ -598,9 +809,17 @@ def _turned(w, r) -> list:
     """(I + [w]x) R as 9 floats (rows), for w (3 floats) and R (9 floats, rows)."""
     wx, wy, wz = w
     r0, r1, r2, r3, r4, r5, r6, r7, r8 = r
-    return [r0 + (wy * r6 - wz * r3), r1 + (wy * r7 - wz * r4), r2 + (wy * r8 - wz * r5),
-            r3 + (wz * r0 - wx * r6), r4 + (wz * r1 - wx * r7), r5 + (wz * r2 - wx * r8),
-            r6 + (wx * r3 - wy * r0), r7 + (wx * r4 - wy * r1), r8 + (wx * r5 - wy * r2)]
+    return [
+        r0 + (wy * r6 - wz * r3),
+        r1 + (wy * r7 - wz * r4),
+        r2 + (wy * r8 - wz * r5),
+        r3 + (wz * r0 - wx * r6),
+        r4 + (wz * r1 - wx * r7),
+        r5 + (wz * r2 - wx * r8),
+        r6 + (wx * r3 - wy * r0),
+        r7 + (wx * r4 - wy * r1),
+        r8 + (wx * r5 - wy * r2),
+    ]
 
 
 def small_rotation_fit(measured: np.ndarray, predicted: np.ndarray, inverse_inertia: np.ndarray) -> np.ndarray:
@@ -645,55 +864,113 @@ class FusedSensors(Sensors):
         self.dt = control_dt
         model = physics.model.ptr
         self.gravity = model.opt.gravity.copy()
-        self.fix_every = {"cabin": _ticks(1.0 / o.rtk_rate_hz, control_dt, 1),
-                          "platform": _ticks(1.0 / o.ts_rate_hz, control_dt, 1)}
-        self.fix_lag = {"cabin": _latency_ticks(o.rtk_latency_s, control_dt),
-                        "platform": _latency_ticks(o.ts_latency_s, control_dt)}
+        self.fix_every = {
+            "cabin": _ticks(1.0 / o.rtk_rate_hz, control_dt, 1),
+            "platform": _ticks(1.0 / o.ts_rate_hz, control_dt, 1),
+        }
+        self.fix_lag = {
+            "cabin": _latency_ticks(o.rtk_latency_s, control_dt),
+            "platform": _latency_ticks(o.ts_latency_s, control_dt),
+        }
         self.body_ids = {"cabin": physics.cabin_body, "platform": int(model.body("feed_platform").id)}
-        self.point_sites = {"cabin": [model.site(f"rtk{i}").id for i in (1, 2, 3)],
-                            "platform": [model.site(f"prism{i}").id for i in (1, 2, 3)]}
+        self.point_sites = {
+            "cabin": [model.site(f"rtk{i}").id for i in (1, 2, 3)],
+            "platform": [model.site(f"prism{i}").id for i in (1, 2, 3)],
+        }
         self.imu_site = {b: model.site(f"{b}_imu").id for b in self.BODIES}
-        self.noise = {"cabin": (o.rtk_noise_m, o.rtk_common_m, o.rtk_point_m, o.rtk_drift_time_s),
-                      "platform": (o.ts_noise_m, o.ts_common_m, o.ts_point_m, o.ts_drift_time_s)}
+        self.noise = {
+            "cabin": (o.rtk_noise_m, o.rtk_common_m, o.rtk_point_m, o.rtk_drift_time_s),
+            "platform": (o.ts_noise_m, o.ts_common_m, o.ts_point_m, o.ts_drift_time_s),
+        }
         history = max(self.fix_lag.values()) + 2
-        imu = dict(accel_white=o.imu_accel_noise / math.sqrt(control_dt), accel_walk=o.imu_accel_bias_walk *
-                   math.sqrt(control_dt), gyro_white=o.imu_gyro_noise / math.sqrt(control_dt),
-                   gyro_walk=o.imu_gyro_bias_walk * math.sqrt(control_dt))
+        imu = dict(
+            accel_white=o.imu_accel_noise / math.sqrt(control_dt),
+            accel_walk=o.imu_accel_bias_walk * math.sqrt(control_dt),
+            gyro_white=o.imu_gyro_noise / math.sqrt(control_dt),
+            gyro_walk=o.imu_gyro_bias_walk * math.sqrt(control_dt),
+        )
         noises = []
         for b in self.BODIES:
             white, common, point, _ = self.noise[b]
             noises.append(dict(imu, every=self.fix_every[b], fix_white=math.hypot(white, point), fix_drift=common))
-        self.filters = FusedPoses([model.site_pos[self.point_sites[b]] for b in self.BODIES],
-                                  [model.site_pos[self.imu_site[b]] for b in self.BODIES], noises, control_dt,
-                                  self.gravity, history)
+        self.filters = FusedPoses(
+            [model.site_pos[self.point_sites[b]] for b in self.BODIES],
+            [model.site_pos[self.imu_site[b]] for b in self.BODIES],
+            noises,
+            control_dt,
+            self.gravity,
+            history,
+        )
         self._imu_sites = np.array([self.imu_site[b] for b in self.BODIES])
         columns = np.arange(model.nsensordata)  # (2, 3) sensordata columns of each body's reading
         self._vel_columns = np.array([columns[physics.sensor_block(f"{b}_imu_vel")] for b in self.BODIES])
         self._gyro_columns = np.array([columns[physics.sensor_block(f"{b}_imu_gyro")] for b in self.BODIES])
         rate = 1.0 / control_dt
-        imu_noise = (f"white {o.imu_accel_noise:g} m/s^2/sqrt(Hz) and {o.imu_gyro_noise:g} rad/sqrt(s)")
-        imu_bias = (f"turn-on {o.imu_accel_bias:g} m/s^2 and {o.imu_gyro_bias:g} rad/s 1-sigma, random walk "
-                    f"{o.imu_accel_bias_walk:g} m/s^2/sqrt(s) and {o.imu_gyro_bias_walk:g} rad/s/sqrt(s)")
+        imu_noise = f"white {o.imu_accel_noise:g} m/s^2/sqrt(Hz) and {o.imu_gyro_noise:g} rad/sqrt(s)"
+        imu_bias = (
+            f"turn-on {o.imu_accel_bias:g} m/s^2 and {o.imu_gyro_bias:g} rad/s 1-sigma, random walk "
+            f"{o.imu_accel_bias_walk:g} m/s^2/sqrt(s) and {o.imu_gyro_bias_walk:g} rad/s/sqrt(s)"
+        )
 
         def fix_noise(b):
             white, common, point, tau = self.noise[b]
-            return (f"white {1e3 * white:g} mm; Gauss-Markov ({tau:g} s) {1e3 * common:g} mm common and "
-                    f"{1e3 * point:g} mm per point, 1-sigma per coordinate")
+            return (
+                f"white {1e3 * white:g} mm; Gauss-Markov ({tau:g} s) {1e3 * common:g} mm common and "
+                f"{1e3 * point:g} mm per point, 1-sigma per coordinate"
+            )
 
         self.specs = [
-            SensorSpec("cabin_estimate", "cabin pose fused from its SINS and GPS/RTK (Kalman filter)", "m|rad|m/s",
-                       rate, 0.0, "the filter's error (about 15 mm and 0.1 deg RMS)"),
-            SensorSpec("platform_estimate", "feed platform pose fused from its SINS and the total stations (Kalman "
-                       "filter)", "m|rad|m/s", rate, 0.0, "the filter's error (about 3 mm and 0.1 deg RMS)"),
-            SensorSpec("cabin_imu", "cabin SINS: specific force and angular rate, IMU frame", "m/s^2|rad/s", rate,
-                       0.0, imu_noise, imu_bias),
-            SensorSpec("platform_imu", "feed platform SINS: specific force and angular rate, IMU frame",
-                       "m/s^2|rad/s", rate, 0.0, imu_noise, imu_bias),
+            SensorSpec(
+                "cabin_estimate",
+                "cabin pose fused from its SINS and GPS/RTK (Kalman filter)",
+                "m|rad|m/s",
+                rate,
+                0.0,
+                "the filter's error (about 15 mm and 0.1 deg RMS)",
+            ),
+            SensorSpec(
+                "platform_estimate",
+                "feed platform pose fused from its SINS and the total stations (Kalman filter)",
+                "m|rad|m/s",
+                rate,
+                0.0,
+                "the filter's error (about 3 mm and 0.1 deg RMS)",
+            ),
+            SensorSpec(
+                "cabin_imu",
+                "cabin SINS: specific force and angular rate, IMU frame",
+                "m/s^2|rad/s",
+                rate,
+                0.0,
+                imu_noise,
+                imu_bias,
+            ),
+            SensorSpec(
+                "platform_imu",
+                "feed platform SINS: specific force and angular rate, IMU frame",
+                "m/s^2|rad/s",
+                rate,
+                0.0,
+                imu_noise,
+                imu_bias,
+            ),
             # The rates and latencies as simulated: whole numbers of ticks.
-            SensorSpec("cabin_rtk", "GPS/RTK positions of the cabin's three roof antennas", "m",
-                       rate / self.fix_every["cabin"], self.fix_lag["cabin"] * control_dt, fix_noise("cabin")),
-            SensorSpec("platform_ts", "total-station positions of the feed platform's three prisms", "m",
-                       rate / self.fix_every["platform"], self.fix_lag["platform"] * control_dt, fix_noise("platform")),
+            SensorSpec(
+                "cabin_rtk",
+                "GPS/RTK positions of the cabin's three roof antennas",
+                "m",
+                rate / self.fix_every["cabin"],
+                self.fix_lag["cabin"] * control_dt,
+                fix_noise("cabin"),
+            ),
+            SensorSpec(
+                "platform_ts",
+                "total-station positions of the feed platform's three prisms",
+                "m",
+                rate / self.fix_every["platform"],
+                self.fix_lag["platform"] * control_dt,
+                fix_noise("platform"),
+            ),
             *encoder_specs(rate),
         ]
 
@@ -704,10 +981,12 @@ class FusedSensors(Sensors):
         rng = np.random.default_rng([seed, 0xFA58])
         # IMU errors per tick: white noise, and a bias = turn-on + random walk.
         dt = self.dt
-        self.accel_error = ImuErrors(rng, n, o.imu_accel_noise / math.sqrt(dt), o.imu_accel_bias,
-                                     o.imu_accel_bias_walk * math.sqrt(dt))
-        self.gyro_error = ImuErrors(rng, n, o.imu_gyro_noise / math.sqrt(dt), o.imu_gyro_bias,
-                                    o.imu_gyro_bias_walk * math.sqrt(dt))
+        self.accel_error = ImuErrors(
+            rng, n, o.imu_accel_noise / math.sqrt(dt), o.imu_accel_bias, o.imu_accel_bias_walk * math.sqrt(dt)
+        )
+        self.gyro_error = ImuErrors(
+            rng, n, o.imu_gyro_noise / math.sqrt(dt), o.imu_gyro_bias, o.imu_gyro_bias_walk * math.sqrt(dt)
+        )
         # Fix errors per fix (rows: fixes; points; coordinates): white, common slow, per-point slow.
         self.fix_error = {}
         for b in self.BODIES:
@@ -715,8 +994,11 @@ class FusedSensors(Sensors):
             every = self.fix_every[b]
             m = n // every + 1
             fix_dt = every * dt
-            self.fix_error[b] = (rng.normal(0.0, white, (m, 3, 3)) + gauss_markov(rng, (m, 1, 3), common, tau, fix_dt)
-                                 + gauss_markov(rng, (m, 3, 3), point, tau, fix_dt))
+            self.fix_error[b] = (
+                rng.normal(0.0, white, (m, 3, 3))
+                + gauss_markov(rng, (m, 1, 3), common, tau, fix_dt)
+                + gauss_markov(rng, (m, 3, 3), point, tau, fix_dt)
+            )
         self._last_velocity = np.zeros((2, 3))
         self.pending = {b: deque() for b in self.BODIES}  # (arrival tick, points (3, 3), taken at tick)
         # Per tick: position (3) and rotation (9) of each body, streamed to a file of its own.
@@ -734,12 +1016,20 @@ class FusedSensors(Sensors):
         bodies = [self.body_ids[b] for b in self.BODIES]
         self.filters.reset(data.xpos[bodies], data.xmat[bodies].reshape(-1, 3, 3))
         for k, b in enumerate(self.BODIES):
-            obs.update({f"{b}_estimate_position": self._position[k], f"{b}_estimate_rotation": self._rotation[k],
-                        f"{b}_estimate_velocity": self._velocity[k], f"{b}_estimate_time": self._time,
-                        f"{b}_imu_accel": self._accel[k], f"{b}_imu_gyro": self._gyro[k]})
+            obs.update(
+                {
+                    f"{b}_estimate_position": self._position[k],
+                    f"{b}_estimate_rotation": self._rotation[k],
+                    f"{b}_estimate_velocity": self._velocity[k],
+                    f"{b}_estimate_time": self._time,
+                    f"{b}_imu_accel": self._accel[k],
+                    f"{b}_imu_gyro": self._gyro[k],
+                }
+            )
         for key in ("cabin_rtk", "platform_ts"):
-            obs.update({f"{key}_points": np.zeros((3, 3)), f"{key}_time": np.zeros(1),
-                        f"{key}_count": np.zeros(1, dtype=int)})
+            obs.update(
+                {f"{key}_points": np.zeros((3, 3)), f"{key}_time": np.zeros(1), f"{key}_count": np.zeros(1, dtype=int)}
+            )
         obs.update(ab_angles=np.zeros(2), ab_rotation=np.eye(3), leg_positions=np.zeros(6), leg_setpoints=np.zeros(6))
         self.observation = obs
         self._fix_key = {"cabin": "cabin_rtk", "platform": "platform_ts"}
@@ -749,17 +1039,28 @@ class FusedSensors(Sensors):
         self._imu_rotations = [data.site_xmat[int(i)] for i in self._imu_sites]  # views of the live rows
         columns = np.concatenate([self._vel_columns.ravel(), self._gyro_columns.ravel()])
         low = int(columns.min())
-        self._imu_readings = data.sensordata[low:int(columns.max()) + 1]  # a view
-        self._imu_places = [(int(v[0]) - low, int(g[0]) - low) for v, g in zip(self._vel_columns, self._gyro_columns)]
+        self._imu_readings = data.sensordata[low : int(columns.max()) + 1]  # a view
+        self._imu_places = [
+            (int(v[0]) - low, int(g[0]) - low) for v, g in zip(self._vel_columns, self._gyro_columns, strict=True)
+        ]
         if not all(np.array_equal(c, c[0] + np.arange(3)) for c in (*self._vel_columns, *self._gyro_columns)):
             raise ValueError("the IMUs' readings must be 3 consecutive sensordata columns each")
         self._gravity_list = self.gravity.tolist()
         self._fixes = []
         for b in self.BODIES:
             key = self._fix_key[b]
-            self._fixes.append((self.fix_every[b], self.fix_lag[b], index_view(self.point_sites[b]),
-                                self.fix_error[b], self.pending[b], obs[f"{key}_points"], obs[f"{key}_time"],
-                                obs[f"{key}_count"]))
+            self._fixes.append(
+                (
+                    self.fix_every[b],
+                    self.fix_lag[b],
+                    index_view(self.point_sites[b]),
+                    self.fix_error[b],
+                    self.pending[b],
+                    obs[f"{key}_points"],
+                    obs[f"{key}_time"],
+                    obs[f"{key}_count"],
+                )
+            )
         self._encoders = Encoders(physics, obs)
         self._estimate_flat = self._estimate.reshape(24)
         self._accel_flat, self._gyro_flat = self._accel.reshape(6), self._gyro.reshape(6)
@@ -786,7 +1087,7 @@ class FusedSensors(Sensors):
         for k, site_rotation in enumerate(self._imu_rotations):
             r0, r1, r2, r3, r4, r5, r6, r7, r8 = site_rotation.tolist()
             at, gt = self._imu_places[k]
-            v0, v1, v2 = block[at:at + 3]
+            v0, v1, v2 = block[at : at + 3]
             w0, w1, w2 = (r0 * v0 + r2 * v2) + r1 * v1, (r3 * v0 + r5 * v2) + r4 * v1, (r6 * v0 + r8 * v2) + r7 * v1
             if tick > 0:
                 l0, l1, l2 = self._last_velocity[k]
@@ -794,8 +1095,13 @@ class FusedSensors(Sensors):
             else:
                 f0, f1, f2 = -gx, -gy, -gz
             e0, e1, e2 = accel_error[k]
-            accels.append([((r0 * f0 + r3 * f1) + r6 * f2) + e0, ((r1 * f0 + r4 * f1) + r7 * f2) + e1,
-                           ((r2 * f0 + r5 * f1) + r8 * f2) + e2])
+            accels.append(
+                [
+                    ((r0 * f0 + r3 * f1) + r6 * f2) + e0,
+                    ((r1 * f0 + r4 * f1) + r7 * f2) + e1,
+                    ((r2 * f0 + r5 * f1) + r8 * f2) + e2,
+                ]
+            )
             e0, e1, e2 = gyro_error[k]
             gyros.append([block[gt] + e0, block[gt + 1] + e1, block[gt + 2] + e2])
             velocities.append([w0, w1, w2])
@@ -867,12 +1173,16 @@ def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
     adrs = [model.jnt_qposadr[model.body_jntadr[model.body(name).id]] for _, name in bodies]
     position, attitude = [[], []], [[], []]  # per body, per chunk: the ticks' errors, m and rad
     for start, rows in log.chunks(["qpos"]):
-        qpos = rows["qpos"][:max(n - start, 0)]
+        qpos = rows["qpos"][: max(n - start, 0)]
         estimate = estimates.span("estimate", start, start + qpos.shape[0])
         for k, adr in enumerate(adrs):
-            position[k].append(np.linalg.norm(estimate[:, k, :3] - qpos[:, adr:adr + 3], axis=1))
-            attitude[k].append((Rotation.from_matrix(estimate[:, k, 3:].reshape(-1, 3, 3))
-                                * Rotation.from_quat(qpos[:, adr + 3:adr + 7], scalar_first=True).inv()).magnitude())
+            position[k].append(np.linalg.norm(estimate[:, k, :3] - qpos[:, adr : adr + 3], axis=1))
+            attitude[k].append(
+                (
+                    Rotation.from_matrix(estimate[:, k, 3:].reshape(-1, 3, 3))
+                    * Rotation.from_quat(qpos[:, adr + 3 : adr + 7], scalar_first=True).inv()
+                ).magnitude()
+            )
     out = {}
     for k, (body, _) in enumerate(bodies):
         p, a = np.concatenate(position[k]), np.concatenate(attitude[k])

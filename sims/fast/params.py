@@ -9,34 +9,50 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from planbench import models
+from planbench import models, run_limits
+from planbench.drives import DRIVES
+from planbench.fast.loads import CableLoads, ChainCableLoads
+from planbench.fast.measurement import SensorOptions, floats_per_tick
+from planbench.fast.physics import (
+    CABLE_EA,
+    CONTROL_DT,
+    LEG_ACTUATORS,
+    PHYSICS_DT,
+    SEGMENT_OMEGA_DT_LIMIT,
+    _compiled,
+    discretized_spec,
+    max_cable_segments,
+)
+from planbench.params import ParamError, PlantParams, ScenarioParams, param
 from planbench.planners import fast
 from planbench.planners.fast import plan as fp
 from planbench.planners.fast import sky as sky
-from planbench import run_limits
-from planbench.fast.loads import CableLoads, ChainCableLoads
-from planbench.drives import DRIVES
-from planbench.fast.measurement import SensorOptions, floats_per_tick
-from planbench.fast.physics import (CABLE_EA, CONTROL_DT, LEG_ACTUATORS, PHYSICS_DT, SEGMENT_OMEGA_DT_LIMIT, _compiled,
-                               discretized_spec, max_cable_segments)
-from planbench.params import ParamError, PlantParams, ScenarioParams, param
 from planbench.plant import set_inertial
 from planbench.wind import MEAN_SPEED, SPECTRA, MeasuredWind, WindFileError
-
 
 # ----------------------------------------------------------------------------- plant uncertainty
 
 #: Everything the cabin carries, 30 091.8 kg (CASPR, REFERENCE.md): the shell and structure,
 #: the A-B rotator, the Stewart legs, the feed platform and the receiver (models/fast/README.md).
 #: The lumped cable masses (anchor_mass*) belong to the cables.
-CABIN_BODIES = ("cabin", "ab_a", "ab_b", *(f"leg{i}_{part}" for i in range(1, 7) for part in ("housing", "rod")),
-                "feed_platform", "receiver")
+CABIN_BODIES = (
+    "cabin",
+    "ab_a",
+    "ab_b",
+    *(f"leg{i}_{part}" for i in range(1, 7) for part in ("housing", "rod")),
+    "feed_platform",
+    "receiver",
+)
 #: What bounds the tower tops' errors (assumed; no public figure): their survey and construction
 #: tolerance, the guide pulleys' exit points, the >100 m towers' deflection under the cables'
 #: pull (the model's towers are rigid): tens of mm; 0.1 m bounds it.
-_TOWER_ERROR = dict(unit="mm", low=-100.0, high=100.0,
-                    reason="survey and construction tolerance of the tower tops, the pulleys' exit points and the "
-                           "towers' deflection under load: tens of mm (assumed); 0.1 m bounds it")
+_TOWER_ERROR = dict(
+    unit="mm",
+    low=-100.0,
+    high=100.0,
+    reason="survey and construction tolerance of the tower tops, the pulleys' exit points and the "
+    "towers' deflection under load: tens of mm (assumed); 0.1 m bounds it",
+)
 
 
 @dataclass(frozen=True)
@@ -56,32 +72,65 @@ class FastPlant(PlantParams):
     """
 
     cable_ea_error: float = param(
-        0.0, f"error of the cables' axial stiffness EA ({CABLE_EA / 1e6:g} MN nominal) as a fraction", "fraction",
-        low=-0.35, high=0.10, reason="steel wire rope's effective modulus is 100-160 GPa (REFERENCE.md): -33 % to "
-        "+7 % of the nominal 150 GPa, rounded out")
+        0.0,
+        f"error of the cables' axial stiffness EA ({CABLE_EA / 1e6:g} MN nominal) as a fraction",
+        "fraction",
+        low=-0.35,
+        high=0.10,
+        reason="steel wire rope's effective modulus is 100-160 GPa (REFERENCE.md): -33 % to "
+        "+7 % of the nominal 150 GPa, rounded out",
+    )
     cable_mass_error: float = param(
-        0.0, f"error of the cables' mass per length ({fast.FAST.cable_mass_per_length:g} kg/m nominal) as a fraction",
-        "fraction", low=-0.2, high=0.2, reason="46 mm steel wire ropes weigh about 8.5 (six-strand) to 12 kg/m "
-        "(locked coil) (rope makers' tables, assumed), +/-20 % of 10 kg/m")
+        0.0,
+        f"error of the cables' mass per length ({fast.FAST.cable_mass_per_length:g} kg/m nominal) as a fraction",
+        "fraction",
+        low=-0.2,
+        high=0.2,
+        reason="46 mm steel wire ropes weigh about 8.5 (six-strand) to 12 kg/m "
+        "(locked coil) (rope makers' tables, assumed), +/-20 % of 10 kg/m",
+    )
     anchor_radial_error: float = param(
-        0.0, "every tower top's cable exit moved outward (away from the dish axis) by this", **_TOWER_ERROR)
+        0.0, "every tower top's cable exit moved outward (away from the dish axis) by this", **_TOWER_ERROR
+    )
     anchor_height_error: float = param(0.0, "every tower top's cable exit moved up by this", **_TOWER_ERROR)
     anchor_errors: tuple[tuple[float, ...], ...] = param(
-        ((0.0, 0.0, 0.0),) * 6, "each tower top's cable exit moved by (x east, y north, z up), one row per tower 1-6, "
-        "added to anchor_radial_error and anchor_height_error", length=3, min_items=6, max_items=6, **_TOWER_ERROR)
+        ((0.0, 0.0, 0.0),) * 6,
+        "each tower top's cable exit moved by (x east, y north, z up), one row per tower 1-6, "
+        "added to anchor_radial_error and anchor_height_error",
+        length=3,
+        min_items=6,
+        max_items=6,
+        **_TOWER_ERROR,
+    )
     cabin_mass_error: float = param(
-        0.0, "error of the mass and inertia of everything the cabin carries (30 091.8 kg: shell, A-B rotator, "
-        "Stewart, feed platform, receiver) as a fraction, every part alike", "fraction", low=-0.1, high=0.1,
-        reason="CASPR's 30 091.8 kg against the public '30 t'; receivers and equipment change (assumed +/-10 %)")
+        0.0,
+        "error of the mass and inertia of everything the cabin carries (30 091.8 kg: shell, A-B rotator, "
+        "Stewart, feed platform, receiver) as a fraction, every part alike",
+        "fraction",
+        low=-0.1,
+        high=0.1,
+        reason="CASPR's 30 091.8 kg against the public '30 t'; receivers and equipment change (assumed +/-10 %)",
+    )
     cabin_com_offset: tuple[float, ...] = param(
-        (0.0, 0.0, 0.0), "shift of the whole cabin's centre of mass (the shell's moves by the cabin's mass over the "
-        "shell's, 1.295 times this), cabin frame (x, y, z)", "m", low=-0.5, high=0.5, length=3,
-        reason="its place 1 m below the anchor plane is an assumption (planbench.planners.fast); 0.5 m, under a tenth of the "
-        "cabin's 7.6 m height and 13 m diameter (assumed)")
+        (0.0, 0.0, 0.0),
+        "shift of the whole cabin's centre of mass (the shell's moves by the cabin's mass over the "
+        "shell's, 1.295 times this), cabin frame (x, y, z)",
+        "m",
+        low=-0.5,
+        high=0.5,
+        length=3,
+        reason="its place 1 m below the anchor plane is an assumption (planbench.planners.fast); "
+        "0.5 m, under a tenth of the cabin's 7.6 m height and 13 m diameter (assumed)",
+    )
     stewart_force_scale: float = param(
-        1.0, "the Stewart legs' force limits as a fraction of their +/-30 kN rating", "fraction", low=0.5, high=1.0,
+        1.0,
+        "the Stewart legs' force limits as a fraction of their +/-30 kN rating",
+        "fraction",
+        low=0.5,
+        high=1.0,
         reason="the rating is what a drive guarantees; derating (heat, supply voltage) only lowers it; half still "
-        "carries the legs' largest static load, 12.4 kN (models/fast/README.md)")
+        "carries the legs' largest static load, 12.4 kN (models/fast/README.md)",
+    )
 
     @property
     def cable_ea(self) -> float:
@@ -120,14 +169,21 @@ class FastPlant(PlantParams):
         ids = [nominal.body(b).id for b in CABIN_BODIES]
         ratio = nominal.body_mass[ids].sum() / nominal.body_mass[nominal.body("cabin").id]
         for body in CABIN_BODIES:
-            set_inertial(spec, nominal, body, 1.0 + self.cabin_mass_error,
-                         ratio * np.asarray(self.cabin_com_offset) if body == "cabin" else None)
+            set_inertial(
+                spec,
+                nominal,
+                body,
+                1.0 + self.cabin_mass_error,
+                ratio * np.asarray(self.cabin_com_offset) if body == "cabin" else None,
+            )
         for i in range(1, 4):
             spec.body(f"anchor_mass{i}").mass = nominal.body_mass[nominal.body(f"anchor_mass{i}").id] * (
-                1.0 + self.cable_mass_error)
+                1.0 + self.cable_mass_error
+            )
         for name in LEG_ACTUATORS:
-            spec.actuator(name).forcerange = nominal.actuator_forcerange[nominal.actuator(name).id] * \
-                self.stewart_force_scale
+            spec.actuator(name).forcerange = (
+                nominal.actuator_forcerange[nominal.actuator(name).id] * self.stewart_force_scale
+            )
         return spec
 
     def model(self, cable_segments: int = 0) -> mujoco.MjModel:
@@ -138,7 +194,7 @@ class FastPlant(PlantParams):
             spec = discretized_spec(cable_segments, spec, self.cable_ea, self.cable_mass_per_length)
         return spec.compile()
 
-    def loads(self, cable_segments: int = 0, **wind) -> "CableLoads":
+    def loads(self, cable_segments: int = 0, **wind) -> CableLoads:
         """The plant's cable physics and wind (CableLoads, or ChainCableLoads for the
         discretized cables) with this plant's EA and mass per length; ``wind``: CableLoads'
         wind arguments."""
@@ -151,10 +207,12 @@ class FastPlant(PlantParams):
         if cable_segments:
             most = max_cable_segments(ea=self.cable_ea, mass_per_length=self.cable_mass_per_length)
             if cable_segments > most:
-                raise ParamError(f"cable_segments = {cable_segments} with plant.cable_ea_error = "
-                                 f"{self.cable_ea_error:g} and plant.cable_mass_error = {self.cable_mass_error:g}: "
-                                 f"the segments vibrate beyond the timestep's limit omega dt <= "
-                                 f"{SEGMENT_OMEGA_DT_LIMIT:g}; use at most {most}")
+                raise ParamError(
+                    f"cable_segments = {cable_segments} with plant.cable_ea_error = "
+                    f"{self.cable_ea_error:g} and plant.cable_mass_error = {self.cable_mass_error:g}: "
+                    f"the segments vibrate beyond the timestep's limit omega dt <= "
+                    f"{SEGMENT_OMEGA_DT_LIMIT:g}; use at most {most}"
+                )
 
 
 # ----------------------------------------------------------------------------- sources
@@ -219,13 +277,19 @@ DEFAULT_CABLE_SEGMENTS = 2
 PER_TICK_FLOATS = 10
 
 
-def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: SensorOptions = SensorOptions(),
-                       control_dt: float = CONTROL_DT) -> float:
+def log_bytes_per_tick(
+    cable_segments: int = DEFAULT_CABLE_SEGMENTS,
+    sensors: SensorOptions = SensorOptions(),
+    control_dt: float = CONTROL_DT,
+) -> float:
     """Bytes a FAST run keeps per control tick, in memory or on disk: the runner's log of the compiled model
     (13 planned channels; the discretized cables add their nodes' joints), PER_TICK_FLOATS and
     the sensors' (``planbench.fast.measurement.floats_per_tick``)."""
-    return run_limits.floats(run_limits.runlog_floats_per_tick(_compiled(cable_segments), len(fp.PLAN_LABELS))
-                             + PER_TICK_FLOATS + floats_per_tick(sensors, control_dt))
+    return run_limits.floats(
+        run_limits.runlog_floats_per_tick(_compiled(cable_segments), len(fp.PLAN_LABELS))
+        + PER_TICK_FLOATS
+        + floats_per_tick(sensors, control_dt)
+    )
 
 
 # ----------------------------------------------------------------------------- parameters
@@ -241,36 +305,72 @@ class FastParams(ScenarioParams):
     wind: float = param(DEFAULT_WIND_M_S, "mean wind at the cabin", **MEAN_SPEED)
     wind_direction: float = param(WIND_AZIMUTH_DEG, "azimuth the wind blows toward, from east toward north", **_ANGLE)
     turbulence_intensity: float | None = param(
-        None, "sigma_u / U of the turbulence; none: the spectrum's own (Kaimal: IEC class B)", "", low=0.0, high=0.5,
-        reason="beyond 0.5 a one-point Gaussian turbulence model does not hold")
+        None,
+        "sigma_u / U of the turbulence; none: the spectrum's own (Kaimal: IEC class B)",
+        "",
+        low=0.0,
+        high=0.5,
+        reason="beyond 0.5 a one-point Gaussian turbulence model does not hold",
+    )
     wind_spectrum: str = param("kaimal", "turbulence spectrum", choices=tuple(SPECTRA))
     wind_file: str | None = param(
-        None, "measured wind instead of the model: CSV rows t (s), speed (m/s)[, direction (deg)], covering the "
-        "run; resampled to the control ticks (a relative path is the scenario file's directory's)", path=True)
+        None,
+        "measured wind instead of the model: CSV rows t (s), speed (m/s)[, direction (deg)], covering the "
+        "run; resampled to the control ticks (a relative path is the scenario file's directory's)",
+        path=True,
+    )
     stewart: bool = param(True, "the Stewart stabilizer in the cabin on (off: the feed rides the A-B rotator)")
-    drives: str = param("as-built", "the winches: as-built (each rope within its drive's speed and acceleration, "
-                        "0.5 m/s and 0.05 m/s^2; models/fast/README.md) or ideal (each rope at its command every "
-                        "tick)", choices=DRIVES)
-    sensors: SensorOptions = param(SensorOptions(), "the measurement system (planbench.fast.measurement.SensorOptions: "
-                                   "fused, FAST's, or ideal; its rates, latencies, noises and biases)")
-    cable_segments: int = param(DEFAULT_CABLE_SEGMENTS, "each cable as a chain of this many elastic segments (2: "
-                                "the measured 0.19 Hz cabin-cable mode, models/fast/README.md); 0: straight cables "
-                                "with the lumped catenary law (faster, lowest mode 0.30 Hz)", low=0,
-                                high=max_cable_segments(),
-                                reason="more segments vibrate beyond the 2 ms timestep's limit omega dt <= "
-                                       f"{SEGMENT_OMEGA_DT_LIMIT:g}")
-    duration: float | None = param(None, "simulated time; none: the whole session", "s", low=0.0, low_open=True,
-                                   reason="at least one control tick (checked against control_rate_hz: 20 ms at "
-                                          "the default 50 Hz)")
-    control_rate_hz: float = param(1.0 / CONTROL_DT, "the control loop's rate: the sensors are read and the "
-                                   "controller called once per tick (FAST's own rates are not public: assumed, "
-                                   "sims/fast/physics.py CONTROL_DT; 100 Hz gives the earlier figures)", "Hz",
-                                   low=10.0, high=1.0 / PHYSICS_DT,
-                                   reason="the 2 ms physics step divided by a whole number (500, 250, 166.7, "
-                                          "125, 100, 83.3, 71.4, 62.5, 55.6, 50, ... 10 Hz)")
-    dut1: float = param(0.0, "UT1 - UTC of the observing day (the IERS Bulletin A's value; 0: UTC taken for UT1, "
-                        "at most 0.9 s = 13.5 arcsec of hour angle off)", "s", low=-sky.MAX_DUT1, high=sky.MAX_DUT1,
-                        low_open=True, high_open=True, reason="UTC keeps UT1 - UTC within 0.9 s, by its definition")
+    drives: str = param(
+        "as-built",
+        "the winches: as-built (each rope within its drive's speed and acceleration, "
+        "0.5 m/s and 0.05 m/s^2; models/fast/README.md) or ideal (each rope at its command every "
+        "tick)",
+        choices=DRIVES,
+    )
+    sensors: SensorOptions = param(
+        SensorOptions(),
+        "the measurement system (planbench.fast.measurement.SensorOptions: "
+        "fused, FAST's, or ideal; its rates, latencies, noises and biases)",
+    )
+    cable_segments: int = param(
+        DEFAULT_CABLE_SEGMENTS,
+        "each cable as a chain of this many elastic segments (2: "
+        "the measured 0.19 Hz cabin-cable mode, models/fast/README.md); 0: straight cables "
+        "with the lumped catenary law (faster, lowest mode 0.30 Hz)",
+        low=0,
+        high=max_cable_segments(),
+        reason=f"more segments vibrate beyond the 2 ms timestep's limit omega dt <= {SEGMENT_OMEGA_DT_LIMIT:g}",
+    )
+    duration: float | None = param(
+        None,
+        "simulated time; none: the whole session",
+        "s",
+        low=0.0,
+        low_open=True,
+        reason="at least one control tick (checked against control_rate_hz: 20 ms at the default 50 Hz)",
+    )
+    control_rate_hz: float = param(
+        1.0 / CONTROL_DT,
+        "the control loop's rate: the sensors are read and the "
+        "controller called once per tick (FAST's own rates are not public: assumed, "
+        "sims/fast/physics.py CONTROL_DT; 100 Hz gives the earlier figures)",
+        "Hz",
+        low=10.0,
+        high=1.0 / PHYSICS_DT,
+        reason="the 2 ms physics step divided by a whole number (500, 250, 166.7, "
+        "125, 100, 83.3, 71.4, 62.5, 55.6, 50, ... 10 Hz)",
+    )
+    dut1: float = param(
+        0.0,
+        "UT1 - UTC of the observing day (the IERS Bulletin A's value; 0: UTC taken for UT1, "
+        "at most 0.9 s = 13.5 arcsec of hour angle off)",
+        "s",
+        low=-sky.MAX_DUT1,
+        high=sky.MAX_DUT1,
+        low_open=True,
+        high_open=True,
+        reason="UTC keeps UT1 - UTC within 0.9 s, by its definition",
+    )
 
     def check(self) -> None:
         # The start time first: later checks (the source's zenith angle) compute with it.
@@ -282,11 +382,11 @@ class FastParams(ScenarioParams):
             except (ValueError, TypeError) as e:
                 raise ParamError(f"start_utc = {start!r} is not a UTC time ({_UTC['reason']}): {e}") from None
             if not 1972 <= year <= 2099:
-                raise ParamError(f"start_utc = {start!r} is outside the years 1972-2099, where UTC has its leap "
-                                 "seconds")
+                raise ParamError(
+                    f"start_utc = {start!r} is outside the years 1972-2099, where UTC has its leap seconds"
+                )
         if self.cable_segments == 1:
-            raise ParamError("cable_segments = 1 is not a chain: 0 (lumped cables) or 2 ... "
-                             f"{max_cable_segments()}")
+            raise ParamError(f"cable_segments = 1 is not a chain: 0 (lumped cables) or 2 ... {max_cable_segments()}")
         if self.wind_file is not None:
             try:
                 MeasuredWind(self.wind_file)
@@ -294,13 +394,17 @@ class FastParams(ScenarioParams):
                 raise ParamError(f"wind_file: {e}") from None
         steps = 1.0 / (self.control_rate_hz * PHYSICS_DT)
         if abs(steps - round(steps)) > 1e-6:
-            raise ParamError(f"control_rate_hz = {self.control_rate_hz:g} Hz is not the 2 ms physics step divided "
-                             f"by a whole number (it would be {steps:.3g} steps a tick): 500 / k Hz, e.g. 50 or 100")
+            raise ParamError(
+                f"control_rate_hz = {self.control_rate_hz:g} Hz is not the 2 ms physics step divided "
+                f"by a whole number (it would be {steps:.3g} steps a tick): 500 / k Hz, e.g. 50 or 100"
+            )
         self.sensors.check_rates(self.control_rate_hz)
         if self.duration is not None and self.duration < self.control_dt * (1.0 - 1e-9):
-            raise ParamError(f"duration = {self.duration:g} s is outside [{self.control_dt:g}, ...] s: at least one "
-                             f"control tick ({self.control_dt * 1e3:g} ms) at control_rate_hz = "
-                             f"{self.control_rate_hz:g} Hz")
+            raise ParamError(
+                f"duration = {self.duration:g} s is outside [{self.control_dt:g}, ...] s: at least one "
+                f"control tick ({self.control_dt * 1e3:g} ms) at control_rate_hz = "
+                f"{self.control_rate_hz:g} Hz"
+            )
         if self.duration is not None:
             run_limits.check_duration(self.duration, self.control_dt, self.log_bytes_per_tick())
 
@@ -317,14 +421,27 @@ class FastParams(ScenarioParams):
 class FastSourceParams(FastParams):
     """A session on one source: by catalogue name or by RA/Dec, from a start time."""
 
-    source: str | None = param("3C 286", "the source, from the built-in catalogue (planbench.fast.SOURCES); for "
-                               "source_radec instead leave it out (a scenario file: giving source_radec clears "
-                               "it) or --set source=none", choices=tuple(SOURCES), excludes=("source_radec",))
+    source: str | None = param(
+        "3C 286",
+        "the source, from the built-in catalogue (planbench.fast.SOURCES); for "
+        "source_radec instead leave it out (a scenario file: giving source_radec clears "
+        "it) or --set source=none",
+        choices=tuple(SOURCES),
+        excludes=("source_radec",),
+    )
     source_radec: tuple[float, ...] | None = param(
-        None, "the source's ICRS (J2000) right ascension and declination; none: source", unit=("deg", "deg"),
-        low=(0.0, -90.0), high=(360.0, 90.0), reason="RA and Dec", length=2, excludes=("source",))
-    start_utc: str | None = param(None, "the observation's start; none: centred on the source's transit nearest "
-                                  f"{OBSERVING_NIGHT}", **_UTC)
+        None,
+        "the source's ICRS (J2000) right ascension and declination; none: source",
+        unit=("deg", "deg"),
+        low=(0.0, -90.0),
+        high=(360.0, 90.0),
+        reason="RA and Dec",
+        length=2,
+        excludes=("source",),
+    )
+    start_utc: str | None = param(
+        None, f"the observation's start; none: centred on the source's transit nearest {OBSERVING_NIGHT}", **_UTC
+    )
 
     def source_of(self):
         """A catalogue name, or (ra, dec) in rad."""
@@ -333,8 +450,10 @@ class FastSourceParams(FastParams):
     def check(self) -> None:
         super().check()
         if self.source is not None and self.source_radec is not None:
-            raise ParamError(f"source = {self.source!r} and source_radec = {list(self.source_radec)} are both given: "
-                             "give one (leave source out to observe at source_radec)")
+            raise ParamError(
+                f"source = {self.source!r} and source_radec = {list(self.source_radec)} are both given: "
+                "give one (leave source out to observe at source_radec)"
+            )
         if self.source is None and self.source_radec is None:
             raise ParamError("source and source_radec are both none: give one (a catalogue name or [RA, Dec] deg)")
 
@@ -343,9 +462,15 @@ class FastSourceParams(FastParams):
 class FastTrackingParams(FastSourceParams):
     """Park -> the source, start, tracking, termination."""
 
-    tracking: float = param(1200.0, "time on the source", "s", low=10.0, high=6 * 3600.0,
-                            reason="10 s to 6 h (a source stays within 40 deg of FAST's zenith for at most 5.9 h: at "
-                                   "Dec = latitude, cos H = (cos 40 - sin^2 lat) / cos^2 lat, H = 44.6 deg)")
+    tracking: float = param(
+        1200.0,
+        "time on the source",
+        "s",
+        low=10.0,
+        high=6 * 3600.0,
+        reason="10 s to 6 h (a source stays within 40 deg of FAST's zenith for at most 5.9 h: at "
+        "Dec = latitude, cos H = (cos 40 - sin^2 lat) / cos^2 lat, H = 44.6 deg)",
+    )
 
     def check(self) -> None:
         super().check()
@@ -354,32 +479,53 @@ class FastTrackingParams(FastSourceParams):
         try:
             sky.track(ra, dec, start, self.tracking, step=max(self.tracking / 100.0, 1.0), dut1=self.dut1)
         except fast.ZenithLimitError as e:
-            raise ParamError(f"source, start_utc, tracking: {e} (FAST observes within 40 deg of the zenith, "
-                             "Table 1)") from None
+            raise ParamError(
+                f"source, start_utc, tracking: {e} (FAST observes within 40 deg of the zenith, Table 1)"
+            ) from None
 
 
 @dataclass(frozen=True)
 class FastScanParams(FastSourceParams):
     """The paper's motion scan: legs along RA or Dec around the source, with transitions."""
 
-    legs_along: str = param("dec", "the legs run along Dec (the paper's scan along RA, Fig. 8) or along RA "
-                            "(Fig. 11)", choices=("dec", "ra"))
+    legs_along: str = param(
+        "dec", "the legs run along Dec (the paper's scan along RA, Fig. 8) or along RA (Fig. 11)", choices=("dec", "ra")
+    )
     legs: int = param(RA_SCAN["legs"], "number of legs", low=1, high=50, reason="a raster of 1 to 50 legs")
-    leg_length: float = param(RA_SCAN["leg_deg"], "length of a leg on the sky", "deg", low=0.01, high=10.0,
-                              reason="36 arcsec to 10 deg")
-    scan_speed: float = param(RA_SCAN["speed_deg_h"], "scan speed along a leg", "deg/h", low=0.1, high=60.0,
-                              reason="the paper's 5-15 deg/h; 60 deg/h is FAST's fastest scan")
-    leg_spacing: float = param(RA_SCAN["spacing_deg"], "spacing of the legs", "deg", low=0.001, high=1.0,
-                               reason="3.6 arcsec to 1 deg (the paper: 3 arcmin)")
+    leg_length: float = param(
+        RA_SCAN["leg_deg"], "length of a leg on the sky", "deg", low=0.01, high=10.0, reason="36 arcsec to 10 deg"
+    )
+    scan_speed: float = param(
+        RA_SCAN["speed_deg_h"],
+        "scan speed along a leg",
+        "deg/h",
+        low=0.1,
+        high=60.0,
+        reason="the paper's 5-15 deg/h; 60 deg/h is FAST's fastest scan",
+    )
+    leg_spacing: float = param(
+        RA_SCAN["spacing_deg"],
+        "spacing of the legs",
+        "deg",
+        low=0.001,
+        high=1.0,
+        reason="3.6 arcsec to 1 deg (the paper: 3 arcmin)",
+    )
 
 
 @dataclass(frozen=True)
 class FastSwitchParams(FastParams):
     """Tracking one source after another, with focal-surface switches between."""
 
-    sources: tuple[str, ...] = param(("3C 286", "3C 295"), "the sources, in order, from the catalogue",
-                                     choices=tuple(SOURCES), min_items=2, max_items=10,
-                                     reason="a switch needs two; ten fill a night")
+    sources: tuple[str, ...] = param(
+        ("3C 286", "3C 295"),
+        "the sources, in order, from the catalogue",
+        choices=tuple(SOURCES),
+        min_items=2,
+        max_items=10,
+        reason="a switch needs two; ten fill a night",
+    )
     tracking: float = param(300.0, "time on each source", "s", low=10.0, high=3600.0, reason="10 s to an hour")
-    start_utc: str | None = param(None, "the first observation's start; none: the first source's transit "
-                                  f"nearest {OBSERVING_NIGHT}", **_UTC)
+    start_utc: str | None = param(
+        None, f"the first observation's start; none: the first source's transit nearest {OBSERVING_NIGHT}", **_UTC
+    )

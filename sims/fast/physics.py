@@ -89,8 +89,9 @@ def unstretched_length(chord, tension, span, ea: float = CABLE_EA, weight: float
     return np.asarray(chord) / chord_factor(tension, span, ea, weight)
 
 
-def catenary_tension(chord, unstretched, span, guess, iterations: int = 30,
-                     ea: float = CABLE_EA, weight: float = CABLE_WEIGHT):
+def catenary_tension(
+    chord, unstretched, span, guess, iterations: int = 30, ea: float = CABLE_EA, weight: float = CABLE_WEIGHT
+):
     """The tension (N) at which a cable of unstretched length L0 spans the chord ``chord``.
 
     Newton's method on L0 g(T) - L = 0 from ``guess``; g is increasing in T, so the root is
@@ -183,8 +184,12 @@ def end_fraction(segments: int, load: bool) -> float:
 SEGMENT_OMEGA_DT_LIMIT = 0.7
 
 
-def max_cable_segments(shortest_cable_m: float | None = None, timestep: float | None = None,
-                       ea: float = CABLE_EA, mass_per_length: float = fast.FAST.cable_mass_per_length) -> int:
+def max_cable_segments(
+    shortest_cable_m: float | None = None,
+    timestep: float | None = None,
+    ea: float = CABLE_EA,
+    mass_per_length: float = fast.FAST.cable_mass_per_length,
+) -> int:
     """The most segments a discretized cable may have: its segments' axial mode
     omega = 2 sqrt(EA / mu) n / L must keep omega dt <= SEGMENT_OMEGA_DT_LIMIT.
 
@@ -199,7 +204,7 @@ def max_cable_segments(shortest_cable_m: float | None = None, timestep: float | 
     if shortest_cable_m is None or timestep is None:
         model = _compiled(0)
         if shortest_cable_m is None:
-            shortest_cable_m = float(np.min(model.key("home").ctrl[:len(CABLE_ACTUATORS)]))
+            shortest_cable_m = float(np.min(model.key("home").ctrl[: len(CABLE_ACTUATORS)]))
         if timestep is None:
             timestep = float(model.opt.timestep)
     wave = 2.0 * math.sqrt(ea / mass_per_length)  # omega l, m/s
@@ -215,8 +220,12 @@ def _compiled(cable_segments: int = 0) -> mujoco.MjModel:
     return discretized_spec(cable_segments).compile()
 
 
-def discretized_spec(segments: int, spec: mujoco.MjSpec | None = None, ea: float = CABLE_EA,
-                     mass_per_length: float = fast.FAST.cable_mass_per_length) -> mujoco.MjSpec:
+def discretized_spec(
+    segments: int,
+    spec: mujoco.MjSpec | None = None,
+    ea: float = CABLE_EA,
+    mass_per_length: float = fast.FAST.cable_mass_per_length,
+) -> mujoco.MjSpec:
     """models/fast (or ``spec``, a perturbed plant's: ``FastPlant.spec``) with each cable
     discretized into ``segments`` elastic segments of the cables' ``ea`` (N) and
     ``mass_per_length`` (kg/m).
@@ -250,13 +259,26 @@ def discretized_spec(segments: int, spec: mujoco.MjSpec | None = None, ea: float
         anchor = home_data.site_xpos[home.site(f"anchor{i}").id]
         sites = [f"tower{i}_top"]
         for k in range(1, segments):
-            node = spec.worldbody.add_body(name=f"cable{i}_node{k}", pos=top + (anchor - top) * k / segments,
-                                           gravcomp=node_gravcomp(segments))
+            node = spec.worldbody.add_body(
+                name=f"cable{i}_node{k}", pos=top + (anchor - top) * k / segments, gravcomp=node_gravcomp(segments)
+            )
             for axis, label in zip(np.eye(3), "xyz", strict=True):
-                node.add_joint(name=f"cable{i}_node{k}_{label}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=axis,
-                               damping=2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass)
-            node.add_geom(name=f"cable{i}_node{k}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.3, 0, 0],
-                          mass=mass, contype=0, conaffinity=0, group=2, rgba=[0.12, 0.12, 0.14, 1])
+                node.add_joint(
+                    name=f"cable{i}_node{k}_{label}",
+                    type=mujoco.mjtJoint.mjJNT_SLIDE,
+                    axis=axis,
+                    damping=2 * NODE_DAMPING_RATIO * 2 * math.pi * STRING_MODE_HZ * mass,
+                )
+            node.add_geom(
+                name=f"cable{i}_node{k}",
+                type=mujoco.mjtGeom.mjGEOM_SPHERE,
+                size=[0.3, 0, 0],
+                mass=mass,
+                contype=0,
+                conaffinity=0,
+                group=2,
+                rgba=[0.12, 0.12, 0.14, 1],
+            )
             node.add_site(name=f"cable{i}_node{k}")
             sites.append(f"cable{i}_node{k}")
         sites.append(f"anchor{i}")
@@ -277,7 +299,7 @@ class FastPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/fast/scene.xml with FAST's accessors."""
 
     @classmethod
-    def load(cls, cable_segments: int = 0, plant: "FastPlant | None" = None) -> "FastPhysics":
+    def load(cls, cable_segments: int = 0, plant: FastPlant | None = None) -> FastPhysics:
         """The model at keyframe home; ``cable_segments`` >= 2 for the discretized cables;
         ``plant`` (None or nominal: the model as it is) perturbs it (``FastPlant.model``)."""
         if plant is None or plant.is_nominal:
@@ -421,8 +443,7 @@ class FastPhysics(dm_mujoco.Physics):
         mass = model.body_mass[ids]
         return float(mass.sum()), (mass[:, None] * data.xipos[ids]).sum(axis=0) / mass.sum()
 
-    def set_configuration(self, origin, rotation, theta_a: float, theta_b: float,
-                          multifeed: float = 0.0) -> None:
+    def set_configuration(self, origin, rotation, theta_a: float, theta_b: float, multifeed: float = 0.0) -> None:
         """Put the feed support at rest: cabin pose, A-B angles, Stewart legs nominal (the
         universal joints and slides at zero, the platform where the loops close)."""
         model, data = self.model.ptr, self.data.ptr
@@ -430,14 +451,14 @@ class FastPhysics(dm_mujoco.Physics):
         rotation = np.asarray(rotation, dtype=float)
         data.qpos[:] = model.qpos0
         cabin = self._qpos_adr("cabin")
-        data.qpos[cabin:cabin + 3] = origin
-        data.qpos[cabin + 3:cabin + 7] = wxyz(rotation)
+        data.qpos[cabin : cabin + 3] = origin
+        data.qpos[cabin + 3 : cabin + 7] = wxyz(rotation)
         data.qpos[self.ab_qpos] = theta_a, theta_b
         g = fast.FAST
         r_ab = fast.ab_rotation(theta_a, theta_b, g.alpha)
         plat = self._qpos_adr("feed_platform")
-        data.qpos[plat:plat + 3] = origin + rotation @ (g.ab_center + r_ab @ g.r_ab_s)
-        data.qpos[plat + 3:plat + 7] = wxyz(rotation @ r_ab)
+        data.qpos[plat : plat + 3] = origin + rotation @ (g.ab_center + r_ab @ g.r_ab_s)
+        data.qpos[plat + 3 : plat + 7] = wxyz(rotation @ r_ab)
         data.qpos[self.multifeed_qpos] = multifeed
         data.qvel[:] = 0.0
         data.act[:] = 0.0
@@ -469,19 +490,24 @@ class FastPhysics(dm_mujoco.Physics):
                 point = np.array([np.interp(share * arc[-1], arc, curve[:, j]) for j in range(3)])
                 body = model.body(f"cable{i + 1}_node{k}")
                 adr = model.jnt_qposadr[body.jntadr[0]]
-                data.qpos[adr:adr + 3] = point - model.body_pos[body.id]
+                data.qpos[adr : adr + 3] = point - model.body_pos[body.id]
 
     @functools.cached_property
     def node_bodies(self) -> np.ndarray:
         """(6, segments - 1) body ids of the discretized cables' nodes, tower to anchor."""
-        return np.array([[self.model.ptr.body(f"cable{i}_node{k}").id for k in range(1, self.cable_segments)]
-                         for i in range(1, 7)])
+        return np.array(
+            [[self.model.ptr.body(f"cable{i}_node{k}").id for k in range(1, self.cable_segments)] for i in range(1, 7)]
+        )
 
     @functools.cached_property
     def segment_tendons(self) -> np.ndarray:
         """(6, segments) tendon ids of the discretized cables' segments, tower to anchor."""
-        return np.array([[self.model.ptr.tendon(f"cable{i}_seg{k}").id for k in range(1, self.cable_segments + 1)]
-                         for i in range(1, 7)])
+        return np.array(
+            [
+                [self.model.ptr.tendon(f"cable{i}_seg{k}").id for k in range(1, self.cable_segments + 1)]
+                for i in range(1, 7)
+            ]
+        )
 
     def anchor_forces(self) -> np.ndarray:
         """(6, 3) force of each cable on the cabin at its anchor, N (world)."""

@@ -56,17 +56,17 @@ def fast_report(ts: dict, t: np.ndarray, checks, path, tension_min: float) -> No
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
     observing = ts["observing"].astype(bool)
     for ax in axes.flat:
-        ax.fill_between(t, 0, 1, where=observing, transform=ax.get_xaxis_transform(),
-                        color="0.93", lw=0)
+        ax.fill_between(t, 0, 1, where=observing, transform=ax.get_xaxis_transform(), color="0.93", lw=0)
     ax = axes[0, 0]
     ax.plot(t, ts["feed_error_mm"], lw=0.7, label="feed |actual - planned|")
-    ax.plot(t, 1e3 * np.linalg.norm(ts["cabin_pos_actual"] - ts["cabin_pos_planned"], axis=1), lw=0.7,
-            label="cabin origin")
+    ax.plot(
+        t, 1e3 * np.linalg.norm(ts["cabin_pos_actual"] - ts["cabin_pos_planned"], axis=1), lw=0.7, label="cabin origin"
+    )
     ax.set(title="position errors (grey: observing)", xlabel="t [s]", ylabel="mm")
     ax.legend(fontsize=8)
     ax = axes[0, 1]
     for j, name in enumerate(ts["cable_names"]):
-        line, = ax.plot(t, ts["cable_tension"][:, j] / 1e3, lw=0.7, label=str(name))
+        (line,) = ax.plot(t, ts["cable_tension"][:, j] / 1e3, lw=0.7, label=str(name))
         ax.plot(t, ts["cable_tension_planned"][:, j] / 1e3, "--", color=line.get_color(), lw=0.6)
     ax.axhline(tension_min / 1e3, color="r", lw=0.8)
     ax.set_ylim(bottom=0.0)

@@ -12,20 +12,30 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from planbench.planners import fast
-from planbench.planners.fast import plan as fp
-from planbench.planners.fast import sky as sky
-from planbench.planners.errors import LimitError
 from planbench import run_limits
 from planbench.checks import Check
 from planbench.controllers import demanded_force
 from planbench.fast.controller import ControllerOptions, FastController, parked_command, winch_feedforward
 from planbench.fast.loads import CableLoads, ChainCableLoads, Winches
 from planbench.fast.measurement import FusedSensors, SensorOptions, estimate_errors, make_sensors
-from planbench.fast.params import (DEC_SCAN, RA_SCAN, FastParams, FastPlant, FastScanParams, FastSwitchParams,
-                              FastTrackingParams, _radec, _start, _transit)
+from planbench.fast.params import (
+    DEC_SCAN,
+    RA_SCAN,
+    FastParams,
+    FastPlant,
+    FastScanParams,
+    FastSwitchParams,
+    FastTrackingParams,
+    _radec,
+    _start,
+    _transit,
+)
 from planbench.fast.physics import CONTROL_DT, STRING_MODE_HZ, FastPhysics
 from planbench.params import ParamError
+from planbench.planners import fast
+from planbench.planners.errors import LimitError
+from planbench.planners.fast import plan as fp
+from planbench.planners.fast import sky as sky
 from planbench.runner import RunLog, Setup
 from planbench.scenarios import BENCHMARK, DEMO, Scenario
 from planbench.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
@@ -50,22 +60,30 @@ def _observation(source, start_jd, duration: float, name: str, dut1: float = 0.0
     return fp.observation_segment(path.t, path.directions(), name=name, angles=angles), path
 
 
-def tracking_plan(duration: float = 1200.0, source="3C 286", start_utc: str | None = None,
-                  dut1: float = 0.0) -> fp.FastPlan:
+def tracking_plan(
+    duration: float = 1200.0, source="3C 286", start_utc: str | None = None, dut1: float = 0.0
+) -> fp.FastPlan:
     """Park -> source (switch), start, ``duration`` s of tracking from ``start_utc`` (default
     centred on the transit), termination. ``source``: a catalogue name or (ra, dec) rad;
     ``dut1``: UT1 - UTC, s."""
-    obs, path = _observation(source, _start(source, start_utc, duration, dut1), duration,
-                             f"observation ({source_name(source)})", dut1)
+    obs, path = _observation(
+        source, _start(source, start_utc, duration, dut1), duration, f"observation ({source_name(source)})", dut1
+    )
     start, stop = fp.start_segment(obs), fp.termination_segment(obs)
     switch, times = fp.switch_segments(PARK, start.start, multifeed1=fp.start_angle(obs, start))
-    return fp.FastPlan(switch + [start, obs, stop], info={
-        "source": source_name(source), "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
-        "switch_times_s": times.__dict__})
+    return fp.FastPlan(
+        switch + [start, obs, stop],
+        info={
+            "source": source_name(source),
+            "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
+            "switch_times_s": times.__dict__,
+        },
+    )
 
 
-def source_switch_plan(duration: float = 300.0, sources=("3C 286", "3C 295"),
-                       start_utc: str | None = None, dut1: float = 0.0) -> fp.FastPlan:
+def source_switch_plan(
+    duration: float = 300.0, sources=("3C 286", "3C 295"), start_utc: str | None = None, dut1: float = 0.0
+) -> fp.FastPlan:
     """Park -> the first source, track, stop; then for each next source a switch along the
     focal surface, track, stop. The first observation starts at ``start_utc`` (default the
     first source's transit), each next one when the switch to it ends."""
@@ -85,11 +103,13 @@ def source_switch_plan(duration: float = 300.0, sources=("3C 286", "3C 295"),
         guess = t_end
         for _ in range(3):
             offset = guess + 1.0  # s from the first observation's start
-            obs_b, _ = _observation(source, (jd1, jd2 + offset / 86400.0), duration,
-                                    f"observation ({source_name(source)})", dut1)
+            obs_b, _ = _observation(
+                source, (jd1, jd2 + offset / 86400.0), duration, f"observation ({source_name(source)})", dut1
+            )
             start_b = fp.start_segment(obs_b)
-            switch_b, times_b = fp.switch_segments(p0, start_b.start, multifeed0=fp.end_angle(obs_a, stop_a),
-                                                   multifeed1=fp.start_angle(obs_b, start_b))
+            switch_b, times_b = fp.switch_segments(
+                p0, start_b.start, multifeed0=fp.end_angle(obs_a, stop_a), multifeed1=fp.start_angle(obs_b, start_b)
+            )
             guess = t_end + sum(s.duration for s in switch_b) + start_b.duration
         stop_b = fp.termination_segment(obs_b)
         segments += switch_b + [start_b, obs_b, stop_b]
@@ -118,18 +138,29 @@ def write_figures(plan: fp.FastPlan, out_dir) -> None:
 
     t = np.arange(0.0, plan.duration, 0.1)
     fast_plan_figure(plan, t, Path(out_dir) / "figures.png")
-    (Path(out_dir) / "segments.json").write_text(json.dumps(
-        {"segments": plan.segment_table(), "info": plan.info}, indent=1, default=float))
+    (Path(out_dir) / "segments.json").write_text(
+        json.dumps({"segments": plan.segment_table(), "info": plan.info}, indent=1, default=float)
+    )
 
 
 # ----------------------------------------------------------------------------- motion scans
+
 
 def _scan_factory(spec: dict, source="3C 286"):
     ra, dec = _radec(source)
 
     def make(t2: float):
-        return sky.MotionScan(ra, dec, spec["legs_along"], np.radians(spec["leg_deg"]), spec["legs"],
-                              np.radians(spec["spacing_deg"]), spec["speed_deg_h"] * sky.DEG_PER_HOUR, t2)
+        return sky.MotionScan(
+            ra,
+            dec,
+            spec["legs_along"],
+            np.radians(spec["leg_deg"]),
+            spec["legs"],
+            np.radians(spec["spacing_deg"]),
+            spec["speed_deg_h"] * sky.DEG_PER_HOUR,
+            t2,
+        )
+
     return make
 
 
@@ -172,8 +203,13 @@ def scan_plan(spec: dict, source="3C 286", start_utc: str | None = None, dut1: f
         pos, vel, _ = tr.evaluate(tau)
         length = float(np.sum(np.linalg.norm(np.diff(pos, axis=0), axis=1)))
         chord = pos[-1] - pos[0]
-        geometric.update({"l_2_mm": 1e3 * length, "V_c_mm_s": 1e3 * 2 * length / tr.duration,
-                          "p_c": float(chord[1] / chord[0]) if chord[0] else float("inf")})
+        geometric.update(
+            {
+                "l_2_mm": 1e3 * length,
+                "V_c_mm_s": 1e3 * 2 * length / tr.duration,
+                "p_c": float(chord[1] / chord[0]) if chord[0] else float("inf"),
+            }
+        )
     if spec["legs_along"] == "dec":
         paper = fp.paper_ra_scan_fits(speed, t2)
         name = "motion scan along right ascension (legs along Dec), eq. 11-14"
@@ -182,10 +218,17 @@ def scan_plan(spec: dict, source="3C 286", start_utc: str | None = None, dut1: f
         v_m, v_inv = geometric["V_m_mm_s"], geometric["V_m_inv_mm_s"]
         geometric["t3_s"] = 2 * v_m / (fast.A_MAX * 1e3) + 2 * v_inv / (fast.A_MAX * 1e3)
         name = "motion scan along declination (legs along RA), eq. 15-20"
-    return fp.FastPlan(switch + [start] + segments + [stop], info={
-        "scan": name, "speed_deg_h": speed, "paper_empirical": paper, "geometric": geometric,
-        "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
-        "switch_times_s": times.__dict__})
+    return fp.FastPlan(
+        switch + [start] + segments + [stop],
+        info={
+            "scan": name,
+            "speed_deg_h": speed,
+            "paper_empirical": paper,
+            "geometric": geometric,
+            "observation_start_utc": sky.jd_to_iso(path.jd1[0], path.jd2[0]),
+            "switch_times_s": times.__dict__,
+        },
+    )
 
 
 def ra_scan_plan() -> fp.FastPlan:
@@ -215,6 +258,8 @@ OUTPUT_RATE_HZ = 10.0
 def output_stride(control_dt: float) -> int:
     """Ticks between two rows of a long run's timeseries.npz (OUTPUT_RATE_HZ)."""
     return max(1, int(round(1.0 / (OUTPUT_RATE_HZ * control_dt))))
+
+
 #: Segments during which the feed must hold its accuracy (names of planbench.planners.fast_plan).
 OBSERVING_PREFIXES = ("observation", "leg", "transition")
 
@@ -244,8 +289,16 @@ class FastEvaluation:
     judged); ``planned_tower_tops`` (6, 3) m, the nominal model's cable exits from which the
     plan's unstretched lengths are computed (default the plant's: the nominal plant)."""
 
-    def __init__(self, physics: FastPhysics, problem: fp.FastProblem, loads: CableLoads, description: dict,
-                 planned_tower_tops: np.ndarray | None = None, sensors=None, stride: int = 1):
+    def __init__(
+        self,
+        physics: FastPhysics,
+        problem: fp.FastProblem,
+        loads: CableLoads,
+        description: dict,
+        planned_tower_tops: np.ndarray | None = None,
+        sensors=None,
+        stride: int = 1,
+    ):
         self.physics, self.problem, self.loads = physics, problem, loads
         self.sensors = sensors  # the fused system's estimates are judged against the truth
         self.planned_tower_tops = planned_tower_tops
@@ -301,8 +354,9 @@ class FastEvaluation:
             "ab_actual": rows["qpos"][:, p.ab_qpos],
             "stewart_leg": legs,
             "stewart_setpoint": rows["act"][:, p.leg_act],
-            "stewart_force_demanded": demanded_force(kp, kv, rows["act"][:, p.leg_act], legs,
-                                                     rows["qvel"][:, p.leg_dofs]),
+            "stewart_force_demanded": demanded_force(
+                kp, kv, rows["act"][:, p.leg_act], legs, rows["qvel"][:, p.leg_dofs]
+            ),
             "segment": segment,
             "observing": observing_mask(self.goal, segment),
         }
@@ -329,7 +383,7 @@ class FastEvaluation:
                 scalars[key].append(s[key])
             for key, value in s.items():
                 # (a copy: a view would keep the whole chunk it was read with)
-                rows_kept.setdefault(key, []).append(value[-start % self.stride::self.stride].copy())
+                rows_kept.setdefault(key, []).append(value[-start % self.stride :: self.stride].copy())
             tension, law = s["cable_tension"], s["cable_tension_law"]
             low = np.unravel_index(np.argmin(tension), tension.shape)
             high = np.unravel_index(np.argmax(law), law.shape)
@@ -341,8 +395,12 @@ class FastEvaluation:
             extreme("leg_abs", np.abs(s["stewart_leg"]).max(initial=0.0), None, lambda a, b: a > b)
             extreme("setpoint_abs", np.abs(s["stewart_setpoint"]).max(initial=0.0), None, lambda a, b: a > b)
             extreme("force_abs", np.abs(s["stewart_force_demanded"]).max(), None, lambda a, b: a > b)
-            extreme("feedback_abs", np.abs(s["cable_unstretched"] - s["cable_unstretched_planned"]).max(), None,
-                    lambda a, b: a > b)
+            extreme(
+                "feedback_abs",
+                np.abs(s["cable_unstretched"] - s["cable_unstretched_planned"]).max(),
+                None,
+                lambda a, b: a > b,
+            )
             ab = np.abs(s["ab_actual"] - s["ab_planned"]).max(axis=0)
             ext["ab_abs"] = (ab if "ab_abs" not in ext else np.maximum(ext["ab_abs"][0], ab), None)
         out = {key: np.concatenate(parts) for key, parts in scalars.items()}
@@ -358,8 +416,9 @@ class FastEvaluation:
         n = log.n
         observing = s["observing"]
         window = observing if observing.any() else np.ones(n, bool)
-        where = ("over the observing segments" if observing.any()
-                 else "no observing segment in this run: over the whole run")
+        where = (
+            "over the observing segments" if observing.any() else "no observing segment in this run: over the whole run"
+        )
         feed_mm, cabin_mm = 1e3 * s["feed_error"], 1e3 * s["cabin_error"]
         t_min = fast.FAST_LIMITS.tension_min
         tension_min, low = ext["tension_min"]
@@ -372,51 +431,81 @@ class FastEvaluation:
             return float(log.t[row])
 
         checks = [
-            Check("feed_error_rms", _rms(feed_mm[window]), FEED_RMS_LIMIT_MM, "mm",
-                  note=(f"Stewart {stewart}; " if stewart else "") + f"against the goal feed path; {where}"),
+            Check(
+                "feed_error_rms",
+                _rms(feed_mm[window]),
+                FEED_RMS_LIMIT_MM,
+                "mm",
+                note=(f"Stewart {stewart}; " if stewart else "") + f"against the goal feed path; {where}",
+            ),
             Check("feed_error_max", float(feed_mm[window].max()), FEED_MAX_LIMIT_MM, "mm", note=where),
-            Check("cabin_error_rms", _rms(cabin_mm[window]), CABIN_RMS_LIMIT_MM, "mm",
-                  note=f"cabin origin; {where}"),
-            Check("cable_tension_min", float(tension_min) / 1e3, t_min / 1e3, "kN", ">=",
-                  note=f"cable{low[1] + 1} at t = {time_of(low[0]):.2f} s; a slack cable fails"),
-            Check("cable_tension_max", float(law_max) / 1e3, p.tension_max / 1e3, "kN",
-                  note=f"cable{high[1] + 1} at t = {time_of(high[0]):.2f} s (catenary law, before the winch's clamp)"),
-            Check("stewart_stroke", 1e3 * float(stroke), 1e3 * fast.STEWART.stroke, "mm",
-                  note="largest leg change, measured or its drive's set-point"),
+            Check("cabin_error_rms", _rms(cabin_mm[window]), CABIN_RMS_LIMIT_MM, "mm", note=f"cabin origin; {where}"),
+            Check(
+                "cable_tension_min",
+                float(tension_min) / 1e3,
+                t_min / 1e3,
+                "kN",
+                ">=",
+                note=f"cable{low[1] + 1} at t = {time_of(low[0]):.2f} s; a slack cable fails",
+            ),
+            Check(
+                "cable_tension_max",
+                float(law_max) / 1e3,
+                p.tension_max / 1e3,
+                "kN",
+                note=f"cable{high[1] + 1} at t = {time_of(high[0]):.2f} s (catenary law, before the winch's clamp)",
+            ),
+            Check(
+                "stewart_stroke",
+                1e3 * float(stroke),
+                1e3 * fast.STEWART.stroke,
+                "mm",
+                note="largest leg change, measured or its drive's set-point",
+            ),
             Check("stewart_force", float(ext["force_abs"][0]) / 1e3, force_limit / 1e3, "kN", note="demanded"),
         ]
         segments = {}
         for k, seg in enumerate(self.goal.segments):
             mask = s["segment"] == k
             if mask.any():
-                segments[seg.name] = segments.get(seg.name, []) + [{
-                    "t0_s": seg.t0, "feed_error_rms_mm": _rms(feed_mm[mask]),
-                    "feed_error_max_mm": float(feed_mm[mask].max()), "cabin_error_rms_mm": _rms(cabin_mm[mask])}]
+                segments[seg.name] = segments.get(seg.name, []) + [
+                    {
+                        "t0_s": seg.t0,
+                        "feed_error_rms_mm": _rms(feed_mm[mask]),
+                        "feed_error_max_mm": float(feed_mm[mask].max()),
+                        "cabin_error_rms_mm": _rms(cabin_mm[mask]),
+                    }
+                ]
         ab_error = np.degrees(ext["ab_abs"][0]) * 3600.0
         metrics = dict(self.description)
-        metrics.update({
-            "cables": (f"{p.cable_segments} segments each" if p.cable_segments
-                       else "straight, lumped catenary law"),
-            "wind_mean_m_s": self.loads.mean_speed,
-            "wind_toward_deg": float(np.degrees(np.arctan2(self.loads.direction[1], self.loads.direction[0]))),
-            "feed_error_rms_all_mm": _rms(feed_mm),
-            "feed_error_max_all_mm": float(feed_mm.max()),
-            "cabin_error_max_mm": float(cabin_mm[window].max()),
-            "observing_s": float(observing.sum() * (log.t[1] - log.t[0])) if n > 1 else 0.0,
-            "segments": segments,
-            "cable_tension_range_kN": [float(tension_min) / 1e3, float(ext["tension_max"][0]) / 1e3],
-            "planned_tension_range_kN": [float(ext["planned_min"][0]) / 1e3, float(ext["planned_max"][0]) / 1e3],
-            # The winch commands less the unstretched lengths the plan implies: the feedback.
-            "cable_feedback_max_mm": 1e3 * float(ext["feedback_abs"][0]),
-            "ab_error_max_arcsec": ab_error.round(2).tolist(),
-            "stewart_leg_max_mm": 1e3 * float(ext["leg_abs"][0]),
-        })
+        metrics.update(
+            {
+                "cables": (
+                    f"{p.cable_segments} segments each" if p.cable_segments else "straight, lumped catenary law"
+                ),
+                "wind_mean_m_s": self.loads.mean_speed,
+                "wind_toward_deg": float(np.degrees(np.arctan2(self.loads.direction[1], self.loads.direction[0]))),
+                "feed_error_rms_all_mm": _rms(feed_mm),
+                "feed_error_max_all_mm": float(feed_mm.max()),
+                "cabin_error_max_mm": float(cabin_mm[window].max()),
+                "observing_s": float(observing.sum() * (log.t[1] - log.t[0])) if n > 1 else 0.0,
+                "segments": segments,
+                "cable_tension_range_kN": [float(tension_min) / 1e3, float(ext["tension_max"][0]) / 1e3],
+                "planned_tension_range_kN": [float(ext["planned_min"][0]) / 1e3, float(ext["planned_max"][0]) / 1e3],
+                # The winch commands less the unstretched lengths the plan implies: the feedback.
+                "cable_feedback_max_mm": 1e3 * float(ext["feedback_abs"][0]),
+                "ab_error_max_arcsec": ab_error.round(2).tolist(),
+                "stewart_leg_max_mm": 1e3 * float(ext["leg_abs"][0]),
+            }
+        )
         if isinstance(self.sensors, FusedSensors):
             metrics["measurement_error_rms"] = estimate_errors(self.sensors, p, log)
         if self.loads.mean_speed > 0:
             wind = self.loads.speed[:n]
-            peak = max(float(np.linalg.norm(part["force"], axis=1).max(initial=0.0))
-                       for part in self.loads.log(n).chunks(["force"]))  # (the max of the chunks' maxima)
+            peak = max(
+                float(np.linalg.norm(part["force"], axis=1).max(initial=0.0))
+                for part in self.loads.log(n).chunks(["force"])
+            )  # (the max of the chunks' maxima)
             metrics.update({"wind_speed_std_m_s": float(np.std(wind)), "wind_force_peak_N": peak})
         return checks, metrics
 
@@ -444,15 +533,14 @@ class FastEvaluation:
             "observing": s["observing"],
         }
         if self.loads.mean_speed > 0:
-            out["wind_speed"] = self.loads.speed[:n][::self.stride]
+            out["wind_speed"] = self.loads.speed[:n][:: self.stride]
             out["wind_force"] = _hold_last_every(self.loads.log(n), "force", n, self.stride)
         return out
 
     def report(self, log: RunLog, checks, path) -> None:
         from planbench.fast.report import fast_report
 
-        fast_report(self.timeseries(log), self.summary(log)["t_every"], checks, path,
-                    fast.FAST_LIMITS.tension_min)
+        fast_report(self.timeseries(log), self.summary(log)["t_every"], checks, path, fast.FAST_LIMITS.tension_min)
 
 
 def problem(plan: fp.FastPlan) -> fp.FastProblem:
@@ -461,9 +549,15 @@ def problem(plan: fp.FastPlan) -> fp.FastProblem:
     return fp.problem_of(plan, OBSERVING_PREFIXES)
 
 
-def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_options: ControllerOptions | None = None,
-          planner=None, controller=None, sensor_options: SensorOptions | None = None,
-          plant: FastPlant | None = None) -> Setup:
+def build(
+    plan: fp.FastPlan | fp.FastProblem,
+    params: FastParams,
+    controller_options: ControllerOptions | None = None,
+    planner=None,
+    controller=None,
+    sensor_options: SensorOptions | None = None,
+    plant: FastPlant | None = None,
+) -> Setup:
     """A run of a session (``plan``: its goal plan, or the problem): ``planner`` (default the
     paper's, whose plan is the goal) plans it, ``controller`` (default ``FastController`` with
     ``controller_options``, else the stabilizer as ``params.stewart`` says) follows it, with
@@ -495,14 +589,14 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
     # The nominal model (the controller's) at the start; the plant is it, or a perturbed copy.
     nominal = FastPhysics.load(segments)
     s0 = fp.reference_state(trajectory.sample(np.array([0.0])))
-    nominal.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
-                              s0.multifeed[0])
+    nominal.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0], s0.multifeed[0])
     nominal.data.ctrl[:] = parked_command(nominal, s0)  # parked: the winches hold the start
     physics = nominal
     if perturbed:
         physics = FastPhysics.load(segments, plant)
-        physics.set_configuration(s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0],
-                                  s0.multifeed[0])
+        physics.set_configuration(
+            s0.cabin_origin[0], s0.cabin_rotation[0], s0.theta_a[0], s0.theta_b[0], s0.multifeed[0]
+        )
         physics.data.ctrl[:] = nominal.data.ctrl  # the operator parks it with the nominal model's lengths
         perturbed_start(physics, nominal, plant)
     description = {}
@@ -511,33 +605,55 @@ def build(plan: fp.FastPlan | fp.FastProblem, params: "FastParams", controller_o
             controller_options = ControllerOptions(stewart=params.stewart)
         controller = FastController(controller_options)
         description["stewart"] = "on" if controller_options.stewart else "off"
-    wind = dict(wind_speed=params.wind, wind_azimuth_deg=params.wind_direction, spectrum=params.wind_spectrum,
-                turbulence_intensity=params.turbulence_intensity, measured=measured,
-                winches=Winches() if params.drives == "as-built" else None)
+    wind = dict(
+        wind_speed=params.wind,
+        wind_azimuth_deg=params.wind_direction,
+        spectrum=params.wind_spectrum,
+        turbulence_intensity=params.turbulence_intensity,
+        measured=measured,
+        winches=Winches() if params.drives == "as-built" else None,
+    )
     if perturbed:
         loads = plant.loads(segments, **wind)  # the true cables' EA and weight
     else:
         loads = (ChainCableLoads if segments else CableLoads)(**wind)
     sensors = make_sensors(physics, params.sensors if sensor_options is None else sensor_options, control_dt)
     stride = output_stride(control_dt) if duration > LONG_RUN_S else 1
-    evaluation = FastEvaluation(physics, session, loads, description, planned_tower_tops=nominal.tower_tops,
-                                sensors=sensors, stride=stride)
-    task = Task(problem=session, sensors=sensors, evaluation=evaluation, control_dt=control_dt, duration=duration,
-                disturbance=loads, nominal_physics=nominal_copy(nominal) if perturbed else None)  # None: a copy
-    return Setup(physics, task, Components(planner=planner, trajectory=trajectory, controller=controller),
-                 Output(output_stride=stride),
-                 Provenance(seed=params.seed, params=params, plant=plant if plant is not None else FastPlant()))
+    evaluation = FastEvaluation(
+        physics, session, loads, description, planned_tower_tops=nominal.tower_tops, sensors=sensors, stride=stride
+    )
+    task = Task(
+        problem=session,
+        sensors=sensors,
+        evaluation=evaluation,
+        control_dt=control_dt,
+        duration=duration,
+        disturbance=loads,
+        nominal_physics=nominal_copy(nominal) if perturbed else None,
+    )  # None: a copy
+    return Setup(
+        physics,
+        task,
+        Components(planner=planner, trajectory=trajectory, controller=controller),
+        Output(output_stride=stride),
+        Provenance(seed=params.seed, params=params, plant=plant if plant is not None else FastPlant()),
+    )
 
 
-def goal_plan(params: "FastParams") -> fp.FastPlan:
+def goal_plan(params: FastParams) -> fp.FastPlan:
     """The session a scenario's parameters describe: tracking, a scan or a switch. A source
     that leaves FAST's 40 deg zenith-angle range during it is a ParamError naming the keys."""
     try:
         if isinstance(params, FastTrackingParams):
             return tracking_plan(params.tracking, params.source_of(), params.start_utc, params.dut1)
         if isinstance(params, FastScanParams):
-            spec = {"legs_along": params.legs_along, "speed_deg_h": params.scan_speed, "leg_deg": params.leg_length,
-                    "legs": params.legs, "spacing_deg": params.leg_spacing}
+            spec = {
+                "legs_along": params.legs_along,
+                "speed_deg_h": params.scan_speed,
+                "leg_deg": params.leg_length,
+                "legs": params.legs,
+                "spacing_deg": params.leg_spacing,
+            }
             return scan_plan(spec, params.source_of(), params.start_utc, params.dut1)
         if isinstance(params, FastSwitchParams):
             return source_switch_plan(params.tracking, params.sources, params.start_utc, params.dut1)
@@ -551,7 +667,7 @@ def goal_plan(params: "FastParams") -> fp.FastPlan:
     raise TypeError(f"no session for {type(params).__name__}")
 
 
-def build_scenario(params: "FastParams", planner=None, controller=None, plant: FastPlant | None = None) -> Setup:
+def build_scenario(params: FastParams, planner=None, controller=None, plant: FastPlant | None = None) -> Setup:
     """A FAST scenario's run: its session (``goal_plan``) built with ``build``; ``plant``: the
     plant's uncertainty (None: nominal)."""
     return build(goal_plan(params), params, planner=planner, controller=controller, plant=plant)
@@ -569,7 +685,9 @@ def build_scenario(params: "FastParams", planner=None, controller=None, plant: F
 SETTLE_CABIN_HZ = 0.30
 SETTLE_SPEED = 1e-6
 SETTLE_MAX_S = 60.0
-SETTLE_DT = 0.01  # s: the loads' tick while settling (the earlier control tick; the settled state does not depend on it)
+SETTLE_DT = (
+    0.01  # s: the loads' tick while settling (the earlier control tick; the settled state does not depend on it)
+)
 
 
 def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: float = SETTLE_MAX_S) -> np.ndarray:
@@ -597,9 +715,11 @@ def static_equilibrium(physics: FastPhysics, loads: CableLoads, max_duration: fl
         mujoco.mj_step(model, data, nstep=steps)
         if tick % 100 == 99 and float(np.abs(data.qvel).max()) < SETTLE_SPEED:
             return data.qpos.copy()
-    raise LimitError(f"the plant does not come to rest within {max_duration:g} s under the parked commands "
-                     f"(joint speeds up to {float(np.abs(data.qvel).max()):.3g}, more than {SETTLE_SPEED:g} m/s or "
-                     "rad/s): a cable slack or a drive at its limit")
+    raise LimitError(
+        f"the plant does not come to rest within {max_duration:g} s under the parked commands "
+        f"(joint speeds up to {float(np.abs(data.qvel).max()):.3g}, more than {SETTLE_SPEED:g} m/s or "
+        "rad/s): a cable slack or a drive at its limit"
+    )
 
 
 def perturbed_start(physics: FastPhysics, nominal: FastPhysics, plant: FastPlant) -> None:
@@ -628,13 +748,20 @@ def perturbed_start(physics: FastPhysics, nominal: FastPhysics, plant: FastPlant
 # ----------------------------------------------------------------------------- scenarios
 
 #: What the FAST runs share: plan plots and the paper's figures.
-_RUN = dict(build=build_scenario, plan=goal_plan, kinds=plan_kinds, plan_extras=write_figures, control_dt=CONTROL_DT,
-            plant=FastPlant())
+_RUN = dict(
+    build=build_scenario,
+    plan=goal_plan,
+    kinds=plan_kinds,
+    plan_extras=write_figures,
+    control_dt=CONTROL_DT,
+    plant=FastPlant(),
+)
 
 SCENARIOS = (
     Scenario(
         "fast-tracking",
-        "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its transit, termination; cables, A-B rotator, Stewart stabilizer under wind",
+        "FAST feed support: park -> 3C 286 (line + focal arc), start, 20 min of tracking across its "
+        "transit, termination; cables, A-B rotator, Stewart stabilizer under wind",
         FastTrackingParams(),
         **_RUN,
         demo_cameras=("closeup",),
@@ -642,13 +769,15 @@ SCENARIOS = (
     ),
     Scenario(
         "fast-ra-scan",
-        "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 deg/h, transitions of the shortest t2 under A_t-max) under wind",
+        "FAST feed support: the paper's motion scan along RA around 3C 286 (4 legs along Dec at 15 "
+        "deg/h, transitions of the shortest t2 under A_t-max) under wind",
         FastScanParams(),
         **_RUN,
     ),
     Scenario(
         "fast-source-switch",
-        "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of tracking, under wind",
+        "FAST feed support: park -> 3C 286, 5 min of tracking, focal-arc switch to 3C 295, 5 min of "
+        "tracking, under wind",
         FastSwitchParams(),
         **_RUN,
     ),
@@ -657,9 +786,15 @@ SCENARIOS = (
 PLANS = (
     Scenario(
         "fast-dec-scan",
-        "FAST feed: the paper's motion scan along Dec around 3C 286: 3 legs along RA at 5 deg/h, transitions, beside the paper's eq. 15-20",
-        FastScanParams(legs_along="ra", legs=DEC_SCAN["legs"], leg_length=DEC_SCAN["leg_deg"],
-                       scan_speed=DEC_SCAN["speed_deg_h"], leg_spacing=DEC_SCAN["spacing_deg"]),
+        "FAST feed: the paper's motion scan along Dec around 3C 286: 3 legs along RA at 5 deg/h, "
+        "transitions, beside the paper's eq. 15-20",
+        FastScanParams(
+            legs_along="ra",
+            legs=DEC_SCAN["legs"],
+            leg_length=DEC_SCAN["leg_deg"],
+            scan_speed=DEC_SCAN["speed_deg_h"],
+            leg_spacing=DEC_SCAN["spacing_deg"],
+        ),
         None,
         goal_plan,
         kinds=plan_kinds,

@@ -23,28 +23,74 @@ and declares the mechanism's record.
 
 from __future__ import annotations
 
-from planbench.planners.hexapod import STRUT_LABELS
-from planbench.hexapod.controller import INTEGRAL_TIME_S, HexapodController
-from planbench.hexapod.params import (ASYNC_TARGET_MM_DEG, CONTROL_DT, DEFAULT_WIND_M_S, SETTLE_S, SYNC_TARGET_MM_DEG,
-                                 HexapodMove, HexapodParams,
-                                 HexapodPlant, pose_mm_deg, pose_si)
-from planbench.hexapod.physics import (DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, PLATFORM_KEY_QPOS, HexapodPhysics,
-                                  apply_plant, check_elevation,
-                                  log_bytes_per_tick, magnified_qpos, top_end_rotation)
 from planbench.hexapod import plan_columns
+from planbench.hexapod.controller import INTEGRAL_TIME_S, HexapodController
+from planbench.hexapod.params import (
+    ASYNC_TARGET_MM_DEG,
+    CONTROL_DT,
+    DEFAULT_WIND_M_S,
+    SETTLE_S,
+    SYNC_TARGET_MM_DEG,
+    HexapodMove,
+    HexapodParams,
+    HexapodPlant,
+    pose_mm_deg,
+    pose_si,
+)
+from planbench.hexapod.physics import (
+    DEFAULT_ELEVATION_DEG,
+    ELEVATION_RANGE_DEG,
+    PLATFORM_KEY_QPOS,
+    HexapodPhysics,
+    apply_plant,
+    check_elevation,
+    log_bytes_per_tick,
+    magnified_qpos,
+    top_end_rotation,
+)
 from planbench.hexapod.plan_checks import judge_plans
 from planbench.hexapod.sensors import sensors
-from planbench.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, ARRIVAL_TOLERANCE, ARRIVAL_ULPS, CAMERA_DRAG_COEFFICIENT,
-                               ENCODER_COUNT_M, ENCODER_SETTLE_M, FOLLOWING_LIMIT_UM, OWN_TIME_LIMIT_S,
-                               POSE_FINAL_LIMIT_UM, SETTLE_WINDOW_S, STRUT_MOVE_THRESHOLD_M, VIDEO_MAGNIFICATION,
-                               WIND_AZIMUTH_DEG, HexapodEvaluation, arrival_times, build, camera_area,
-                               default_duration, end_tick, environment_reward, hexapod_speed_check, plan,
-                               plan_moves, problems, strut_kinds, strut_tolerances)
+from planbench.hexapod.task import (
+    ARRIVAL_SPREAD_LIMIT_S,
+    ARRIVAL_TOLERANCE,
+    ARRIVAL_ULPS,
+    CAMERA_DRAG_COEFFICIENT,
+    ENCODER_COUNT_M,
+    ENCODER_SETTLE_M,
+    FOLLOWING_LIMIT_UM,
+    OWN_TIME_LIMIT_S,
+    POSE_FINAL_LIMIT_UM,
+    SETTLE_WINDOW_S,
+    STRUT_MOVE_THRESHOLD_M,
+    VIDEO_MAGNIFICATION,
+    WIND_AZIMUTH_DEG,
+    HexapodEvaluation,
+    arrival_times,
+    build,
+    camera_area,
+    default_duration,
+    end_tick,
+    environment_reward,
+    hexapod_speed_check,
+    plan,
+    plan_moves,
+    problems,
+    strut_kinds,
+    strut_tolerances,
+)
+from planbench.planners.hexapod import STRUT_LABELS
 from planbench.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
 from planbench.wind import horizontal_direction
 
-_RUN = dict(build=build, plan=plan, kinds=strut_kinds, control_dt=CONTROL_DT, plant=HexapodPlant(), judge_plans=judge_plans,
-            plan_columns=plan_columns)
+_RUN = dict(
+    build=build,
+    plan=plan,
+    kinds=strut_kinds,
+    control_dt=CONTROL_DT,
+    plant=HexapodPlant(),
+    judge_plans=judge_plans,
+    plan_columns=plan_columns,
+)
 
 SCENARIOS = (
     Scenario(
@@ -56,7 +102,8 @@ SCENARIOS = (
     ),
     Scenario(
         "hexapod-async-move",
-        "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at its own minimum time",
+        "Rubin camera hexapod, 3 t camera: asynchronous move of ~2.6 mm and 0.1 deg, each strut at "
+        "its own minimum time",
         HexapodParams(moves=(HexapodMove(ASYNC_TARGET_MM_DEG, False),)),
         **_RUN,
     ),

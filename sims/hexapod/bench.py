@@ -23,18 +23,29 @@ def planning_throughput(n_moves: int = PLANNING_MOVES, seed: int = 0) -> list[di
     rows = []
     for synchronous in (True, False):
         for method in ("closed", "iteration"):
-            best, moves = best_time(lambda synchronous=synchronous, method=method: hexapod.plan_moves(
-                start, target, synchronous=synchronous, method=method))
-            rows.append({"mode": "sync" if synchronous else "async", "method": method,
-                         "moves": len(moves), "wall_s": best, "moves_per_s": len(moves) / best})
+            best, moves = best_time(
+                lambda synchronous=synchronous, method=method: hexapod.plan_moves(
+                    start, target, synchronous=synchronous, method=method
+                )
+            )
+            rows.append(
+                {
+                    "mode": "sync" if synchronous else "async",
+                    "method": method,
+                    "moves": len(moves),
+                    "wall_s": best,
+                    "moves_per_s": len(moves) / best,
+                }
+            )
     return rows
 
 
 def format_planning(rows: list[dict]) -> str:
     lines = [f"{'hexapod batch planning':<24} {'moves':>7} {'wall s':>8} {'moves/s':>10}"]
     for r in rows:
-        lines.append(f"{r['mode'] + ', ' + r['method']:<24} {r['moves']:>7d} {r['wall_s']:>8.4f} "
-                     f"{r['moves_per_s']:>10.0f}")
+        lines.append(
+            f"{r['mode'] + ', ' + r['method']:<24} {r['moves']:>7d} {r['wall_s']:>8.4f} {r['moves_per_s']:>10.0f}"
+        )
     return "\n".join(lines)
 
 

@@ -10,13 +10,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planbench.planners import hexapod as hexapod_planner
-from planbench.planners.errors import LimitError
-from planbench.planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS
 from planbench import run_limits
 from planbench.drives import DRIVES, torque_constant_error
 from planbench.hexapod.physics import DEFAULT_ELEVATION_DEG, ELEVATION_RANGE_DEG, _radial, log_bytes_per_tick
-from planbench.params import Params, ParamError, PlantParams, ScenarioParams, param
+from planbench.params import ParamError, Params, PlantParams, ScenarioParams, param
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.errors import LimitError
+from planbench.planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS
 from planbench.wind import MEAN_SPEED
 
 CONTROL_DT = hexapod_planner.CONTROL_DT  # s: the generator's and the controller's 200 Hz
@@ -54,8 +54,14 @@ class HexapodMove(Params):
     """One move of a hexapod run."""
 
     target: tuple[float, ...] = param(
-        (0.0,) * 6, "target pose x, y, z (mm), rx, ry, rz (deg) of the mirror-side pivot frame",
-        unit=_POSE_UNITS, low=_POSE_LOW, high=_POSE_HIGH, reason=_POSE_REASON, length=6)
+        (0.0,) * 6,
+        "target pose x, y, z (mm), rx, ry, rz (deg) of the mirror-side pivot frame",
+        unit=_POSE_UNITS,
+        low=_POSE_LOW,
+        high=_POSE_HIGH,
+        reason=_POSE_REASON,
+        length=6,
+    )
     synchronous: bool = param(True, "all six struts arrive on the same tick (false: each at its own minimum time)")
 
     def check(self) -> None:
@@ -76,24 +82,51 @@ class HexapodParams(ScenarioParams):
     """A hexapod run: moves one after another from a start pose, at an elevation, in wind."""
 
     start_pose: tuple[float, ...] = param(
-        (0.0,) * 6, "start pose x, y, z (mm), rx, ry, rz (deg); the hexapod starts there at rest",
-        unit=_POSE_UNITS, low=_POSE_LOW, high=_POSE_HIGH, reason=_POSE_REASON, length=6)
+        (0.0,) * 6,
+        "start pose x, y, z (mm), rx, ry, rz (deg); the hexapod starts there at rest",
+        unit=_POSE_UNITS,
+        low=_POSE_LOW,
+        high=_POSE_HIGH,
+        reason=_POSE_REASON,
+        length=6,
+    )
     moves: tuple[HexapodMove, ...] = param(
-        (HexapodMove(),), "the moves, one after another: [[moves]] tables of target and synchronous",
-        min_items=1, max_items=100, reason="at least one move; a hundred fill a night")
-    dwell: float = param(SETTLE_S, "time from the tick one move's trajectory ends on to the next move's start "
-                         "(on the first tick after it)", "s", low=SETTLE_S,
-                         high=600.0, reason="each arrival is judged after the integral action's 1 s of settling")
-    elevation: float = param(DEFAULT_ELEVATION_DEG, "telescope elevation: gravity's direction in the hexapod frame",
-                             "deg", low=ELEVATION_RANGE_DEG[0], high=ELEVATION_RANGE_DEG[1],
-                             reason="the telescope's elevation range")
+        (HexapodMove(),),
+        "the moves, one after another: [[moves]] tables of target and synchronous",
+        min_items=1,
+        max_items=100,
+        reason="at least one move; a hundred fill a night",
+    )
+    dwell: float = param(
+        SETTLE_S,
+        "time from the tick one move's trajectory ends on to the next move's start (on the first tick after it)",
+        "s",
+        low=SETTLE_S,
+        high=600.0,
+        reason="each arrival is judged after the integral action's 1 s of settling",
+    )
+    elevation: float = param(
+        DEFAULT_ELEVATION_DEG,
+        "telescope elevation: gravity's direction in the hexapod frame",
+        "deg",
+        low=ELEVATION_RANGE_DEG[0],
+        high=ELEVATION_RANGE_DEG[1],
+        reason="the telescope's elevation range",
+    )
     wind: float = param(DEFAULT_WIND_M_S, "mean wind on the camera (Kaimal turbulence), 0 for none", **MEAN_SPEED)
-    drives: str = param("as-built", "the struts' drives: as-built (motor, gearbox, ball screw, friction, the drive's "
-                        "loops, a counting encoder; models/hexapod/README.md) or ideal (one stiff servo per strut)",
-                        choices=DRIVES)
-    duration: float | None = param(None, "simulated time; none: to the tick the last move's trajectory ends on, "
-                                   "plus 1 s of settling", "s",
-                                   low=CONTROL_DT, reason="at least one control tick (5 ms)")
+    drives: str = param(
+        "as-built",
+        "the struts' drives: as-built (motor, gearbox, ball screw, friction, the drive's "
+        "loops, a counting encoder; models/hexapod/README.md) or ideal (one stiff servo per strut)",
+        choices=DRIVES,
+    )
+    duration: float | None = param(
+        None,
+        "simulated time; none: to the tick the last move's trajectory ends on, plus 1 s of settling",
+        "s",
+        low=CONTROL_DT,
+        reason="at least one control tick (5 ms)",
+    )
 
     def check(self) -> None:
         _check_pose(self.start_pose, "start_pose")
@@ -103,8 +136,9 @@ class HexapodParams(ScenarioParams):
             # (rz = 5e-222 deg, found by hypothesis) moves no strut, and a plan of it has no length.
             struts = hexapod_planner.strut_positions(np.array([pose_si(previous), pose_si(move.target)]))
             if np.array_equal(struts[0], struts[1]):
-                raise ParamError(f"moves[{i}].target equals the pose before it (no strut length changes): "
-                                 "a move of zero length")
+                raise ParamError(
+                    f"moves[{i}].target equals the pose before it (no strut length changes): a move of zero length"
+                )
             previous = move.target
         if self.duration is not None:
             run_limits.check_duration(self.duration, CONTROL_DT, self.log_bytes_per_tick())
@@ -125,49 +159,89 @@ class HexapodPlant(PlantParams):
     AS_BUILT_FIELDS = ("friction_error", "screw_stiffness_error", "torque_constant_error")
 
     camera_mass_error: float = param(
-        0.0, "true camera mass relative to the model's 3000 kg (its inertia scales with it)", "fraction",
-        low=-0.1, high=0.1,
-        reason="LSSTCam is 'about 3 t' (REFERENCE.md): +-10 % bounds that rounded figure (assumption)")
+        0.0,
+        "true camera mass relative to the model's 3000 kg (its inertia scales with it)",
+        "fraction",
+        low=-0.1,
+        high=0.1,
+        reason="LSSTCam is 'about 3 t' (REFERENCE.md): +-10 % bounds that rounded figure (assumption)",
+    )
     camera_com_offset: tuple[float, ...] = param(
-        (0.0, 0.0, 0.0), "offset of the camera's centre of mass from its axis and mid-length, x, y, z in the "
-        "hexapod frame (its mass and central inertia kept)", "m", low=-0.05, high=0.05, length=3,
+        (0.0, 0.0, 0.0),
+        "offset of the camera's centre of mass from its axis and mid-length, x, y, z in the "
+        "hexapod frame (its mass and central inertia kept)",
+        "m",
+        low=-0.05,
+        high=0.05,
+        length=3,
         reason="the camera's uniform density is an assumption (models/hexapod/README.md); its mass centre is "
-               "taken as known to +-50 mm per axis (cabling, cryostat, filter exchanger; assumption)")
+        "taken as known to +-50 mm per axis (cabling, cryostat, filter exchanger; assumption)",
+    )
     base_pivot_radius_error: float = param(
-        0.0, "radial error of the six base pivots (their circle's radius, 0.692 m, is this much larger)", "m",
-        low=-0.001, high=0.001,
+        0.0,
+        "radial error of the six base pivots (their circle's radius, 0.692 m, is this much larger)",
+        "m",
+        low=-0.001,
+        high=0.001,
         reason="machining and assembly of the pivot circles before a kinematic calibration, assumed +-1 mm; "
-               "ts_mthexapod's constants.py gives the calibrated pivots to 1 um")
+        "ts_mthexapod's constants.py gives the calibrated pivots to 1 um",
+    )
     platform_pivot_radius_error: float = param(
-        0.0, "radial error of the six mirror-side pivots (their circle's radius, 0.697 m, is this much larger)",
-        "m", low=-0.001, high=0.001,
+        0.0,
+        "radial error of the six mirror-side pivots (their circle's radius, 0.697 m, is this much larger)",
+        "m",
+        low=-0.001,
+        high=0.001,
         reason="machining and assembly of the pivot circles before a kinematic calibration, assumed +-1 mm; "
-               "ts_mthexapod's constants.py gives the calibrated pivots to 1 um")
+        "ts_mthexapod's constants.py gives the calibrated pivots to 1 um",
+    )
     drive_stiffness_error: float = param(
-        0.0, "every strut drive's servo stiffness kp relative to the model's (ideal drives: servo and axial, "
+        0.0,
+        "every strut drive's servo stiffness kp relative to the model's (ideal drives: servo and axial, "
         "100 N/um; as built: the position loop's 96.8 N/um)",
-        "fraction", low=-0.3, high=0.3,
+        "fraction",
+        low=-0.3,
+        high=0.3,
         reason="the 100 N/um is an order-of-magnitude assumption (models/hexapod/README.md); ball-screw "
-               "preload, bearings and the flexures spread it by tens of %: +-30 % assumed")
+        "preload, bearings and the flexures spread it by tens of %: +-30 % assumed",
+    )
     drive_force_scale: float = param(
-        1.0, "every strut drive's force limit relative to its 50 kN rating", "fraction", low=0.5, high=1.0,
+        1.0,
+        "every strut drive's force limit relative to its 50 kN rating",
+        "fraction",
+        low=0.5,
+        high=1.0,
         reason="a drive delivers at most its rated force; down to half of it when derated (heat, a low DC "
-               "bus); assumption")
+        "bus); assumption",
+    )
     friction_error: float = param(
-        0.0, "as-built drives: every strut's Coulomb and viscous friction relative to the model's", "fraction",
-        low=-0.5, high=1.0,
+        0.0,
+        "as-built drives: every strut's Coulomb and viscous friction relative to the model's",
+        "fraction",
+        low=-0.5,
+        high=1.0,
         reason="ball-screw preload drag and gearbox losses vary with preload, lubrication and temperature: "
-               "half to twice the model's (assumption; models/hexapod/README.md)")
+        "half to twice the model's (assumption; models/hexapod/README.md)",
+    )
     screw_stiffness_error: float = param(
-        0.0, "as-built drives: every strut's axial stiffness (screw, nut, bearings, gearbox) relative to the "
-        "model's", "fraction", low=-0.3, high=0.3,
-        reason="preload and bearing spread of catalogue rigidity figures, +-30 % (assumption)")
+        0.0,
+        "as-built drives: every strut's axial stiffness (screw, nut, bearings, gearbox) relative to the model's",
+        "fraction",
+        low=-0.3,
+        high=0.3,
+        reason="preload and bearing spread of catalogue rigidity figures, +-30 % (assumption)",
+    )
     torque_constant_error: float = torque_constant_error("the strut motors")
     encoder_bias_um: tuple[float, ...] = param(
-        (0.0,) * 6, "zero offset of each strut's encoder, strut1 ... strut6: the drive and the controller read "
-        "q + bias", "um", low=-10.0, high=10.0, length=6,
+        (0.0,) * 6,
+        "zero offset of each strut's encoder, strut1 ... strut6: the drive and the controller read q + bias",
+        "um",
+        low=-10.0,
+        high=10.0,
+        length=6,
         reason="a strut's length calibration, assumed within 10 um (ten times the 1 um end-of-move error); "
-               "the encoders resolve 0.1 um (REFERENCE.md: 10 counts/um)")
+        "the encoders resolve 0.1 um (REFERENCE.md: 10 counts/um)",
+    )
 
     def encoder_bias_si(self) -> np.ndarray:
         """(6,) the encoder biases, m."""

@@ -19,14 +19,19 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 from scipy.spatial.transform import Rotation
 
-from planbench import models
+from planbench import models, run_limits
+from planbench.drives import (
+    DriveTrain,
+    add_drive_train,
+    check_option,
+    drive_coordinates,
+    servo_gains,
+    transmission_deflection,
+)
 from planbench.planners import hexapod as hexapod_planner
 from planbench.planners.errors import LimitError
 from planbench.planners.hexapod import RUBIN_CAMERA, STRUT_LABELS
 from planbench.planners.rotations import wxyz
-from planbench import run_limits
-from planbench.drives import (DRIVES, DriveTrain, add_drive_train, check_option, drive_coordinates, servo_gains,
-                         transmission_deflection)
 from planbench.plant import set_inertial
 from planbench.runner import RunLog
 
@@ -54,8 +59,7 @@ def check_elevation(elevation_deg: float) -> float:
     """The elevation (deg) if the telescope can point there, else a LimitError (bad input)."""
     lo, hi = ELEVATION_RANGE_DEG
     if not np.isfinite(elevation_deg) or not lo <= elevation_deg <= hi:
-        raise LimitError(f"elevation {elevation_deg!r} deg is outside the telescope's range "
-                         f"[{lo:g}, {hi:g}] deg")
+        raise LimitError(f"elevation {elevation_deg!r} deg is outside the telescope's range [{lo:g}, {hi:g}] deg")
     return float(elevation_deg)
 
 
@@ -69,28 +73,40 @@ STRUT_RATIO = 2.0 * math.pi * 10.0 / 0.010
 STRUT_ROTOR_INERTIA = 4e-4  # kg m^2
 STRUT_EFFICIENCY = 0.97 * 0.9  # the planetary stage's and the ball screw's
 STRUT_TORQUE_CONSTANT = 0.9  # N m/A
-STRUT_LOOP_INERTIA = STRUT_ROTOR_INERTIA * STRUT_RATIO ** 2 + 1000.0  # kg: rotor + a strut's share
+STRUT_LOOP_INERTIA = STRUT_ROTOR_INERTIA * STRUT_RATIO**2 + 1000.0  # kg: rotor + a strut's share
 STRUT_KP, STRUT_KV = servo_gains(STRUT_LOOP_INERTIA, 20.0, 0.7)
 #: The drive's current limits, set to the strut's 50 kN rating and a 40 kN continuous load, A.
 _AMPS_PER_NEWTON = 1.0 / (STRUT_TORQUE_CONSTANT * STRUT_RATIO * STRUT_EFFICIENCY)
 STRUT_DRIVE = DriveTrain(
-    ratio=STRUT_RATIO, rotor_inertia=STRUT_ROTOR_INERTIA, torque_constant=STRUT_TORQUE_CONSTANT,
-    peak_current=50e3 * _AMPS_PER_NEWTON, continuous_current=40e3 * _AMPS_PER_NEWTON,
-    max_motor_speed=6000 * 2 * math.pi / 60, efficiency=STRUT_EFFICIENCY,
-    stiffness=2.8e8, coulomb_friction=1300.0, viscous_friction=2.0e4,
-    kp=STRUT_KP, kv=STRUT_KV, encoder_resolution=50e-9)
+    ratio=STRUT_RATIO,
+    rotor_inertia=STRUT_ROTOR_INERTIA,
+    torque_constant=STRUT_TORQUE_CONSTANT,
+    peak_current=50e3 * _AMPS_PER_NEWTON,
+    continuous_current=40e3 * _AMPS_PER_NEWTON,
+    max_motor_speed=6000 * 2 * math.pi / 60,
+    efficiency=STRUT_EFFICIENCY,
+    stiffness=2.8e8,
+    coulomb_friction=1300.0,
+    viscous_friction=2.0e4,
+    kp=STRUT_KP,
+    kv=STRUT_KV,
+    encoder_resolution=50e-9,
+)
 #: Bending stiffness of each end flexure about each axis, N m/rad (the universal joints'
 #: stiffness, zero moment at the zero pose).
 FLEXURE_STIFFNESS = 2.6e4
 
 
-def strut_drive(plant: "HexapodPlant | None" = None) -> DriveTrain:
+def strut_drive(plant: HexapodPlant | None = None) -> DriveTrain:
     """A strut's drive train as built (``STRUT_DRIVE``), with ``plant``'s errors of its friction,
     screw stiffness and torque constant."""
     if plant is None:
         return STRUT_DRIVE
-    return STRUT_DRIVE.with_errors(friction=plant.friction_error, stiffness=plant.screw_stiffness_error,
-                                   torque_constant=plant.torque_constant_error)
+    return STRUT_DRIVE.with_errors(
+        friction=plant.friction_error,
+        stiffness=plant.screw_stiffness_error,
+        torque_constant=plant.torque_constant_error,
+    )
 
 
 @functools.lru_cache(maxsize=16)
@@ -100,7 +116,7 @@ def _compiled(elevation_deg: float, drives: str = "ideal") -> mujoco.MjModel:
 
 
 @functools.lru_cache(maxsize=16)
-def _compiled_plant(elevation_deg: float, plant: "HexapodPlant", drives: str = "ideal") -> mujoco.MjModel:
+def _compiled_plant(elevation_deg: float, plant: HexapodPlant, drives: str = "ideal") -> mujoco.MjModel:
     """The scene at ``elevation_deg`` (deg) with ``drives`` perturbed into the plant ``plant``,
     compiled."""
     spec = _spec(elevation_deg, drives, plant)
@@ -113,7 +129,7 @@ def _compiled_plant(elevation_deg: float, plant: "HexapodPlant", drives: str = "
 PLATFORM_KEY_QPOS = -7
 
 
-def _spec(elevation_deg: float, drives: str = "ideal", plant: "HexapodPlant | None" = None) -> mujoco.MjSpec:
+def _spec(elevation_deg: float, drives: str = "ideal", plant: HexapodPlant | None = None) -> mujoco.MjSpec:
     """The scene's MjSpec with the top end tilted to ``elevation_deg`` (deg) and its struts'
     drives (``DRIVES``; as built: ``STRUT_DRIVE``, with ``plant``'s errors of its elements)."""
     check_option(drives)
@@ -142,8 +158,8 @@ def _spec(elevation_deg: float, drives: str = "ideal", plant: "HexapodPlant | No
     hinges = sum(1 for j in spec.joints if j.type != mujoco.mjtJoint.mjJNT_FREE)
     qpos = np.zeros(hinges + 7)
     free = PLATFORM_KEY_QPOS
-    qpos[free:free + 3] = platform_pos
-    qpos[free + 3:] = quat
+    qpos[free : free + 3] = platform_pos
+    qpos[free + 3 :] = quat
     key.qpos = qpos
     return spec
 
@@ -156,7 +172,7 @@ def _radial(xyz, error: float) -> np.ndarray:
     return xyz
 
 
-def apply_plant(spec: mujoco.MjSpec, plant: "HexapodPlant", nominal: mujoco.MjModel) -> None:
+def apply_plant(spec: mujoco.MjSpec, plant: HexapodPlant, nominal: mujoco.MjModel) -> None:
     """Edit the hexapod's MjSpec into the plant ``plant`` (``nominal``: the same spec
     compiled unperturbed). Each edit touches only its own elements:
 
@@ -205,8 +221,9 @@ class HexapodPhysics(dm_mujoco.Physics):
     drives = "ideal"
 
     @classmethod
-    def load(cls, elevation_deg: float = 90.0, plant: "HexapodPlant | None" = None,
-             drives: str = "ideal") -> "HexapodPhysics":
+    def load(
+        cls, elevation_deg: float = 90.0, plant: HexapodPlant | None = None, drives: str = "ideal"
+    ) -> HexapodPhysics:
         """The scene at ``elevation_deg`` (deg) at its home keyframe with the struts' ``drives``
         (``DRIVES``); ``plant`` (None: the nominal plant) the true machine, perturbed as
         ``HexapodPlant`` says (``apply_plant``)."""
@@ -315,8 +332,8 @@ class HexapodPhysics(dm_mujoco.Physics):
         """(n, 6) hexapod poses (x, y, z, rx, ry, rz) of logged qpos rows (n, nq)."""
         qpos = np.atleast_2d(qpos)
         origin, rotation = self.top_end_frame
-        pos_world = qpos[:, self._free_qpos:self._free_qpos + 3]
-        quat_world = qpos[:, self._free_qpos + 3:self._free_qpos + 7]
+        pos_world = qpos[:, self._free_qpos : self._free_qpos + 3]
+        quat_world = qpos[:, self._free_qpos + 3 : self._free_qpos + 7]
         position = (pos_world - origin) @ rotation - RUBIN_CAMERA.rotation_pivot
         r_world = Rotation.from_quat(np.roll(quat_world, -1, axis=1))
         angles = (Rotation.from_matrix(rotation.T) * r_world).as_euler("XYZ")
@@ -349,8 +366,8 @@ class HexapodPhysics(dm_mujoco.Physics):
         model, data = self.model.ptr, self.data.ptr
         origin, rotation = self.top_end_frame
         position, r_pose = hexapod_planner.platform_frame(pose, self.geometry)
-        data.qpos[self._free_qpos:self._free_qpos + 3] = origin + rotation @ position
-        data.qpos[self._free_qpos + 3:self._free_qpos + 7] = wxyz(rotation @ r_pose)
+        data.qpos[self._free_qpos : self._free_qpos + 3] = origin + rotation @ position
+        data.qpos[self._free_qpos + 3 : self._free_qpos + 7] = wxyz(rotation @ r_pose)
         pivots = hexapod_planner.pivot_positions(pose, self.geometry)
         for i, name in enumerate(STRUT_LABELS):
             housing = model.body(f"{name}_housing")
@@ -369,7 +386,9 @@ class HexapodPhysics(dm_mujoco.Physics):
             # As built: each motor stands off its rod by the screw's deflection under the
             # static load, F / k, so that the machine starts at rest.
             force = static_drive_forces(self, data.qpos[self.strut_qpos][None, :])[0]
-            data.qpos[self.drive_qpos] = data.qpos[self.strut_qpos] + transmission_deflection(model, STRUT_LABELS, force)
+            data.qpos[self.drive_qpos] = data.qpos[self.strut_qpos] + transmission_deflection(
+                model, STRUT_LABELS, force
+            )
             data.act[:] = data.qpos[self.drive_qpos]
         mujoco.mj_forward(model, data)
 
@@ -379,8 +398,9 @@ class HexapodPhysics(dm_mujoco.Physics):
         (``geometry``) put it (forward kinematics from ``guess``, a pose), then ``set_pose``."""
         model = self.model.ptr
         built = np.array([model.body(f"{n}_rod").pos[2] for n in STRUT_LABELS])
-        pose, _ = hexapod_planner.forward_kinematics(np.asarray(strut_positions, dtype=float) + built,
-                                                     self.geometry, initial=guess)
+        pose, _ = hexapod_planner.forward_kinematics(
+            np.asarray(strut_positions, dtype=float) + built, self.geometry, initial=guess
+        )
         self.set_pose(pose)
 
     def loop_closure_error(self) -> float:
@@ -418,7 +438,7 @@ def static_drive_forces(physics: HexapodPhysics, strut_positions: np.ndarray) ->
     # Centres of mass along the strut from its base pivot, m (rod frame origin = tip).
     housing_arm = model.body_ipos[housing, 2]
     rod_arm = leg_length[..., 0] + model.body_ipos[rod, 2]
-    weight_moment = (model.body_mass[housing] * housing_arm + model.body_mass[rod] * rod_arm)
+    weight_moment = model.body_mass[housing] * housing_arm + model.body_mass[rod] * rod_arm
     strut_moment = np.cross(units * weight_moment[..., None], gravity)
     tip_force = np.cross(legs, strut_moment) / leg_length**2
     force -= tip_force.sum(axis=1)

@@ -98,19 +98,28 @@ Example::
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
+from planbench.checks import Check
+from planbench.hexapod.params import HexapodParams
+from planbench.hexapod.task import (
+    ARRIVAL_SPREAD_LIMIT_S,
+    OWN_TIME_LIMIT_S,
+    POSE_FINAL_LIMIT_UM,
+    arrival_times,
+    hexapod_speed_check,
+    plan_moves,
+    problems,
+    strut_tolerances,
+)
 from planbench.planners import hexapod as hexapod_planner
 from planbench.planners.errors import PlanningError
 from planbench.planners.hexapod import POSE_LABELS, RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS, StrutMove
 from planbench.planners.legs import component_norm, leg_vector_components
 from planbench.planners.trajectory import PiecewiseTrajectory, control_ticks
-from planbench.checks import Check
-from planbench.hexapod.params import HexapodParams
-from planbench.hexapod.task import (ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM, arrival_times,
-                               hexapod_speed_check, plan_moves, problems, strut_tolerances)
+
 #: Forward kinematics stops for a pose once its largest strut-length residual is below this,
 #: m (0.1 nm: 1e-8 of the smallest pose limit, 1e-4 of the 1 um end-pose limit).
 FK_TOLERANCE_M = 1e-10
@@ -145,14 +154,18 @@ def _strut_lengths(pose: np.ndarray) -> np.ndarray:
     """``planbench.planners.hexapod.strut_lengths`` without its input check (the poses here are the
     kinematics' own iterates, finite by construction), on components (the same numbers),
     (M, 6) -> (M, 6) m."""
-    vectors, _ = leg_vector_components(RUBIN_CAMERA.base_pivots, RUBIN_CAMERA.platform_local,
-                                       RUBIN_CAMERA.rotation_pivot + pose[:, :3],
-                                       hexapod_planner.rotation_matrix(pose[:, 3:]))
+    vectors, _ = leg_vector_components(
+        RUBIN_CAMERA.base_pivots,
+        RUBIN_CAMERA.platform_local,
+        RUBIN_CAMERA.rotation_pivot + pose[:, :3],
+        hexapod_planner.rotation_matrix(pose[:, 3:]),
+    )
     return component_norm(*vectors)
 
 
-def poses_of_lengths(lengths: np.ndarray, guess: np.ndarray, inverse_jacobian: np.ndarray,
-                     which: np.ndarray | None = None):
+def poses_of_lengths(
+    lengths: np.ndarray, guess: np.ndarray, inverse_jacobian: np.ndarray, which: np.ndarray | None = None
+):
     """Forward kinematics of many strut-length sets, each on its own.
 
     The chord method: pose <- pose - J0^-1 (L(pose) - lengths) with a fixed J0 per row near
@@ -219,8 +232,16 @@ def _switching_ticks(moves: hexapod_planner.StrutMoves) -> np.ndarray:
 
 def _sample_rows(moves: hexapod_planner.StrutMoves, rows: np.ndarray, t: np.ndarray):
     """The planner's own ``StrutMove.sample`` of move ``rows[r]`` at time ``t[r]`` for every r."""
-    batch = StrutMove(moves.start[rows], moves.target[rows], moves.n_ticks[rows], moves.n_accel[rows],
-                      moves.accel[rows], moves.dt, None, moves.synchronous)
+    batch = StrutMove(
+        moves.start[rows],
+        moves.target[rows],
+        moves.n_ticks[rows],
+        moves.n_accel[rows],
+        moves.accel[rows],
+        moves.dt,
+        None,
+        moves.synchronous,
+    )
     return batch.sample(t)
 
 
@@ -232,9 +253,9 @@ class _Anchors:
 
     def __init__(self, moves: hexapod_planner.StrutMoves):
         middle = 0.5 * (moves.start_pose + moves.target_pose)
-        self.poses = np.stack([moves.start_pose, middle, moves.target_pose], axis=1)          # (N, 3, 6)
+        self.poses = np.stack([moves.start_pose, middle, moves.target_pose], axis=1)  # (N, 3, 6)
         self.struts = np.stack([moves.start, hexapod_planner.strut_positions(middle), moves.target], axis=1)
-        self.inverse = _inverse_jacobians(self.poses.reshape(-1, 6))                         # (3N, 6, 6)
+        self.inverse = _inverse_jacobians(self.poses.reshape(-1, 6))  # (3N, 6, 6)
 
     def nearest(self, rows: np.ndarray, position: np.ndarray) -> np.ndarray:
         """(R,) the row of ``inverse`` of the anchor nearest to each position (R, 6) of move
@@ -265,10 +286,10 @@ def _poses_along(anchors: _Anchors, position: np.ndarray):
         if k == points - 1:
             guess = anchors.poses[:, 2]
         else:
-            guess = previous_pose + np.einsum("nij,nj->ni", anchors.inverse[which],
-                                              position[:, k] - previous_position)
-        poses[:, k], residual[:, k] = poses_of_lengths(position[:, k] + RUBIN_CAMERA.nominal_lengths,
-                                                       guess, anchors.inverse, which)
+            guess = previous_pose + np.einsum("nij,nj->ni", anchors.inverse[which], position[:, k] - previous_position)
+        poses[:, k], residual[:, k] = poses_of_lengths(
+            position[:, k] + RUBIN_CAMERA.nominal_lengths, guess, anchors.inverse, which
+        )
         previous_pose, previous_position = poses[:, k], position[:, k]
     return poses, residual
 
@@ -285,7 +306,7 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     count = len(moves)
     dt = moves.dt
     index = np.arange(count)
-    ticks = _switching_ticks(moves)                           # (N, B)
+    ticks = _switching_ticks(moves)  # (N, B)
     b = ticks.shape[1]
     # Sample times per move: switching ticks and the midpoints between them, interleaved.
     times = np.empty((count, 2 * b - 1))
@@ -295,7 +316,7 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     rows = np.repeat(index, points)
     sample = _sample_rows(moves, rows, times.ravel())
     position = sample.position.reshape(count, points, 6)
-    speed = np.abs(sample.velocity).reshape(count, points, 6).max(axis=1)      # (N, 6)
+    speed = np.abs(sample.velocity).reshape(count, points, 6).max(axis=1)  # (N, 6)
     accel = np.abs(sample.acceleration).reshape(count, points, 6).max(axis=1)
     stroke = np.abs(position).max(axis=1)
 
@@ -313,7 +334,7 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     when = times[index, point]
     # Inside each piece, each axis as the quadratic q(s), s in [0, 1], through its ends and
     # midpoint: its vertex, where inside, is a candidate extreme, evaluated exactly.
-    fa, fm, fb = u[:, 0:-1:2], u[:, 1::2], u[:, 2::2]                          # (N, B-1, 6)
+    fa, fm, fb = u[:, 0:-1:2], u[:, 1::2], u[:, 2::2]  # (N, B-1, 6)
     lin = -3.0 * fa + 4.0 * fm - fb
     quad = 2.0 * fa - 4.0 * fm + 2.0 * fb
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -330,14 +351,16 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     vrows = np.repeat(index, VERTICES_EVALUATED)
     vposition = _sample_rows(moves, vrows, t_vertex.ravel()).position
     # From the exact pose at the piece's sample nearest in time (its start, midpoint or end).
-    nearest = (2 * piece + np.rint(2.0 * np.clip((t_vertex - t_a) / np.where(t_b > t_a, t_b - t_a, 1.0), 0, 1))
-               .astype(np.intp)).ravel()
+    nearest = (
+        2 * piece + np.rint(2.0 * np.clip((t_vertex - t_a) / np.where(t_b > t_a, t_b - t_a, 1.0), 0, 1)).astype(np.intp)
+    ).ravel()
     which = anchors.nearest(vrows, vposition)
-    guess = poses[vrows, nearest] + np.einsum("nij,nj->ni", anchors.inverse[which],
-                                              vposition - position[vrows, nearest])
+    guess = poses[vrows, nearest] + np.einsum(
+        "nij,nj->ni", anchors.inverse[which], vposition - position[vrows, nearest]
+    )
     vposes, vresidual = poses_of_lengths(vposition + RUBIN_CAMERA.nominal_lengths, guess, anchors.inverse, which)
     converged &= (vresidual <= FK_TOLERANCE_M).reshape(count, -1).all(axis=1)
-    vu = np.abs(pose_ratio(vposes)).reshape(count, -1)                        # (N, V * 6)
+    vu = np.abs(pose_ratio(vposes)).reshape(count, -1)  # (N, V * 6)
     vbest = np.argmax(vu, axis=1)
     better = vu[index, vbest] > ratio
     vpoint, vaxis = np.divmod(vbest, 6)
@@ -351,8 +374,12 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     # switching tick.
     velocity = sample.velocity.reshape(count, points, 6)
     block = max(1, KINEMATICS_BLOCK // points)
-    hex_speed = np.concatenate([hexapod_planner.hexapod_speed_ratios(poses[lo:lo + block], velocity[lo:lo + block])
-                                .max(axis=1) for lo in range(0, count, block)])
+    hex_speed = np.concatenate(
+        [
+            hexapod_planner.hexapod_speed_ratios(poses[lo : lo + block], velocity[lo : lo + block]).max(axis=1)
+            for lo in range(0, count, block)
+        ]
+    )
     _, moving = strut_tolerances(moves.start, moves.target)
     arrival = moves.n_ticks * dt
     own = _own_times(moves)
@@ -361,11 +388,15 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
         "spread": np.where(moving.any(axis=1), big - small, 0.0),
         "late": np.where(moving.any(axis=1), np.where(moving, arrival - own, -np.inf).max(axis=1), 0.0),
         **{key: np.where(converged, hex_speed[:, k], np.nan) for k, key in enumerate(_HEX_KEYS)},
-        "speed": speed.max(axis=1), "speed_strut": speed.argmax(axis=1),
+        "speed": speed.max(axis=1),
+        "speed_strut": speed.argmax(axis=1),
         "accel": accel.max(axis=1),
-        "stroke": stroke.max(axis=1), "stroke_strut": stroke.argmax(axis=1),
-        "ratio": np.where(converged, ratio, np.nan), "ratio_axis": axis,
-        "ratio_value": value, "ratio_time": when,
+        "stroke": stroke.max(axis=1),
+        "stroke_strut": stroke.argmax(axis=1),
+        "ratio": np.where(converged, ratio, np.nan),
+        "ratio_axis": axis,
+        "ratio_value": value,
+        "ratio_time": when,
         "end_error": np.where(converged, pivot_error_um(poses[:, -1], moves.target_pose), np.nan),
     }
 
@@ -385,20 +416,27 @@ def _plan_group(start: np.ndarray, target: np.ndarray, synchronous: bool):
     for lo in range(0, start.shape[0], CHUNK_MOVES):
         hi = min(lo + CHUNK_MOVES, start.shape[0])
         try:
-            results.append(_judge_strut_moves(hexapod_planner.plan_moves(
-                start[lo:hi], target[lo:hi], synchronous=synchronous, method="closed")))
+            results.append(
+                _judge_strut_moves(
+                    hexapod_planner.plan_moves(start[lo:hi], target[lo:hi], synchronous=synchronous, method="closed")
+                )
+            )
             continue
         except PlanningError:
             pass
         for k in range(lo, hi):
             try:
-                results.append(_judge_strut_moves(hexapod_planner.plan_moves(
-                    start[k:k + 1], target[k:k + 1], synchronous=synchronous, method="closed")))
+                results.append(
+                    _judge_strut_moves(
+                        hexapod_planner.plan_moves(
+                            start[k : k + 1], target[k : k + 1], synchronous=synchronous, method="closed"
+                        )
+                    )
+                )
             except PlanningError as e:
                 failures[k] = f"{type(e).__name__}: {e}"
                 results.append(None)
-    out = {key: np.concatenate([r[key] if r is not None else np.full(1, np.nan) for r in results])
-           for key in _KEYS}
+    out = {key: np.concatenate([r[key] if r is not None else np.full(1, np.nan) for r in results]) for key in _KEYS}
     return out, failures
 
 
@@ -406,8 +444,21 @@ def _plan_group(start: np.ndarray, target: np.ndarray, synchronous: bool):
 
 #: The per-move quantities a run's checks are made of (``_judge_strut_moves``).
 _HEX_KEYS = ("hex_radial", "hex_axial", "hex_radial_angular", "hex_axial_angular")
-_KEYS = ("spread", "late", "speed", "speed_strut", "accel", "stroke", "stroke_strut", "ratio",
-         "ratio_axis", "ratio_value", "ratio_time", "end_error", *_HEX_KEYS)
+_KEYS = (
+    "spread",
+    "late",
+    "speed",
+    "speed_strut",
+    "accel",
+    "stroke",
+    "stroke_strut",
+    "ratio",
+    "ratio_axis",
+    "ratio_value",
+    "ratio_time",
+    "end_error",
+    *_HEX_KEYS,
+)
 
 
 def _worst(values: np.ndarray) -> int:
@@ -425,12 +476,25 @@ def _run_checks(m: dict, synchronous: np.ndarray, lo: int, hi: int) -> list[Chec
     sync = synchronous[lo:hi]
     checks = []
     if sync.any():
-        checks.append(Check("arrival_spread", float(m["spread"][lo:hi][sync].max()), ARRIVAL_SPREAD_LIMIT_S, "s",
-                            note="last minus first strut arrival of the planned motion"))
+        checks.append(
+            Check(
+                "arrival_spread",
+                float(m["spread"][lo:hi][sync].max()),
+                ARRIVAL_SPREAD_LIMIT_S,
+                "s",
+                note="last minus first strut arrival of the planned motion",
+            )
+        )
     if not sync.all():
-        checks.append(Check("arrival_vs_own_time", float(m["late"][lo:hi][~sync].max()), OWN_TIME_LIMIT_S, "s",
-                            note="each planned strut's arrival minus its minimum time 2 max(t_i, t'_min) "
-                                 "(early is negative)"))
+        checks.append(
+            Check(
+                "arrival_vs_own_time",
+                float(m["late"][lo:hi][~sync].max()),
+                OWN_TIME_LIMIT_S,
+                "s",
+                note="each planned strut's arrival minus its minimum time 2 max(t_i, t'_min) (early is negative)",
+            )
+        )
     if several:
         ws, wv, wr, we = (lo + _worst(m[k][lo:hi]) for k in ("speed", "stroke", "ratio", "end_error"))
     else:
@@ -438,24 +502,55 @@ def _run_checks(m: dict, synchronous: np.ndarray, lo: int, hi: int) -> list[Chec
     move = f" (move {wr - lo})" if several else ""
     axis = int(m["ratio_axis"][wr])
     ratio, end = float(m["ratio"][wr]), float(m["end_error"][we])
-    no_fk = ("not evaluated: forward kinematics of the planned strut lengths did not converge to "
-             f"{FK_TOLERANCE_M:g} m" + (f" (move {we - lo})" if several else ""))
+    no_fk = (
+        "not evaluated: forward kinematics of the planned strut lengths did not converge to "
+        f"{FK_TOLERANCE_M:g} m" + (f" (move {we - lo})" if several else "")
+    )
     checks += [
-        Check("strut_velocity", 1e6 * float(m["speed"][ws]), 1e6 * limits.strut_speed, "um/s",
-              note=f"planned, peak on {STRUT_LABELS[int(m['speed_strut'][ws])]}"),
-        Check("strut_accel", 1e6 * float(m["accel"][lo:hi].max()), 1e6 * limits.strut_accel, "um/s2",
-              note="planned, per tick"),
+        Check(
+            "strut_velocity",
+            1e6 * float(m["speed"][ws]),
+            1e6 * limits.strut_speed,
+            "um/s",
+            note=f"planned, peak on {STRUT_LABELS[int(m['speed_strut'][ws])]}",
+        ),
+        Check(
+            "strut_accel",
+            1e6 * float(m["accel"][lo:hi].max()),
+            1e6 * limits.strut_accel,
+            "um/s2",
+            note="planned, per tick",
+        ),
         _hex_speed(m, lo, hi, no_fk),
-        Check("plan_stroke", 1e3 * float(m["stroke"][wv]), 1e3 * limits.stroke, "mm",
-              note=f"planned strut length change, peak on {STRUT_LABELS[int(m['stroke_strut'][wv])]}"),
-        Check("pose_limits", ratio, 1.0, "ratio",
-              note=f"|pose - centre| / half range of the worst axis along the planned path: "
-                   f"{POSE_LABELS[axis]} = {_AXIS_SCALE[axis] * float(m['ratio_value'][wr]):.5g} "
-                   f"{_AXIS_UNIT[axis]} (limits +/-{_AXIS_SCALE[axis] * _HALF[axis]:.4g}) at "
-                   f"t = {float(m['ratio_time'][wr]):.3f} s{move}" if np.isfinite(ratio) else no_fk),
-        Check("plan_pose_error_final", end, POSE_FINAL_LIMIT_UM, "um",
-              note="mirror-side pivots at the forward kinematics of the planned end strut lengths "
-                   "against the target pose" + (", worst move" if several else "") if np.isfinite(end) else no_fk),
+        Check(
+            "plan_stroke",
+            1e3 * float(m["stroke"][wv]),
+            1e3 * limits.stroke,
+            "mm",
+            note=f"planned strut length change, peak on {STRUT_LABELS[int(m['stroke_strut'][wv])]}",
+        ),
+        Check(
+            "pose_limits",
+            ratio,
+            1.0,
+            "ratio",
+            note=f"|pose - centre| / half range of the worst axis along the planned path: "
+            f"{POSE_LABELS[axis]} = {_AXIS_SCALE[axis] * float(m['ratio_value'][wr]):.5g} "
+            f"{_AXIS_UNIT[axis]} (limits +/-{_AXIS_SCALE[axis] * _HALF[axis]:.4g}) at "
+            f"t = {float(m['ratio_time'][wr]):.3f} s{move}"
+            if np.isfinite(ratio)
+            else no_fk,
+        ),
+        Check(
+            "plan_pose_error_final",
+            end,
+            POSE_FINAL_LIMIT_UM,
+            "um",
+            note="mirror-side pivots at the forward kinematics of the planned end strut lengths "
+            "against the target pose" + (", worst move" if several else "")
+            if np.isfinite(end)
+            else no_fk,
+        ),
     ]
     return checks
 
@@ -476,11 +571,14 @@ def _refused_checks(synchronous: np.ndarray, move: int, message: str, several: b
         checks.append(Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=reason))
     if not synchronous.all():
         checks.append(Check.not_evaluated("arrival_vs_own_time", OWN_TIME_LIMIT_S, "s", reason=reason))
-    for name, limit, unit in (("strut_velocity", 1e6 * limits.strut_speed, "um/s"),
-                              ("strut_accel", 1e6 * limits.strut_accel, "um/s2"),
-                              ("hexapod_speed", 1.0, "ratio"),
-                              ("plan_stroke", 1e3 * limits.stroke, "mm"), ("pose_limits", 1.0, "ratio"),
-                              ("plan_pose_error_final", POSE_FINAL_LIMIT_UM, "um")):
+    for name, limit, unit in (
+        ("strut_velocity", 1e6 * limits.strut_speed, "um/s"),
+        ("strut_accel", 1e6 * limits.strut_accel, "um/s2"),
+        ("hexapod_speed", 1.0, "ratio"),
+        ("plan_stroke", 1e3 * limits.stroke, "mm"),
+        ("pose_limits", 1.0, "ratio"),
+        ("plan_pose_error_final", POSE_FINAL_LIMIT_UM, "um"),
+    ):
         checks.append(Check.not_evaluated(name, limit, unit, reason=reason))
     return checks
 
@@ -569,7 +667,7 @@ def judge_trajectories(moves: Sequence[hexapod_planner.MoveProblem], trajectorie
         raise ValueError(f"{len(moves)} moves and {len(trajectories)} trajectories: give one per move")
     m = {k: np.zeros(len(moves)) for k in _KEYS}
     not_resting = None
-    for i, (problem, trajectory) in enumerate(zip(moves, trajectories)):
+    for i, (problem, trajectory) in enumerate(zip(moves, trajectories, strict=True)):
         t = control_ticks(float(trajectory.duration), problem.dt)
         ref = trajectory.sample(t)
         position = np.asarray(ref.position, dtype=float)
@@ -605,9 +703,15 @@ def judge_trajectories(moves: Sequence[hexapod_planner.MoveProblem], trajectorie
     checks = _run_checks(m, synchronous, 0, len(moves))
     if not_resting is not None:
         # As in a run: arrivals exist only where the planned motion comes to rest on its target.
-        reason = ("the planned move" + (f" {not_resting}" if len(moves) > 1 else "")
-                  + " does not come to rest on its target at its end (arrival_times' tolerance)")
-        checks = [Check.not_evaluated(c.name, c.limit, c.unit, reason=reason)
-                  if c.name in ("arrival_spread", "arrival_vs_own_time") else c for c in checks]
+        reason = (
+            "the planned move"
+            + (f" {not_resting}" if len(moves) > 1 else "")
+            + " does not come to rest on its target at its end (arrival_times' tolerance)"
+        )
+        checks = [
+            Check.not_evaluated(c.name, c.limit, c.unit, reason=reason)
+            if c.name in ("arrival_spread", "arrival_vs_own_time")
+            else c
+            for c in checks
+        ]
     return checks
-

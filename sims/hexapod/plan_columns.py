@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from planbench.planners import hexapod as hexapod_planner
-from planbench.planners.hexapod import RUBIN_LIMITS
 from planbench.hexapod import plan_checks
 from planbench.hexapod.params import HexapodMove, HexapodParams, pose_si
 from planbench.hexapod.task import ARRIVAL_SPREAD_LIMIT_S, OWN_TIME_LIMIT_S, POSE_FINAL_LIMIT_UM
 from planbench.params import _bound
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.hexapod import RUBIN_LIMITS
 
 
 def supports(base: HexapodParams, paths) -> bool:
@@ -65,7 +65,7 @@ def poses_of(base: HexapodParams, paths, values, n: int) -> tuple[np.ndarray, np
     start = np.tile(np.asarray(base.start_pose, dtype=float), (n, 1))
     targets = np.tile(np.asarray([m.target for m in base.moves], dtype=float), (n, 1, 1))
     synchronous = np.tile(np.asarray([m.synchronous for m in base.moves], dtype=bool), (n, 1))
-    for path, column in zip(paths, values):
+    for path, column in zip(paths, values, strict=True):
         column = np.asarray(column)
         if path[0] == "start_pose":
             start[:, path[1]] = column
@@ -105,7 +105,8 @@ def validate(base: HexapodParams, paths, values, n: int):
     for column, what in order:
         rows = np.flatnonzero(beyond[:, column] & ~decided)
         if rows.size:
-            for row, text in zip(rows.tolist(), hexapod_planner.stroke_messages(struts[rows, column], what)):
+            texts = hexapod_planner.stroke_messages(struts[rows, column], what)
+            for row, text in zip(rows.tolist(), texts, strict=True):
                 messages[row] = text
             decided[rows] = True
     return messages, unsure, (start, targets, synchronous)
@@ -136,8 +137,10 @@ def judge(poses) -> list[tuple]:
         return _columns_of_checks(plan_checks.checks_of_runs(per_move, refused, flat_sync, np.arange(n + 1) * moves))
     # One move per run: _run_checks' values on arrays (a refused move's quantities are NaN,
     # as are the checks _refused_checks gives it).
-    out = [("arrival_spread", "s", "<=", ARRIVAL_SPREAD_LIMIT_S, per_move["spread"], flat_sync),
-           ("arrival_vs_own_time", "s", "<=", OWN_TIME_LIMIT_S, per_move["late"], ~flat_sync)]
+    out = [
+        ("arrival_spread", "s", "<=", ARRIVAL_SPREAD_LIMIT_S, per_move["spread"], flat_sync),
+        ("arrival_vs_own_time", "s", "<=", OWN_TIME_LIMIT_S, per_move["late"], ~flat_sync),
+    ]
     for name, key, scale, limit, unit in _SINGLE:
         if key is None:
             value = np.max(np.stack([per_move[k] for k in plan_checks._HEX_KEYS], axis=1), axis=1)
@@ -149,8 +152,11 @@ def judge(poses) -> list[tuple]:
     if not flat_sync[0]:
         out[0], out[1] = out[1], out[0]
     out = [out[0], *out[2:], out[1]]
-    return [(name, unit, comparison, limit, value, present, value <= limit)
-            for name, unit, comparison, limit, value, present in out if present.any()]
+    return [
+        (name, unit, comparison, limit, value, present, value <= limit)
+        for name, unit, comparison, limit, value, present in out
+        if present.any()
+    ]
 
 
 def _columns_of_checks(checks: list[list]) -> list[tuple]:

@@ -13,7 +13,7 @@ def hexapod_report(ts: dict, t: np.ndarray, checks, path) -> None:
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
     ax = axes[0, 0]
     for j, name in enumerate(names):
-        line, = ax.plot(t, 1e3 * ts["strut_position_actual"][:, j], label=name)
+        (line,) = ax.plot(t, 1e3 * ts["strut_position_actual"][:, j], label=name)
         ax.plot(t, 1e3 * ts["strut_position_planned"][:, j], "--", color=line.get_color(), lw=0.8)
     ax.set(title="strut length change (solid: encoder, dashed: generator)", xlabel="t [s]", ylabel="mm")
     ax.legend(fontsize=8, ncol=2)

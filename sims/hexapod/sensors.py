@@ -15,10 +15,16 @@ def sensors(physics: HexapodPhysics) -> JointEncoders:
     as-built drives they count in steps of the linear encoder's resolution
     (``STRUT_DRIVE.encoder_resolution``), with the ideal ones they read exactly."""
     bias = physics.encoder_bias
-    encoders = JointEncoders(physics.strut_qpos, physics.strut_dofs, physics.strut_act,
-                             "strut encoders (length change from the zero pose)", "m", CONTROL_DT,
-                             bias=0.0 if bias is None else bias,
-                             resolution=STRUT_DRIVE.encoder_resolution if physics.drives == "as-built" else 0.0)
+    encoders = JointEncoders(
+        physics.strut_qpos,
+        physics.strut_dofs,
+        physics.strut_act,
+        "strut encoders (length change from the zero pose)",
+        "m",
+        CONTROL_DT,
+        bias=0.0 if bias is None else bias,
+        resolution=STRUT_DRIVE.encoder_resolution if physics.drives == "as-built" else 0.0,
+    )
     if bias is not None and bias.any():
         # The datasheet a controller is given (ControlContext.sensors) cannot state the true
         # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").

@@ -9,10 +9,6 @@ import math
 
 import numpy as np
 
-from planbench.planners import hexapod as hexapod_planner
-from planbench.planners.errors import PlanningError
-from planbench.planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
-from planbench.planners.trajectory import PiecewiseTrajectory, TrajectorySample
 from planbench import run_limits
 from planbench.checks import Check
 from planbench.controllers import demanded_force
@@ -21,6 +17,10 @@ from planbench.hexapod.controller import HexapodController
 from planbench.hexapod.params import CONTROL_DT, SETTLE_S, HexapodParams, HexapodPlant, pose_si
 from planbench.hexapod.physics import HexapodPhysics, magnified_qpos
 from planbench.hexapod.sensors import sensors
+from planbench.planners import hexapod as hexapod_planner
+from planbench.planners.errors import PlanningError
+from planbench.planners.hexapod import RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS
+from planbench.planners.trajectory import PiecewiseTrajectory, TrajectorySample
 from planbench.runner import RunLog, Setup
 from planbench.task import Components, Output, Provenance, Task, nominal_copy, plan_checked
 from planbench.wind import BodyWindDrag, horizontal_direction
@@ -71,9 +71,15 @@ def hexapod_speed_check(peaks, what: str) -> Check:
     peaks = np.asarray(peaks, dtype=float)
     worst = int(np.argmax(peaks))
     names = hexapod_planner.HEXAPOD_SPEED_LABELS
-    return Check("hexapod_speed", float(peaks[worst]), 1.0, "ratio",
-                 note=f"{what} pose speed over the hexapod-space limit, peak of each: "
-                      + ", ".join(f"{n} {v:.3f}" for n, v in zip(names, peaks, strict=True)) + f" (worst {names[worst]})")
+    return Check(
+        "hexapod_speed",
+        float(peaks[worst]),
+        1.0,
+        "ratio",
+        note=f"{what} pose speed over the hexapod-space limit, peak of each: "
+        + ", ".join(f"{n} {v:.3f}" for n, v in zip(names, peaks, strict=True))
+        + f" (worst {names[worst]})",
+    )
 
 
 def strut_tolerances(start, target) -> tuple[np.ndarray, np.ndarray]:
@@ -93,8 +99,7 @@ def arrival_times(reference: TrajectorySample, target, tolerance, dt: float) -> 
     """(6,) each strut's arrival in the sample's times, s: the first sample after which its
     position stays within ``tolerance`` (m, per strut) of ``target`` and its speed within
     ``tolerance / dt``; NaN for a strut not at rest on its target at the last sample."""
-    off = ((np.abs(reference.position - target) > tolerance)
-           | (np.abs(reference.velocity) * dt > tolerance))
+    off = (np.abs(reference.position - target) > tolerance) | (np.abs(reference.velocity) * dt > tolerance)
     n = off.shape[0]
     last_off = np.where(off.any(axis=0), n - 1 - np.argmax(off[::-1], axis=0), -1)
     index = np.minimum(last_off + 1, n - 1)
@@ -123,14 +128,17 @@ class HexapodEvaluation:
         self.wind = wind
         self.own_times = [hexapod_planner.own_move_times(m) for m in self.moves]
         self.strut_starts = [hexapod_planner.strut_positions(np.asarray(m.start_pose, dtype=float)) for m in self.moves]
-        self.strut_targets = [hexapod_planner.strut_positions(np.asarray(m.target_pose, dtype=float)) for m in self.moves]
+        self.strut_targets = [
+            hexapod_planner.strut_positions(np.asarray(m.target_pose, dtype=float)) for m in self.moves
+        ]
 
     def _demanded(self, log: RunLog) -> np.ndarray:
         """(n, 6) the drives' demanded forces, N: their loops on the coordinate they read (the
         motor's as built), before the force clamp."""
         p = self.physics
-        return demanded_force(p.kp, p.kv, log.act[:, p.strut_act], p.drive_positions(log.qpos[:, p.drive_qpos]),
-                              log.qvel[:, p.drive_dofs])
+        return demanded_force(
+            p.kp, p.kv, log.act[:, p.strut_act], p.drive_positions(log.qpos[:, p.drive_qpos]), log.qvel[:, p.drive_dofs]
+        )
 
     def _strut_log(self, log: RunLog):
         p = self.physics
@@ -164,31 +172,46 @@ class HexapodEvaluation:
         which = f" of move {i}" if several else ""
         planned_end = self.starts[i] + self.planned[i]
         if end == log.t.size and log.t[-1] < planned_end - 1e-9:
-            return (f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion{which} "
-                    f"(planned to t = {planned_end:.3f} s) came to rest")
+            return (
+                f"the run ended at t = {log.t[-1]:.3f} s, before the commanded motion{which} "
+                f"(planned to t = {planned_end:.3f} s) came to rest"
+            )
         ref = log.reference
         strut = int(np.flatnonzero(np.isnan(arrivals))[0])
         off = ref.position[end - 1, strut] - self.strut_targets[i][strut]
-        return (f"the commanded motion{which} does not come to rest on its target by t = {log.t[end - 1]:.3f} s: "
-                f"{STRUT_LABELS[strut]} {off:.3g} m off at {ref.velocity[end - 1, strut]:.3g} m/s")
+        return (
+            f"the commanded motion{which} does not come to rest on its target by t = {log.t[end - 1]:.3f} s: "
+            f"{STRUT_LABELS[strut]} {off:.3g} m off at {ref.velocity[end - 1, strut]:.3g} m/s"
+        )
 
     def _judge_move(self, log: RunLog, i: int, q, poses) -> dict:
         """One move's arrival, following error and settled pose error (class docstring)."""
         n = log.t.size
         lo = int(self.start_ticks[i])
         nxt = int(self.start_ticks[i + 1]) if i + 1 < len(self.moves) else n
-        end = min(nxt, n)        # arrival ticks lo ... end - 1
-        last = min(nxt, n - 1)   # the pose's settling window ends on this tick
+        end = min(nxt, n)  # arrival ticks lo ... end - 1
+        last = min(nxt, n - 1)  # the pose's settling window ends on this tick
         settle_ticks = end_tick(SETTLE_S)
         if lo >= n:  # the run ended before this move began
-            return {"arrived": False, "ended": False, "arrivals": np.full(6, np.nan), "spread": 0.0, "late": 0.0,
-                    "move_end": self.planned[i], "during": np.arange(0), "following": np.zeros(6),
-                    "pose_error": float("nan"), "encoder_settle": None,
-                    "settled_at": self.starts[i] + self.planned[i] + SETTLE_S,
-                    "reason": f"the run ended at t = {log.t[-1]:.3f} s, before move {i} began (t = {self.starts[i]:.3f} s)"}
+            return {
+                "arrived": False,
+                "ended": False,
+                "arrivals": np.full(6, np.nan),
+                "spread": 0.0,
+                "late": 0.0,
+                "move_end": self.planned[i],
+                "during": np.arange(0),
+                "following": np.zeros(6),
+                "pose_error": float("nan"),
+                "encoder_settle": None,
+                "settled_at": self.starts[i] + self.planned[i] + SETTLE_S,
+                "reason": f"the run ended at t = {log.t[-1]:.3f} s, before move {i} began (t = {self.starts[i]:.3f} s)",
+            }
         ref = log.reference
         rows = np.arange(lo, end)
-        local = TrajectorySample((rows - lo) * CONTROL_DT, ref.position[rows], ref.velocity[rows], ref.acceleration[rows])
+        local = TrajectorySample(
+            (rows - lo) * CONTROL_DT, ref.position[rows], ref.velocity[rows], ref.acceleration[rows]
+        )
         target = self.strut_targets[i]
         tolerance, moving = strut_tolerances(self.strut_starts[i], target)
         arrivals = arrival_times(local, target, tolerance, CONTROL_DT)
@@ -256,17 +279,31 @@ class HexapodEvaluation:
         sync = [i for i, m in enumerate(self.moves) if m.synchronous]
         asyn = [i for i, m in enumerate(self.moves) if not m.synchronous]
         if sync:
-            checks.append(Check("arrival_spread", max(judged[i]["spread"] for i in sync), ARRIVAL_SPREAD_LIMIT_S, "s",
-                                note="last minus first strut arrival of the commanded motion" + per_move("spread"))
-                          if arrived else
-                          Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=short))
+            checks.append(
+                Check(
+                    "arrival_spread",
+                    max(judged[i]["spread"] for i in sync),
+                    ARRIVAL_SPREAD_LIMIT_S,
+                    "s",
+                    note="last minus first strut arrival of the commanded motion" + per_move("spread"),
+                )
+                if arrived
+                else Check.not_evaluated("arrival_spread", ARRIVAL_SPREAD_LIMIT_S, "s", reason=short)
+            )
         if asyn:
             spread_text = ", ".join(f"{judged[i]['spread']:.3f}" for i in asyn)
-            checks.append(Check("arrival_vs_own_time", max(judged[i]["late"] for i in asyn), OWN_TIME_LIMIT_S, "s",
-                                note=f"each strut's arrival minus its minimum time 2 max(t_i, t'_min) (early is "
-                                     f"negative); arrival spread {spread_text} s")
-                          if arrived else
-                          Check.not_evaluated("arrival_vs_own_time", OWN_TIME_LIMIT_S, "s", reason=short))
+            checks.append(
+                Check(
+                    "arrival_vs_own_time",
+                    max(judged[i]["late"] for i in asyn),
+                    OWN_TIME_LIMIT_S,
+                    "s",
+                    note=f"each strut's arrival minus its minimum time 2 max(t_i, t'_min) (early is "
+                    f"negative); arrival spread {spread_text} s",
+                )
+                if arrived
+                else Check.not_evaluated("arrival_vs_own_time", OWN_TIME_LIMIT_S, "s", reason=short)
+            )
         ended_all = all(j["ended"] for j in judged)
         unsettled = next((i for i, j in enumerate(judged) if not j["ended"]), len(judged) - 1)
         settled_at = judged[unsettled]["settled_at"]
@@ -274,25 +311,59 @@ class HexapodEvaluation:
         move_end = last["move_end"]
         following = max(float(j["following"].max()) for j in judged)
         checks += [
-            Check("strut_velocity", 1e6 * v_cmd, 1e6 * limits.strut_speed, "um/s",
-                  note="commanded; measured peak "
-                       f"{1e6 * np.abs(qd).max():.1f} um/s"),
-            Check("strut_accel", 1e6 * a_cmd, 1e6 * limits.strut_accel, "um/s2",
-                  note="commanded by the generator, per tick"),
+            Check(
+                "strut_velocity",
+                1e6 * v_cmd,
+                1e6 * limits.strut_speed,
+                "um/s",
+                note=f"commanded; measured peak {1e6 * np.abs(qd).max():.1f} um/s",
+            ),
+            Check(
+                "strut_accel",
+                1e6 * a_cmd,
+                1e6 * limits.strut_accel,
+                "um/s2",
+                note="commanded by the generator, per tick",
+            ),
             self._hexapod_speed(ref, poses),
-            Check("following_error", following, FOLLOWING_LIMIT_UM, "um",
-                  note=(f"encoder minus reference, t <= {move_end:.3f} s" if not several else
-                        "encoder minus reference during each move" + per_move("move_end", fmt=".3f") + " s")),
-            Check("pose_error_final", max(j["pose_error"] for j in judged), POSE_FINAL_LIMIT_UM, "um",
-                  note=(f"largest mirror-side pivot displacement over the last {SETTLE_WINDOW_S} s"
-                        + (" before each next move and of the run" + per_move("pose_error") if several else "")))
-            if ended_all else
-            Check.not_evaluated("pose_error_final", POSE_FINAL_LIMIT_UM, "um",
-                                reason=f"the run ended at t = {log.t[-1]:.3f} s, before the move"
-                                       + (f" {unsettled}" if several else "") + " plus "
-                                       f"{SETTLE_S:g} s of settling (t = {settled_at:.3f} s)"),
-            Check("strut_force", float(force), float(p.force_limit.min()), "N",
-                  note=f"demanded, peak on {STRUT_LABELS[int(np.argmax(np.abs(demanded).max(0)))]}"),
+            Check(
+                "following_error",
+                following,
+                FOLLOWING_LIMIT_UM,
+                "um",
+                note=(
+                    f"encoder minus reference, t <= {move_end:.3f} s"
+                    if not several
+                    else "encoder minus reference during each move" + per_move("move_end", fmt=".3f") + " s"
+                ),
+            ),
+            Check(
+                "pose_error_final",
+                max(j["pose_error"] for j in judged),
+                POSE_FINAL_LIMIT_UM,
+                "um",
+                note=(
+                    f"largest mirror-side pivot displacement over the last {SETTLE_WINDOW_S} s"
+                    + (" before each next move and of the run" + per_move("pose_error") if several else "")
+                ),
+            )
+            if ended_all
+            else Check.not_evaluated(
+                "pose_error_final",
+                POSE_FINAL_LIMIT_UM,
+                "um",
+                reason=f"the run ended at t = {log.t[-1]:.3f} s, before the move"
+                + (f" {unsettled}" if several else "")
+                + " plus "
+                f"{SETTLE_S:g} s of settling (t = {settled_at:.3f} s)",
+            ),
+            Check(
+                "strut_force",
+                float(force),
+                float(p.force_limit.min()),
+                "N",
+                note=f"demanded, peak on {STRUT_LABELS[int(np.argmax(np.abs(demanded).max(0)))]}",
+            ),
             Check("stroke", 1e3 * float(stroke), 1e3 * limits.stroke, "mm"),
         ]
         final_pose = poses[-1]
@@ -302,11 +373,19 @@ class HexapodEvaluation:
         metrics = {
             "elevation_deg": p.elevation_deg,
             "move_duration_s": move_end,
-            "arrival_times_s": dict(zip(STRUT_LABELS, [None if np.isnan(a) else a for a in arrivals.round(4).tolist()], strict=True)),
+            "arrival_times_s": dict(
+                zip(STRUT_LABELS, [None if np.isnan(a) else a for a in arrivals.round(4).tolist()], strict=True)
+            ),
             "arrival_spread_s": last["spread"],
             "final_translation_error_um": (1e6 * pose_diff[:3]).round(4).tolist(),
             "final_rotation_error_urad": (1e6 * pose_diff[3:]).round(4).tolist(),
-            "following_error_um_per_strut": dict(zip(STRUT_LABELS, (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist() if during.size else [0.0] * 6, strict=True)),
+            "following_error_um_per_strut": dict(
+                zip(
+                    STRUT_LABELS,
+                    (1e6 * np.abs(q - ref.position)[during].max(0)).round(3).tolist() if during.size else [0.0] * 6,
+                    strict=True,
+                )
+            ),
             "peak_drive_force_N": dict(zip(STRUT_LABELS, np.abs(demanded).max(0).round(1).tolist(), strict=True)),
             "static_drive_force_start_N": dict(zip(STRUT_LABELS, demanded[0].round(1).tolist(), strict=True)),
             "encoder_settle_s": last["encoder_settle"],
@@ -314,16 +393,24 @@ class HexapodEvaluation:
             "loop_closure_um": float(1e6 * self.closure_mismatch(log)[window].max()),
         }
         if several:
-            metrics["moves"] = [{
-                "start_s": float(self.starts[i]), "synchronous": bool(m.synchronous),
-                "target_pose_mm_deg": [*(1e3 * m.target_pose[:3]).round(6).tolist(), *np.degrees(m.target_pose[3:]).round(6).tolist()],
-                "arrived": j["arrived"],
-                "move_duration_s": j["move_end"], "arrival_spread_s": j["spread"],
-                "arrival_vs_own_time_s": None if m.synchronous else j["late"],
-                "following_error_um": float(j["following"].max()),
-                "pose_error_um": j["pose_error"] if j["ended"] else None,
-                "encoder_settle_s": j["encoder_settle"],
-            } for i, (m, j) in enumerate(zip(self.moves, judged, strict=True))]
+            metrics["moves"] = [
+                {
+                    "start_s": float(self.starts[i]),
+                    "synchronous": bool(m.synchronous),
+                    "target_pose_mm_deg": [
+                        *(1e3 * m.target_pose[:3]).round(6).tolist(),
+                        *np.degrees(m.target_pose[3:]).round(6).tolist(),
+                    ],
+                    "arrived": j["arrived"],
+                    "move_duration_s": j["move_end"],
+                    "arrival_spread_s": j["spread"],
+                    "arrival_vs_own_time_s": None if m.synchronous else j["late"],
+                    "following_error_um": float(j["following"].max()),
+                    "pose_error_um": j["pose_error"] if j["ended"] else None,
+                    "encoder_settle_s": j["encoder_settle"],
+                }
+                for i, (m, j) in enumerate(zip(self.moves, judged, strict=True))
+            ]
         if self.wind is not None and self.wind.speed is not None:
             n = log.t.size
             metrics["wind_mean_m_s"] = self.wind.mean_speed
@@ -336,12 +423,14 @@ class HexapodEvaluation:
         the pose of the commanded struts by forward kinematics (from the measured pose), its
         rate from the commanded strut speeds (``hexapod_speed_ratios``)."""
         try:
-            commanded, _ = hexapod_planner.forward_kinematics(ref.position + RUBIN_CAMERA.nominal_lengths,
-                                                              initial=poses, tolerance=1e-12)
+            commanded, _ = hexapod_planner.forward_kinematics(
+                ref.position + RUBIN_CAMERA.nominal_lengths, initial=poses, tolerance=1e-12
+            )
         except PlanningError as e:
             return Check.not_evaluated("hexapod_speed", 1.0, "ratio", reason=f"the commanded pose: {e}")
-        return hexapod_speed_check(hexapod_planner.hexapod_speed_ratios(commanded, ref.velocity).max(axis=0),
-                                   "commanded")
+        return hexapod_speed_check(
+            hexapod_planner.hexapod_speed_ratios(commanded, ref.velocity).max(axis=0), "commanded"
+        )
 
     def timeseries(self, log: RunLog) -> dict:
         p = self.physics
@@ -358,8 +447,11 @@ class HexapodEvaluation:
             "drive_force_demanded": self._demanded(log),
             "drive_force_limit": p.force_limit,
             "pose_actual": p.poses_from_qpos(log.qpos),
-            "target_pose": (np.asarray(self.moves[0].target_pose) if len(self.moves) == 1
-                            else np.array([m.target_pose for m in self.moves])),
+            "target_pose": (
+                np.asarray(self.moves[0].target_pose)
+                if len(self.moves) == 1
+                else np.array([m.target_pose for m in self.moves])
+            ),
             "move_start": self.starts,
             "pivot_error_um": self._pivot_errors_per_move(log),
         }
@@ -400,7 +492,7 @@ def camera_area(physics: HexapodPhysics):
     return area
 
 
-def problems(params: "HexapodParams") -> list[hexapod_planner.MoveProblem]:
+def problems(params: HexapodParams) -> list[hexapod_planner.MoveProblem]:
     """The run's moves, each from the pose the one before reached (the first from the start)."""
     out, pose = [], pose_si(params.start_pose)
     for move in params.moves:
@@ -410,7 +502,7 @@ def problems(params: "HexapodParams") -> list[hexapod_planner.MoveProblem]:
     return out
 
 
-def plan_moves(params: "HexapodParams", planner=None):
+def plan_moves(params: HexapodParams, planner=None):
     """(trajectory, moves, starts, durations): every move planned by ``planner`` (default the
     paper's generator), each starting on the first control tick at least ``params.dwell`` s
     after the tick on which the trajectory before it ended (``end_tick``); one move is its
@@ -438,12 +530,12 @@ def default_duration(starts, durations) -> float:
     return (int(round(starts[-1] / CONTROL_DT)) + end_tick(durations[-1]) + end_tick(SETTLE_S)) * CONTROL_DT
 
 
-def plan(params: "HexapodParams"):
+def plan(params: HexapodParams):
     """The run's moves as the paper's generator plans them (``planbench plan``)."""
     return plan_moves(params)[0]
 
 
-def build(params: "HexapodParams", planner=None, controller=None, plant: "HexapodPlant | None" = None) -> Setup:
+def build(params: HexapodParams, planner=None, controller=None, plant: HexapodPlant | None = None) -> Setup:
     """A hexapod run of the moves: ``planner`` (default the paper's generator) plans each,
     ``controller`` (default ``HexapodController()``) follows them from the start pose at rest;
     the checks judge every move's arrival and target pose and the limits on the trajectory the
@@ -474,17 +566,28 @@ def build(params: "HexapodParams", planner=None, controller=None, plant: "Hexapo
         nominal_physics = nominal_copy(nominal)
     wind = None
     if params.wind > 0:
-        wind = BodyWindDrag("camera", params.wind, camera_area(physics), CAMERA_DRAG_COEFFICIENT,
-                            WIND_AZIMUTH_DEG)
+        wind = BodyWindDrag("camera", params.wind, camera_area(physics), CAMERA_DRAG_COEFFICIENT, WIND_AZIMUTH_DEG)
     evaluation = HexapodEvaluation(physics, moves, starts, durations, wind)
     return Setup(
         physics,
-        Task(problem=moves[0] if len(moves) == 1 else tuple(moves), sensors=sensors(physics), evaluation=evaluation,
-             control_dt=CONTROL_DT, duration=duration, disturbance=wind, nominal_physics=nominal_physics),
-        Components(planner=planner if planner is not None else hexapod_planner.PaperMovePlanner(),
-                   trajectory=trajectory, controller=controller if controller is not None else HexapodController()),
-        Output(video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
-               video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)"),
+        Task(
+            problem=moves[0] if len(moves) == 1 else tuple(moves),
+            sensors=sensors(physics),
+            evaluation=evaluation,
+            control_dt=CONTROL_DT,
+            duration=duration,
+            disturbance=wind,
+            nominal_physics=nominal_physics,
+        ),
+        Components(
+            planner=planner if planner is not None else hexapod_planner.PaperMovePlanner(),
+            trajectory=trajectory,
+            controller=controller if controller is not None else HexapodController(),
+        ),
+        Output(
+            video_qpos=magnified_qpos(physics, VIDEO_MAGNIFICATION),
+            video_note=f"platform motion magnified {VIDEO_MAGNIFICATION:g}x (pose change from the start)",
+        ),
         Provenance(seed=params.seed, params=params, plant=plant),
     )
 

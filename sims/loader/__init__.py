@@ -18,30 +18,48 @@ sims/loader/plan_checks.py (planner-only checks), sims/loader/report.py (report.
 
 from __future__ import annotations
 
-from planbench.planners import loader as loader_planner
 from planbench.loader.controller import reference_controller
-from planbench.loader.params import (CONTROL_DT, SETTLE_S, LoaderParams,
-                                LoaderPlant, log_bytes_per_tick)
-from planbench.loader.physics import (ARM_BODIES, OBSTACLE_CONTYPE, ROBOT_CONTYPE, LoaderPhysics, apply_plant,
-                                 joint_kinds, plant_chain, shell_mass)
+from planbench.loader.params import CONTROL_DT, SETTLE_S, LoaderParams, LoaderPlant, log_bytes_per_tick
+from planbench.loader.physics import (
+    ARM_BODIES,
+    OBSTACLE_CONTYPE,
+    ROBOT_CONTYPE,
+    LoaderPhysics,
+    apply_plant,
+    joint_kinds,
+    plant_chain,
+    shell_mass,
+)
 from planbench.loader.plan_checks import judge_plans
-from planbench.loader.task import (KEYPOINT_LIMIT_DEG, TRACKING_LIMIT_DEG, LoaderEvaluation, build, environment_reward,
-                              plan, problem)
+from planbench.loader.task import (
+    KEYPOINT_LIMIT_DEG,
+    TRACKING_LIMIT_DEG,
+    LoaderEvaluation,
+    build,
+    environment_reward,
+    plan,
+    problem,
+)
+from planbench.planners import loader as loader_planner
 from planbench.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
 
-_RUN = dict(build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT, plant=LoaderPlant(), judge_plans=judge_plans)
+_RUN = dict(
+    build=build, plan=plan, kinds=joint_kinds, control_dt=CONTROL_DT, plant=LoaderPlant(), judge_plans=judge_plans
+)
 
 SCENARIOS = (
     Scenario(
         "loader-supply",
-        "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the breechblock and seat ring",
+        "PRR-3R loader: Table 1 key points P2, M1-M4, P3 through the cubic B-spline, past the "
+        "breechblock and seat ring",
         LoaderParams(),
         **_RUN,
         tags=(DEMO, BENCHMARK),
     ),
     Scenario(
         "loader-direct",
-        "PRR-3R loader: P2 to P3 as a straight joint-space move in the same 2.5 s; strikes the obstacles (expected to fail)",
+        "PRR-3R loader: P2 to P3 as a straight joint-space move in the same 2.5 s; strikes the "
+        "obstacles (expected to fail)",
         # The key points checked are the endpoints; M1 ... M4 are not in this problem.
         LoaderParams(key_points=LoaderParams().key_points[::5], key_interval=2.5),
         expect_pass=False,

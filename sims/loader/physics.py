@@ -14,8 +14,14 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 
 from planbench import models
-from planbench.drives import (DriveTrain, add_drive_train, check_option, drive_coordinates, keyframe_with_motors,
-                         transmission_deflection)
+from planbench.drives import (
+    DriveTrain,
+    add_drive_train,
+    check_option,
+    drive_coordinates,
+    keyframe_with_motors,
+    transmission_deflection,
+)
 from planbench.loader.collision import geoms_by_contype
 from planbench.loader.params import LoaderPlant
 from planbench.plant import set_inertial
@@ -55,8 +61,9 @@ _ARCMIN = math.radians(1.0 / 60.0)
 #: against the reflected rotor, lies far above the 10 Hz loop: rigid); RV cycloidal reducers on
 #: the shoulder and elbow, Harmonic Drive strain-wave gears (no backlash) on the wrist.
 TRANSMISSIONS = {
-    "slide": Transmission("ball screw 32 x 10 mm, preloaded, direct drive", 2.0 * math.pi / 0.010, math.inf, 0.0,
-                          0.90, 1.0),
+    "slide": Transmission(
+        "ball screw 32 x 10 mm, preloaded, direct drive", 2.0 * math.pi / 0.010, math.inf, 0.0, 0.90, 1.0
+    ),
     "shoulder": Transmission("RV cycloidal reducer (RV-320E class)", 120.0, 3.0e6, _ARCMIN, 0.85, 1.9),
     "elbow": Transmission("RV cycloidal reducer (RV-160E class)", 120.0, 1.5e6, _ARCMIN, 0.85, 1.9),
     "wrist_pitch": Transmission("strain-wave gear, size 50, ratio 50", 50.0, 2.8e5, 0.0, 0.75, 1.2),
@@ -71,7 +78,7 @@ VISCOUS_FRACTION = 0.03
 MOTOR_ENCODER_COUNTS = 2**20
 
 
-def joint_drive(nominal: mujoco.MjModel, name: str, plant: "LoaderPlant | None" = None) -> DriveTrain:
+def joint_drive(nominal: mujoco.MjModel, name: str, plant: LoaderPlant | None = None) -> DriveTrain:
     """The drive train of the loader's joint ``name`` as built (``TRANSMISSIONS``), with ``plant``'s
     errors of its friction, stiffness, backlash and torque constant. The motor's rotor is the
     model's armature (J N^2), the drive's loop gains, peak torque and rated speed the model's."""
@@ -81,19 +88,32 @@ def joint_drive(nominal: mujoco.MjModel, name: str, plant: "LoaderPlant | None" 
     rated_speed = float(actuator.ctrlrange[1])
     amps = 1.0 / (t.torque_constant * t.ratio * t.efficiency)  # A per N m (or N) at the joint
     drive = DriveTrain(
-        ratio=t.ratio, rotor_inertia=float(nominal.dof_armature[joint.dofadr[0]]) / t.ratio**2,
-        torque_constant=t.torque_constant, peak_current=peak * amps, continuous_current=0.5 * peak * amps,
-        max_motor_speed=rated_speed * t.ratio, efficiency=t.efficiency,
-        kp=float(actuator.gainprm[0]), kv=float(-actuator.biasprm[2]), stiffness=t.stiffness, backlash=t.backlash,
-        coulomb_friction=COULOMB_FRACTION * peak, viscous_friction=VISCOUS_FRACTION * peak / rated_speed,
-        encoder_resolution=2.0 * math.pi / MOTOR_ENCODER_COUNTS / t.ratio)
+        ratio=t.ratio,
+        rotor_inertia=float(nominal.dof_armature[joint.dofadr[0]]) / t.ratio**2,
+        torque_constant=t.torque_constant,
+        peak_current=peak * amps,
+        continuous_current=0.5 * peak * amps,
+        max_motor_speed=rated_speed * t.ratio,
+        efficiency=t.efficiency,
+        kp=float(actuator.gainprm[0]),
+        kv=float(-actuator.biasprm[2]),
+        stiffness=t.stiffness,
+        backlash=t.backlash,
+        coulomb_friction=COULOMB_FRACTION * peak,
+        viscous_friction=VISCOUS_FRACTION * peak / rated_speed,
+        encoder_resolution=2.0 * math.pi / MOTOR_ENCODER_COUNTS / t.ratio,
+    )
     if plant is None:
         return drive
-    return drive.with_errors(friction=plant.friction_error, stiffness=plant.reducer_stiffness_error,
-                             backlash=plant.backlash_error, torque_constant=plant.torque_constant_error)
+    return drive.with_errors(
+        friction=plant.friction_error,
+        stiffness=plant.reducer_stiffness_error,
+        backlash=plant.backlash_error,
+        torque_constant=plant.torque_constant_error,
+    )
 
 
-def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, plant: "LoaderPlant | None" = None) -> None:
+def as_built(spec: mujoco.MjSpec, nominal: mujoco.MjModel, plant: LoaderPlant | None = None) -> None:
     """Edit the loader's MjSpec into the arm as built: each joint's drive train (``joint_drive``),
     the home keyframe rebuilt for the motors' joints (each at its load's value)."""
     for name in models.loader_spec().names:
@@ -110,8 +130,7 @@ class LoaderPhysics(dm_mujoco.Physics):
     drives = "ideal"
 
     @classmethod
-    def load(cls, payload_mass: float = None, plant: "LoaderPlant | None" = None,
-             drives: str = "ideal") -> "LoaderPhysics":
+    def load(cls, payload_mass: float = None, plant: LoaderPlant | None = None, drives: str = "ideal") -> LoaderPhysics:
         """The scene at its home keyframe; ``payload_mass`` (kg, None: the model's 45 kg) scales
         the shell's geoms' masses, so its inertia scales with them (same shape and density
         distribution), edited with MjSpec before compiling. ``plant`` (None: the nominal
@@ -132,8 +151,9 @@ class LoaderPhysics(dm_mujoco.Physics):
             physics = cls.from_xml_path(str(models.scene_path("loader")))
         else:
             # A copy: the cached model is shared, a run's physics is its own.
-            physics = cls.from_model(dm_mujoco.wrapper.MjModel(
-                copy.copy(_compiled(mass, None if nominal else plant, drives))))
+            physics = cls.from_model(
+                dm_mujoco.wrapper.MjModel(copy.copy(_compiled(mass, None if nominal else plant, drives)))
+            )
         physics.drives = drives
         physics.reset(keyframe_id=0)
         return physics
@@ -217,7 +237,7 @@ class LoaderPhysics(dm_mujoco.Physics):
 
 
 @functools.lru_cache(maxsize=8)
-def _compiled(mass: float, plant: "LoaderPlant | None", drives: str) -> mujoco.MjModel:
+def _compiled(mass: float, plant: LoaderPlant | None, drives: str) -> mujoco.MjModel:
     """The scene with a shell of ``mass`` kg, perturbed into ``plant`` (None: nominal), with
     ``drives`` (``DRIVES``), compiled. The drive trains are built from the nominal model (their
     gains and ratings the drives'), then the plant's edits apply on top."""
@@ -254,7 +274,7 @@ def _joint_dofs(physics: LoaderPhysics) -> np.ndarray:
 ARM_BODIES = ("carriage", "upper_arm", "forearm", "wrist_pitch_link", "wrist_yaw_link", "gripper")
 
 
-def apply_plant(spec: mujoco.MjSpec, plant: "LoaderPlant") -> None:
+def apply_plant(spec: mujoco.MjSpec, plant: LoaderPlant) -> None:
     """Edit the loader's MjSpec into the plant ``plant`` (all but the payload's mass, which
     ``LoaderPhysics.load`` scales). Each edit touches only its own elements:
 
@@ -292,12 +312,16 @@ def apply_plant(spec: mujoco.MjSpec, plant: "LoaderPlant") -> None:
             actuator.biasprm = biasprm
 
 
-def plant_chain(plant: "LoaderPlant | None" = None) -> models.SerialChainSpec:
+def plant_chain(plant: LoaderPlant | None = None) -> models.SerialChainSpec:
     """The plant's kinematic chain (``models.loader_spec()`` with its upper-arm length error),
     for the evaluation's shell tip: the checks judge the true machine."""
     chain = models.loader_spec()
     if plant is None or not plant.upper_arm_length_error:
         return chain
-    bodies = tuple(dataclasses.replace(b, pos=b.pos + np.array([plant.upper_arm_length_error, 0.0, 0.0]))
-                   if b.name == "forearm" else b for b in chain.bodies)
+    bodies = tuple(
+        dataclasses.replace(b, pos=b.pos + np.array([plant.upper_arm_length_error, 0.0, 0.0]))
+        if b.name == "forearm"
+        else b
+        for b in chain.bodies
+    )
     return dataclasses.replace(chain, bodies=bodies)

@@ -86,7 +86,8 @@ How it is fast
     only, so a run judged alone gives the same checks, bit for bit (tested).
 
 Throughput (one core of the 2-core development machine, with other jobs on it; the campaign
-examples/loader/random_keypoints_campaign.toml measures it end to end): 6 key points at 0.5 s, uniform in the joint ranges
+examples/loader/random_keypoints_campaign.toml measures it end to end): 6 key points at 0.5 s, uniform in the
+joint ranges
 (almost all strike something, most leave the ranges): 300 runs/s, 10^5 in about 6 min; Table 1's
 key points each moved by up to +/-3 deg (+/-15 mm), paths that pass the obstacles within
 centimetres: 150 runs/s, 10^5 in about 11 min. The clearance is nine tenths of it. Building
@@ -104,21 +105,21 @@ Example::
 from __future__ import annotations
 
 import functools
-from typing import Sequence
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
 
 from planbench import models
-from planbench.planners.errors import PlanningError
-from planbench.planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, LoaderProblem, si_to_table1
-from planbench.planners.loader.bspline import CubicBSplineTrajectory
-from planbench.planners.trajectory import control_ticks
 from planbench.checks import Check
 from planbench.loader.collision import clearance, geoms_by_contype
 from planbench.loader.params import CONTROL_DT, LoaderParams
 from planbench.loader.physics import OBSTACLE_CONTYPE, ROBOT_CONTYPE
 from planbench.loader.task import KEYPOINT_LIMIT_DEG, problem
+from planbench.planners.errors import PlanningError
+from planbench.planners.loader import JOINT_LIMIT_TOLERANCE, TABLE1, CubicBSplinePlanner, LoaderProblem, si_to_table1
+from planbench.planners.loader.bspline import CubicBSplineTrajectory
+from planbench.planners.trajectory import control_ticks
 from planbench.task import plan_checked
 
 #: ``planbench.loader.collision.clearance``'s cap: distances beyond it are reported as it, m.
@@ -248,8 +249,12 @@ class _Collision:
                 if model.jnt_type[joint.id] == mujoco.mjtJoint.mjJNT_SLIDE:
                     reach[j, g] = 1.0
                     continue
-                reach[j, g] = (np.linalg.norm(model.jnt_pos[joint.id]) + np.linalg.norm(model.geom_pos[geom])
-                               + sum(np.linalg.norm(model.body_pos[k]) for k in chain) + model.geom_rbound[geom])
+                reach[j, g] = (
+                    np.linalg.norm(model.jnt_pos[joint.id])
+                    + np.linalg.norm(model.geom_pos[geom])
+                    + sum(np.linalg.norm(model.body_pos[k]) for k in chain)
+                    + model.geom_rbound[geom]
+                )
         return reach
 
     def _pose(self, q: np.ndarray) -> None:
@@ -282,7 +287,7 @@ class _Collision:
         # Capsules only for pairs whose spheres are within CAPSULE_MARGIN_M of the pose's
         # closest pair's: the others' sphere bounds are valid, if loose, and seldom matter.
         threshold = np.minimum(np.asarray(threshold, dtype=float), bound.min(axis=(1, 2)) + CAPSULE_MARGIN_M)
-        close = np.nonzero(bound < threshold[:, None, None])                    # (tick, robot, obstacle)
+        close = np.nonzero(bound < threshold[:, None, None])  # (tick, robot, obstacle)
         if close[0].size:
             t, r, o = close
             half_axis = np.einsum("nij,nj->ni", xmat[t, r].reshape(-1, 3, 3), self.robot_half_axis[r])
@@ -292,9 +297,16 @@ class _Collision:
             if (~plane).any():
                 w = ~plane
                 j = self.solid_index[o[w]]
-                capsule[w] = (_segment_distance(start[w], 2.0 * half_axis[w], self.obstacle_start[j],
-                                                self.obstacle_direction[j], self.obstacle_length2[j])
-                              - self.obstacle_radius[o[w]])
+                capsule[w] = (
+                    _segment_distance(
+                        start[w],
+                        2.0 * half_axis[w],
+                        self.obstacle_start[j],
+                        self.obstacle_direction[j],
+                        self.obstacle_length2[j],
+                    )
+                    - self.obstacle_radius[o[w]]
+                )
             if plane.any():
                 normal, offset = self.normals[o[plane]], self.offsets[o[plane]]
                 ends = np.minimum((start[plane] * normal).sum(-1), ((start + 2.0 * half_axis)[plane] * normal).sum(-1))
@@ -366,14 +378,14 @@ def min_clearances(q: np.ndarray, travel: np.ndarray):
     collision = _collision()
     g, n = q.shape[:2]
     arc = np.concatenate([np.zeros((g, 1)), np.cumsum(travel, axis=1)], axis=1)
-    low = np.full((g, n), np.nan)      # a lower bound of each visited tick (exact where evaluated)
+    low = np.full((g, n), np.nan)  # a lower bound of each visited tick (exact where evaluated)
     exact = np.zeros((g, n), dtype=bool)
     pair = np.full((g, n, 2), -1)
     best = np.full(g, np.inf)
 
     def visit(paths: np.ndarray, ticks: np.ndarray) -> None:
         for lo in range(0, paths.size, ROUND_POSES):
-            p, k = paths[lo:lo + ROUND_POSES], ticks[lo:lo + ROUND_POSES]
+            p, k = paths[lo : lo + ROUND_POSES], ticks[lo : lo + ROUND_POSES]
             bounds = collision.bounds(q[p, k], np.minimum(best[p], DISTMAX_M) + BOUND_SLACK_M)
             least = np.minimum(bounds.min(axis=1), DISTMAX_M)
             low[p, k] = least
@@ -453,7 +465,7 @@ def _judge_group(tasks: Sequence[LoaderProblem]) -> list[dict]:
     first = tasks[0]
     m = len(first.labels)
     g = len(tasks)
-    points = np.concatenate([t.key_points for t in tasks], axis=1)            # (k, m g)
+    points = np.concatenate([t.key_points for t in tasks], axis=1)  # (k, m g)
     stacked = CubicBSplineTrajectory(first.key_times, points, margin=JOINT_LIMIT_TOLERANCE)
     lower, upper = np.tile(first.lower, g), np.tile(first.upper, g)
     rate = np.tile(first.rate_limit, g)
@@ -467,9 +479,12 @@ def _judge_group(tasks: Sequence[LoaderProblem]) -> list[dict]:
     # The range as the planner judges it, with its numbers: the key points and the values at
     # the spline's extrema (``extrema``, the planner's own arithmetic, channel by channel).
     positions, position_t = stacked.extrema()
-    range_ratio = np.concatenate([
-        range_ratio_of(points, lower, upper, stacked.margin),
-        range_ratio_of(positions, lower, upper, stacked.limit_tolerance)])      # (c, m g)
+    range_ratio = np.concatenate(
+        [
+            range_ratio_of(points, lower, upper, stacked.margin),
+            range_ratio_of(positions, lower, upper, stacked.limit_tolerance),
+        ]
+    )  # (c, m g)
     positions = np.concatenate([points, positions])
     position_t = np.concatenate([np.broadcast_to(first.key_times[:, None], points.shape), position_t])
     rate_ratio = speeds / rate
@@ -484,13 +499,12 @@ def _judge_group(tasks: Sequence[LoaderProblem]) -> list[dict]:
     # (the acceleration is linear per segment: its largest magnitude is at a segment's end).
     poly = stacked.segment_polynomials()
     acc_ends = np.concatenate([np.abs(2.0 * poly[:, 1]), np.abs(6.0 * poly[:, 0] * h + 2.0 * poly[:, 1])])
-    acc_max = acc_ends.max(axis=0)                                              # (m g,)
+    acc_max = acc_ends.max(axis=0)  # (m g,)
     speed = np.abs(sample.velocity)
     step = np.diff(ticks)[:, None]
-    between = np.maximum(speed[:-1], speed[1:]) + 0.5 * step * acc_max          # (T-1, m g)
-    reach = _collision().reach                                                  # (m, geoms)
-    travel = (np.einsum("tgj,jr->tgr", between.reshape(-1, g, m), reach).max(axis=-1)
-              * step)                                                           # (T-1, g)
+    between = np.maximum(speed[:-1], speed[1:]) + 0.5 * step * acc_max  # (T-1, m g)
+    reach = _collision().reach  # (m, geoms)
+    travel = np.einsum("tgj,jr->tgr", between.reshape(-1, g, m), reach).max(axis=-1) * step  # (T-1, g)
     clearances = min_clearances(np.moveaxis(q, 1, 0), travel.T)
     out = []
     labels = first.labels
@@ -501,16 +515,27 @@ def _judge_group(tasks: Sequence[LoaderProblem]) -> list[dict]:
         kr, jr = np.unravel_index(int(np.argmax(rr)), rr.shape)
         kt, jt = np.unravel_index(int(np.argmax(rt)), rt.shape)
         d, tick, robot, obstacle, evaluated = (v[i] for v in clearances)
-        out.append({
-            "key_deg": float(key_deg[:, i, 1:].max()), "key_point": int(worst_key[0]),
-            "key_joint": labels[1 + int(worst_key[1])], "key_slide_mm": float(key_slide_mm[i]),
-            "range": float(rr[kr, jr]), "range_joint": labels[jr], "range_t": float(position_t[kr, cols][jr]),
-            "range_value": float(positions[kr, cols][jr]),
-            "rate": float(rt[kt, jt]), "rate_joint": labels[jt], "rate_t": float(speed_t[kt, cols][jt]),
-            "rate_value": float(speeds[kt, cols][jt]),
-            "clearance": float(d), "clearance_t": float(ticks[tick]), "pair": (robot, obstacle),
-            "ticks_evaluated": evaluated, "ticks": ticks.size,
-        })
+        out.append(
+            {
+                "key_deg": float(key_deg[:, i, 1:].max()),
+                "key_point": int(worst_key[0]),
+                "key_joint": labels[1 + int(worst_key[1])],
+                "key_slide_mm": float(key_slide_mm[i]),
+                "range": float(rr[kr, jr]),
+                "range_joint": labels[jr],
+                "range_t": float(position_t[kr, cols][jr]),
+                "range_value": float(positions[kr, cols][jr]),
+                "rate": float(rt[kt, jt]),
+                "rate_joint": labels[jt],
+                "rate_t": float(speed_t[kt, cols][jt]),
+                "rate_value": float(speeds[kt, cols][jt]),
+                "clearance": float(d),
+                "clearance_t": float(ticks[tick]),
+                "pair": (robot, obstacle),
+                "ticks_evaluated": evaluated,
+                "ticks": ticks.size,
+            }
+        )
     return out
 
 
@@ -521,7 +546,7 @@ def range_ratio_of(values: np.ndarray, lower: np.ndarray, upper: np.ndarray, all
     on it, at most 1; one beyond by more is above 1, however little (the planner refuses it).
     So the check passes exactly when the planner accepts, whatever the rounding of the
     ratio."""
-    excess = np.maximum(values - upper, -(values - lower))   # the planner's sign (v - l)
+    excess = np.maximum(values - upper, -(values - lower))  # the planner's sign (v - l)
     ratio = np.abs(values - (upper + lower) / 2.0) / ((upper - lower) / 2.0)
     within = excess <= allowed
     return np.where(within, np.minimum(ratio, 1.0), np.maximum(ratio, np.nextafter(1.0, 2.0)))
@@ -544,19 +569,43 @@ def _checks(j: dict, refusal: str = "") -> list[Check]:
     range_unit = "m" if j["range_joint"] == slide else "rad"
     rate_unit = "m/s" if j["rate_joint"] == slide else "rad/s"
     return [
-        Check("plan_keypoint_error", j["key_deg"], KEYPOINT_LIMIT_DEG, "deg",
-              note=f"planned minus key point, worst {j['key_joint']} at key point {j['key_point']}; "
-                   f"slide {j['key_slide_mm']:.3g} mm"),
-        Check("joint_range", j["range"], 1.0, "ratio",
-              note=f"|theta - centre| / half range, worst {j['range_joint']} = {j['range_value']:.6g} "
-                   f"{range_unit} at t = {j['range_t']:.3f} s" + (f"; {refusal}" if refusal else "")),
-        Check("joint_rate", j["rate"], 1.0, "ratio",
-              note=f"|planned rate| / rate limit, worst {j['rate_joint']} {j['rate_value']:.4g} {rate_unit} "
-                   f"at t = {j['rate_t']:.3f} s"),
-        Check("plan_min_clearance", j["clearance"], 0.0, "m", ">",
-              note=(f"{collision.name(robot)}/{collision.name(obstacle)} at t = {j['clearance_t']:.3f} s"
-                    if robot >= 0 else f"nothing within {DISTMAX_M:g} m")
-                   + f"; {j['ticks_evaluated']} of {j['ticks']} ticks evaluated (branch and bound)"),
+        Check(
+            "plan_keypoint_error",
+            j["key_deg"],
+            KEYPOINT_LIMIT_DEG,
+            "deg",
+            note=f"planned minus key point, worst {j['key_joint']} at key point {j['key_point']}; "
+            f"slide {j['key_slide_mm']:.3g} mm",
+        ),
+        Check(
+            "joint_range",
+            j["range"],
+            1.0,
+            "ratio",
+            note=f"|theta - centre| / half range, worst {j['range_joint']} = {j['range_value']:.6g} "
+            f"{range_unit} at t = {j['range_t']:.3f} s" + (f"; {refusal}" if refusal else ""),
+        ),
+        Check(
+            "joint_rate",
+            j["rate"],
+            1.0,
+            "ratio",
+            note=f"|planned rate| / rate limit, worst {j['rate_joint']} {j['rate_value']:.4g} {rate_unit} "
+            f"at t = {j['rate_t']:.3f} s",
+        ),
+        Check(
+            "plan_min_clearance",
+            j["clearance"],
+            0.0,
+            "m",
+            ">",
+            note=(
+                f"{collision.name(robot)}/{collision.name(obstacle)} at t = {j['clearance_t']:.3f} s"
+                if robot >= 0
+                else f"nothing within {DISTMAX_M:g} m"
+            )
+            + f"; {j['ticks_evaluated']} of {j['ticks']} ticks evaluated (branch and bound)",
+        ),
     ]
 
 
@@ -590,7 +639,7 @@ def judge_plans(params_list: Sequence[LoaderParams], planner=None) -> list[list[
         ticks = float(tasks[members[0]].key_times[-1]) / CONTROL_DT + 2
         size = int(min(CHUNK_RUNS, max(1, CHUNK_TICKS // ticks)))
         for lo in range(0, len(members), size):
-            chunk = members[lo:lo + size]
+            chunk = members[lo : lo + size]
             for i, judged in zip(chunk, _judge_group([tasks[i] for i in chunk]), strict=True):
                 out[i] = _checks(judged, _refusal(tasks[i]) if judged["range"] > 1.0 else "")
     return out
@@ -623,16 +672,27 @@ def judge_trajectory(task: LoaderProblem, trajectory) -> list[Check]:
     values, pairs = clearance(collision.model, full, collision.robot, collision.obstacles)
     i = int(np.argmin(values))
     labels = task.labels
-    return _checks({
-        "key_deg": float(key_deg.max()), "key_point": int(k), "key_joint": labels[1 + int(jk)],
-        "key_slide_mm": float(1e3 * np.abs(at_keys[:, 0]).max()),
-        "range": float(rr[kr, jr]), "range_joint": labels[jr], "range_t": float(ticks[kr]),
-        "range_value": float(q[kr, jr]),
-        "rate": float(rt[kt, jt]), "rate_joint": labels[jt], "rate_t": float(ticks[kt]),
-        "rate_value": float(np.abs(sample.velocity[kt, jt])),
-        "clearance": float(values[i]), "clearance_t": float(ticks[i]), "pair": (int(pairs[i, 0]), int(pairs[i, 1])),
-        "ticks_evaluated": ticks.size, "ticks": ticks.size,
-    })
+    return _checks(
+        {
+            "key_deg": float(key_deg.max()),
+            "key_point": int(k),
+            "key_joint": labels[1 + int(jk)],
+            "key_slide_mm": float(1e3 * np.abs(at_keys[:, 0]).max()),
+            "range": float(rr[kr, jr]),
+            "range_joint": labels[jr],
+            "range_t": float(ticks[kr]),
+            "range_value": float(q[kr, jr]),
+            "rate": float(rt[kt, jt]),
+            "rate_joint": labels[jt],
+            "rate_t": float(ticks[kt]),
+            "rate_value": float(np.abs(sample.velocity[kt, jt])),
+            "clearance": float(values[i]),
+            "clearance_t": float(ticks[i]),
+            "pair": (int(pairs[i, 0]), int(pairs[i, 1])),
+            "ticks_evaluated": ticks.size,
+            "ticks": ticks.size,
+        }
+    )
 
 
 # --------------------------------------------------------------------------- throughput

@@ -13,7 +13,7 @@ def loader_report(ts: dict, t: np.ndarray, checks, path) -> None:
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
     ax = axes[0, 0]
     for j in range(1, len(names)):
-        line, = ax.plot(t, np.rad2deg(ts["q_actual"][:, j]), label=names[j])
+        (line,) = ax.plot(t, np.rad2deg(ts["q_actual"][:, j]), label=names[j])
         ax.plot(t, np.rad2deg(ts["q_planned"][:, j]), "--", color=line.get_color(), lw=0.8)
     ax.plot(ts["key_times"], np.rad2deg(ts["key_points"][:, 1:]), "ko", ms=3)
     ax.set(title="joint angles (solid: simulated, dashed: planned)", xlabel="t [s]", ylabel="deg")

@@ -6,8 +6,8 @@ import dataclasses
 
 import numpy as np
 
-from planbench.loader.params import CONTROL_DT
 from planbench import models
+from planbench.loader.params import CONTROL_DT
 from planbench.loader.physics import LoaderPhysics, joint_drive
 from planbench.task import JointEncoders
 
@@ -22,14 +22,24 @@ def sensors(physics: LoaderPhysics, bias=None) -> JointEncoders:
     added to every reading; None or zeros: none."""
     model = physics.model.ptr
     ideal = physics.drives == "ideal"
-    resolution = 0.0 if ideal else [joint_drive(models.load("loader"), n).encoder_resolution
-                                    for n in physics.joint_names]
-    measures = "encoders of theta1 (m) ... theta6 (rad)" if ideal else \
-        "motor encoders of theta1 (m) ... theta6 (rad), read through the transmission ratios"
-    encoders = JointEncoders(physics.drive_qpos, physics.drive_dofs,
-                             [model.actuator(n).actadr[0] for n in physics.joint_names],
-                             measures, "m|rad", CONTROL_DT, bias=0.0 if bias is None else bias,
-                             resolution=resolution)
+    resolution = (
+        0.0 if ideal else [joint_drive(models.load("loader"), n).encoder_resolution for n in physics.joint_names]
+    )
+    measures = (
+        "encoders of theta1 (m) ... theta6 (rad)"
+        if ideal
+        else "motor encoders of theta1 (m) ... theta6 (rad), read through the transmission ratios"
+    )
+    encoders = JointEncoders(
+        physics.drive_qpos,
+        physics.drive_dofs,
+        [model.actuator(n).actadr[0] for n in physics.joint_names],
+        measures,
+        "m|rad",
+        CONTROL_DT,
+        bias=0.0 if bias is None else bias,
+        resolution=resolution,
+    )
     if bias is not None and np.any(bias):
         # The datasheet a controller is given (ControlContext.sensors) cannot state the true
         # zero offset of this machine's encoders: it is the plant's (summary.json's "plant").

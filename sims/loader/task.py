@@ -5,10 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planbench import models
-from planbench.planners import loader as loader_planner
-from planbench.planners.loader import forward_kinematics
-from planbench import run_limits
+from planbench import models, run_limits
 from planbench.checks import Check
 from planbench.controllers import demanded_force
 from planbench.loader.collision import clearance, obstacle_contact_pairs
@@ -16,6 +13,8 @@ from planbench.loader.controller import reference_controller
 from planbench.loader.params import CONTROL_DT, LoaderParams, LoaderPlant
 from planbench.loader.physics import LoaderPhysics, _joint_dofs, plant_chain
 from planbench.loader.sensors import sensors
+from planbench.planners import loader as loader_planner
+from planbench.planners.loader import forward_kinematics
 from planbench.runner import RunLog, Setup
 from planbench.task import Components, Provenance, Task, nominal_copy, plan_checked
 
@@ -29,8 +28,9 @@ TRACKING_LIMIT_DEG = 0.25
 class LoaderEvaluation:
     """Checks and outputs of a loader run (keypoints are Table 1's, in SI units)."""
 
-    def __init__(self, physics: LoaderPhysics, key_times: np.ndarray, key_points: np.ndarray,
-                 plant: "LoaderPlant | None" = None):
+    def __init__(
+        self, physics: LoaderPhysics, key_times: np.ndarray, key_points: np.ndarray, plant: LoaderPlant | None = None
+    ):
         self.physics = physics
         self.spec = models.loader_spec()
         self.key_times = np.asarray(key_times)
@@ -89,8 +89,10 @@ class LoaderEvaluation:
         pairs = obstacle_contact_pairs(log.contacts, robot, obstacles)
         clear, closest = self.clearance(log)
         i_min = int(np.argmin(clear))
+
         def names(pair):
             return f"{model.geom(int(pair[0])).name}/{model.geom(int(pair[1])).name}"
+
         contact_note = ", ".join(
             f"{names(p)} from t = {log.t[v[0]]:.3f} s for {v[1]} ticks, {1e3 * v[2]:.1f} mm deep"
             for p, v in sorted(pairs.items(), key=lambda kv: kv[1][0])
@@ -98,22 +100,40 @@ class LoaderEvaluation:
         reached_note = f"{int(reached.sum())} of {self.key_times.size} key points reached"
         checks = [
             Check("keypoint_error", float(key_err_deg.max()), KEYPOINT_LIMIT_DEG, "deg", note=reached_note)
-            if key_err_deg.size else
-            Check.not_evaluated("keypoint_error", KEYPOINT_LIMIT_DEG, "deg",
-                                reason=f"the run ended at t = {log.t[-1]:.3f} s, before the first "
-                                       f"key point (t = {self.key_times.min():.3f} s)"),
+            if key_err_deg.size
+            else Check.not_evaluated(
+                "keypoint_error",
+                KEYPOINT_LIMIT_DEG,
+                "deg",
+                reason=f"the run ended at t = {log.t[-1]:.3f} s, before the first "
+                f"key point (t = {self.key_times.min():.3f} s)",
+            ),
             Check("tracking_error", float(err_deg.max()), TRACKING_LIMIT_DEG, "deg"),
             Check("obstacle_contacts", len(pairs), 0, "count", "==", note=contact_note),
-            Check("min_clearance", float(clear[i_min]), 0.0, "m", ">",
-                  note=f"{names(closest[i_min])} at t = {log.t[i_min]:.3f} s"
-                  if closest[i_min, 0] >= 0 else "nothing within 0.5 m"),
-            Check("joint_torque", float(torque_ratio.max()), 1.0, "ratio",
-                  note=f"peak on {self.spec.names[int(np.argmax(torque_ratio.max(0)))]}"),
+            Check(
+                "min_clearance",
+                float(clear[i_min]),
+                0.0,
+                "m",
+                ">",
+                note=f"{names(closest[i_min])} at t = {log.t[i_min]:.3f} s"
+                if closest[i_min, 0] >= 0
+                else "nothing within 0.5 m",
+            ),
+            Check(
+                "joint_torque",
+                float(torque_ratio.max()),
+                1.0,
+                "ratio",
+                note=f"peak on {self.spec.names[int(np.argmax(torque_ratio.max(0)))]}",
+            ),
         ]
         metrics = {
             "keypoint_error_slide_mm": float(key_err_slide_mm.max()) if key_err_slide_mm.size else None,
             "tracking_error_slide_mm": float(1e3 * np.abs(err[:, 0]).max()),
-            "tracking_error_deg_per_joint": dict(zip(self.spec.names[1:], err_deg.max(0).round(6).tolist(), strict=True)),
+            "tracking_error_deg_per_joint": dict(
+                zip(self.spec.names[1:], err_deg.max(0).round(6).tolist(), strict=True)
+            ),
             "peak_torque_per_joint": dict(zip(self.spec.names, np.abs(tau).max(0).round(3).tolist(), strict=True)),
             "torque_limit_per_joint": dict(zip(self.spec.names, self.force_limit.tolist(), strict=True)),
             "final_shell_tip_m": self._shell_tip(log)[-1].tolist(),
@@ -147,21 +167,22 @@ class LoaderEvaluation:
         loader_report(self.timeseries(log), log.t, checks, path)
 
 
-def problem(params: "LoaderParams") -> loader_planner.LoaderProblem:
+def problem(params: LoaderParams) -> loader_planner.LoaderProblem:
     """The run's planning problem: the key points at uniform times, the model's limits."""
     points = loader_planner.table1_to_si(np.array(params.key_points))
     times = np.arange(len(points)) * params.key_interval
     spec = models.loader_spec()
-    return loader_planner.LoaderProblem(times, points, tuple(spec.names), spec.lower, spec.upper,
-                                        spec.rate_limit, spec.force_limit)
+    return loader_planner.LoaderProblem(
+        times, points, tuple(spec.names), spec.lower, spec.upper, spec.rate_limit, spec.force_limit
+    )
 
 
-def plan(params: "LoaderParams"):
+def plan(params: LoaderParams):
     """The paper's cubic B-spline through the run's key points (``planbench plan``)."""
     return loader_planner.CubicBSplinePlanner().plan(problem(params))
 
 
-def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderPlant | None" = None) -> Setup:
+def build(params: LoaderParams, planner=None, controller=None, plant: LoaderPlant | None = None) -> Setup:
     """A loader run: ``planner`` (default the paper's cubic B-spline) plans the key points,
     ``controller`` (default ``reference_controller()``) follows it from the first key point, at
     rest; the checks judge the key points, the obstacles and the drive limits.
@@ -189,10 +210,19 @@ def build(params: "LoaderParams", planner=None, controller=None, plant: "LoaderP
     evaluation = LoaderEvaluation(physics, task.key_times, task.key_points, plant)
     return Setup(
         physics,
-        Task(problem=task, sensors=sensors(physics, bias), evaluation=evaluation, control_dt=CONTROL_DT,
-             duration=duration, nominal_physics=nominal_physics),
-        Components(planner=planner, trajectory=trajectory,
-                   controller=reference_controller() if controller is None else controller),
+        Task(
+            problem=task,
+            sensors=sensors(physics, bias),
+            evaluation=evaluation,
+            control_dt=CONTROL_DT,
+            duration=duration,
+            nominal_physics=nominal_physics,
+        ),
+        Components(
+            planner=planner,
+            trajectory=trajectory,
+            controller=reference_controller() if controller is None else controller,
+        ),
         provenance=Provenance(seed=params.seed, params=params, plant=plant),
     )
 
@@ -203,5 +233,6 @@ def environment_reward(setup: Setup):
     from planbench.envs import joint_tracking_reward
 
     physics = setup.physics
-    return joint_tracking_reward(physics.model.ptr.jnt_qposadr[[physics.model.ptr.joint(n).id
-                                                                for n in physics.joint_names]], np.deg2rad(0.1))
+    return joint_tracking_reward(
+        physics.model.ptr.jnt_qposadr[[physics.model.ptr.joint(n).id for n in physics.joint_names]], np.deg2rad(0.1)
+    )

@@ -46,8 +46,10 @@ class QuinticSwing:
         s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
         ds = np.where(inside, 30.0 * tau**2 * (1.0 - tau) ** 2 / T, 0.0)
         dds = np.where(inside, 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / T**2, 0.0)
+
         def column(x):
             return np.asarray(x, dtype=float).reshape(-1, 1)
+
         return TrajectorySample(t, column(start + span * s), column(span * ds), column(span * dds))
 
 

@@ -16,13 +16,12 @@ from dataclasses import dataclass
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
-from planbench import models
-from planbench.planners import pendulum as pendulum_planner
-from planbench import run_limits
+from planbench import models, run_limits
 from planbench.checks import Check
 from planbench.controllers import ServoFeedforwardController, demanded_force
 from planbench.envs import joint_tracking_reward
 from planbench.params import ScenarioParams, param
+from planbench.planners import pendulum as pendulum_planner
 from planbench.runner import RunLog, Setup
 from planbench.scenarios import BENCHMARK, DEMO, Mechanism, Scenario
 from planbench.task import Components, JointEncoders, Provenance, Task, plan_checked
@@ -38,7 +37,7 @@ class PendulumPhysics(dm_mujoco.Physics):
     """dm_control Physics of models/pendulum/scene.xml."""
 
     @classmethod
-    def load(cls) -> "PendulumPhysics":
+    def load(cls) -> PendulumPhysics:
         physics = cls.from_xml_path(str(models.scene_path("pendulum")))
         physics.reset(keyframe_id=0)
         return physics
@@ -71,12 +70,30 @@ def log_bytes_per_tick() -> float:
 class PendulumParams(ScenarioParams):
     """A swing: its goal, its time, the hold after it."""
 
-    goal: float = param(1.2, "goal angle from hanging", "rad", low=-2.5, high=2.5,
-                        reason="inside the hinge's +/-3 rad range with margin")
-    move_time: float = param(1.0, "time of the swing", "s", low=0.2, high=60.0,
-                             reason="faster than 0.2 s the swing needs more than the 40 N m drive")
-    hold: float = param(0.8, "time simulated at the goal after the swing", "s", low=ARRIVAL_S, high=60.0,
-                        reason="at least the arrival window")
+    goal: float = param(
+        1.2,
+        "goal angle from hanging",
+        "rad",
+        low=-2.5,
+        high=2.5,
+        reason="inside the hinge's +/-3 rad range with margin",
+    )
+    move_time: float = param(
+        1.0,
+        "time of the swing",
+        "s",
+        low=0.2,
+        high=60.0,
+        reason="faster than 0.2 s the swing needs more than the 40 N m drive",
+    )
+    hold: float = param(
+        0.8,
+        "time simulated at the goal after the swing",
+        "s",
+        low=ARRIVAL_S,
+        high=60.0,
+        reason="at least the arrival window",
+    )
 
     def check(self) -> None:
         run_limits.check_duration(self.move_time + self.hold, CONTROL_DT, self.log_bytes_per_tick())
@@ -113,8 +130,11 @@ class PendulumEvaluation:
         return checks, metrics
 
     def timeseries(self, log: RunLog) -> dict:
-        return {"q_planned": log.reference.position[:, 0], "q_actual": log.qpos[:, self.qpos],
-                "drive_torque": log.actuator_force[:, 0]}
+        return {
+            "q_planned": log.reference.position[:, 0],
+            "q_actual": log.qpos[:, self.qpos],
+            "drive_torque": log.actuator_force[:, 0],
+        }
 
     def report(self, log: RunLog, checks, path) -> None:
         from planbench.report import finish, plt
@@ -149,15 +169,24 @@ def build(params: PendulumParams, planner=None, controller=None, plant=None) -> 
     physics.set_start(swing.start)
     model = physics.model.ptr
     actuator = model.actuator("swing")
-    sensors = JointEncoders([physics.swing_qpos], [physics.swing_dof], [actuator.actadr[0]],
-                            "encoder of the swing joint (rad)", "rad", CONTROL_DT)
+    sensors = JointEncoders(
+        [physics.swing_qpos],
+        [physics.swing_dof],
+        [actuator.actadr[0]],
+        "encoder of the swing joint (rad)",
+        "rad",
+        CONTROL_DT,
+    )
     duration = trajectory.duration + params.hold
     evaluation = PendulumEvaluation(physics, params.goal, duration - ARRIVAL_S)
     return Setup(
         physics,
         Task(problem=swing, sensors=sensors, evaluation=evaluation, control_dt=CONTROL_DT, duration=duration),
-        Components(planner=planner, trajectory=trajectory,
-                   controller=ServoFeedforwardController() if controller is None else controller),
+        Components(
+            planner=planner,
+            trajectory=trajectory,
+            controller=ServoFeedforwardController() if controller is None else controller,
+        ),
         provenance=Provenance(seed=params.seed, params=params),
     )
 
@@ -168,9 +197,16 @@ def environment_reward(setup: Setup):
 
 
 SCENARIOS = (
-    Scenario("pendulum-swing", "one-joint pendulum: a quintic swing from hanging to the goal, held there",
-             PendulumParams(), build=build, plan=plan, kinds=lambda: ["hinge"], control_dt=CONTROL_DT,
-             tags=(DEMO, BENCHMARK)),
+    Scenario(
+        "pendulum-swing",
+        "one-joint pendulum: a quintic swing from hanging to the goal, held there",
+        PendulumParams(),
+        build=build,
+        plan=plan,
+        kinds=lambda: ["hinge"],
+        control_dt=CONTROL_DT,
+        tags=(DEMO, BENCHMARK),
+    ),
 )
 
 MECHANISM = Mechanism("pendulum", SCENARIOS, environment_reward, benchmark_runs=1)
