@@ -72,8 +72,8 @@ class ChunkedSample:
 
     def __init__(self, sample: Callable, t: np.ndarray, chunk: int = 4096, stored=None):
         self.sample, self.t, self.chunk = sample, t, max(1, int(chunk))
-        self._held = (0, None)  # (first row, TrajectorySample) of the rows sampled last
-        self._whole = None
+        self._held: tuple = (0, None)  # (first row, TrajectorySample) of the rows sampled last
+        self._whole: TrajectorySample | None = None
         # Rows sampled once and read back: an object with ``span(name, start, stop)`` (a
         # planbench.logfile.LogFile of arrays position, velocity, acceleration), or None.
         self.stored = stored

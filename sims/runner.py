@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from functools import partial
 from math import isfinite
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -87,7 +88,7 @@ class Setup:
       provenance: seed, parameters, plant and plug-ins (``planbench.task.Provenance``).
     """
 
-    physics: object
+    physics: Any  # a dm_control.mujoco.Physics (dm_control has no type information)
     task: Task
     components: Components
     output: Output = field(default_factory=Output)
@@ -105,7 +106,7 @@ class _Logged:
     def __set_name__(self, owner, name):
         self.name = name
 
-    def __get__(self, log, owner=None):
+    def __get__(self, log, owner=None) -> Any:
         if log is None:
             return None  # the dataclass default
         value = log.__dict__.get(self.name)
@@ -124,9 +125,9 @@ class RunLog:
     Arrays: t (n,), qpos, qvel, act, ctrl, actuator_force, sensordata (n, size), mocap_pos
     and mocap_quat (n, nmocap, 3|4) when the model has mocap bodies. ``reference`` is the
     planned motion sampled at ``t`` (of a simulated run, a ``ChunkedSample``: its ``rows``
-    sample a chunk of ticks, its arrays are sampled whole when first read). ``ctrl`` row i holds the controls
-    applied from ``t[i]``;
-    the last row, after which no physics runs, the controls still held there. ``contacts``
+    sample a chunk of ticks, its arrays are sampled whole when first read). ``ctrl`` row i
+    holds the controls applied from ``t[i]``; the last row, after which no physics runs, the
+    controls still held there. ``contacts``
     lists (tick, geom1, geom2, distance) of every contact seen at a tick's end. ``n`` may be
     shorter than planned when the run diverged.
 
@@ -135,15 +136,15 @@ class RunLog:
     reads them a chunk at a time.
     """
 
-    t: np.ndarray = _Logged()
-    qpos: np.ndarray = _Logged()
-    qvel: np.ndarray = _Logged()
-    act: np.ndarray = _Logged()
-    ctrl: np.ndarray = _Logged()
-    actuator_force: np.ndarray = _Logged()
-    sensordata: np.ndarray = _Logged()
-    mocap_pos: np.ndarray = _Logged()
-    mocap_quat: np.ndarray = _Logged()
+    t: _Logged = _Logged()  # an np.ndarray when read
+    qpos: _Logged = _Logged()  # an np.ndarray when read
+    qvel: _Logged = _Logged()  # an np.ndarray when read
+    act: _Logged = _Logged()  # an np.ndarray when read
+    ctrl: _Logged = _Logged()  # an np.ndarray when read
+    actuator_force: _Logged = _Logged()  # an np.ndarray when read
+    sensordata: _Logged = _Logged()  # an np.ndarray when read
+    mocap_pos: _Logged = _Logged()  # an np.ndarray when read
+    mocap_quat: _Logged = _Logged()  # an np.ndarray when read
     reference: TrajectorySample | ChunkedSample | None = None
     contacts: list = field(default_factory=list)
     warnings: dict = field(default_factory=dict)
@@ -178,8 +179,8 @@ class RunLog:
         for start in range(0, n, size):
             yield start, {name: getattr(self, name)[start : start + size] for name in names}
 
-    def every(self, name: str, stride: int) -> np.ndarray:
-        """Rows 0, stride, 2 stride, ... of the array ``name`` (``array[::stride]``), read a
+    def every(self, name: str, stride: int) -> np.ndarray | None:
+        """Rows 0, stride, 2 stride, ... of the array ``name`` (None: a model without it) (``array[::stride]``), read a
         chunk at a time."""
         if self.file is None or self.held(name):
             value = getattr(self, name)
@@ -354,9 +355,12 @@ def start_episode(setup: Setup, seed: int | None = None) -> Episode:
     command, act_adr = controlled_views(setup)
     visible = task.reference_visible
     planner = components.planner
+    nominal_physics = task.nominal_physics
+    if nominal_physics is None:  # Task.attach sets it (a Setup attaches its task)
+        raise RuntimeError("the task is not attached to its physics: Task.attach(physics) first")
     context = ControlContext(
-        model=task.nominal_physics().model.ptr,
-        nominal_physics=task.nominal_physics,
+        model=nominal_physics().model.ptr,
+        nominal_physics=nominal_physics,
         problem=task.problem,
         trajectory=components.trajectory if visible else None,
         reference=reference if visible else None,
@@ -510,7 +514,7 @@ def simulate(
     log.file = read_log(log_path)
     if temporary:  # the open file keeps the data until the log is dropped
         remove_quietly(log_path)
-    if last < n - 1:
+    if last < n - 1 and log.reference is not None:
         log.reference = log.reference.head(last + 1)
     if not log.warnings:
         log.warnings = warning_counts(data)

@@ -434,8 +434,8 @@ class ControlContext:
     model: mujoco.MjModel
     nominal_physics: Callable
     problem: Any
-    trajectory: Trajectory
-    reference: TrajectorySample | ChunkedSample
+    trajectory: Trajectory | None
+    reference: TrajectorySample | ChunkedSample | None
     control_dt: float
     command: np.ndarray
     setpoint: np.ndarray

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -73,6 +74,10 @@ class HexapodGeometry:
     base_pivots: np.ndarray
     platform_pivots: np.ndarray
     rotation_pivot: np.ndarray
+    # Derived in __post_init__: the struts' lengths at the zero pose (m) and the moving
+    # pivots relative to the rotation pivot (m).
+    nominal_lengths: np.ndarray = field(init=False, repr=False, compare=False)
+    platform_local: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         for name in ("base_pivots", "platform_pivots", "rotation_pivot"):
@@ -94,6 +99,20 @@ class HexapodGeometry:
         local = self.platform_pivots - self.rotation_pivot
         local.setflags(write=False)
         object.__setattr__(self, "platform_local", local)
+
+
+def _pose_label(name: str, index: tuple[int, ...]) -> str:
+    """``check_values``'s name of a bad pose value: the pose and its axis."""
+    return f"{name} {POSE_LABELS[index[0]]}"
+
+
+def _pose_unit_of_index(index: tuple[int, ...]) -> str:
+    return _pose_unit(index[-1])
+
+
+def _strut_position_label(name: str, rows: bool, index: tuple[int, ...]) -> str:
+    """``check_values``'s name of a bad strut position: the strut, and its row of many."""
+    return f"{name} {STRUT_LABELS[index[1]]} position" + (f" of row {index[0]}" if rows else "")
 
 
 @dataclass(frozen=True)
@@ -122,7 +141,7 @@ class HexapodLimits:
             value = np.array(getattr(self, name), dtype=float)
             if value.shape != (6,):
                 raise PlanningError(f"{name} must have 6 components (x, y, z, rx, ry, rz), got shape {value.shape}")
-            check_values(value, lambda i, name=name: f"{name} {POSE_LABELS[i[0]]}", lambda i: _pose_unit(i[-1]))
+            check_values(value, partial(_pose_label, name), _pose_unit_of_index)
             value.setflags(write=False)
             object.__setattr__(self, name, value)
         crossed = np.flatnonzero(self.pose_lower > self.pose_upper)
@@ -804,13 +823,7 @@ def plan_strut_moves(
         if pose_displacement.shape != start.shape:
             raise PlanningError(f"pose displacement {pose_displacement.shape} must be {start.shape}, one per move")
     for name, value in (("start", start), ("target", target)):
-        check_values(
-            value,
-            lambda i, name=name, value=value: (
-                f"{name} {STRUT_LABELS[i[1]]} position" + (f" of row {i[0]}" if value.shape[0] > 1 else "")
-            ),
-            "m",
-        )
+        check_values(value, partial(_strut_position_label, name, value.shape[0] > 1), "m")
         check_stroke(value, limits, what=name)
     check_positive(dt, "tick", "s")
     distance = np.abs(target - start)

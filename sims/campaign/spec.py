@@ -42,6 +42,7 @@ import json
 import math
 import re
 import tomllib
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -708,7 +709,7 @@ def _try(spec: CampaignSpec, axis: Axis, value, whole: bool) -> None:
         raise ParamError(f"{section}.{axis.column} = {_show(value)}: {e}") from None
 
 
-def iter_chunks(runs: list[Run], size: int):
+def iter_chunks(runs: Iterable[Run], size: int):
     """``runs`` in consecutive chunks of at most ``size``."""
     it = iter(runs)
     while chunk := list(itertools.islice(it, size)):
