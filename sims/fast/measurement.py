@@ -1163,7 +1163,8 @@ def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
     ``planbench.runner.RunLog``; all rows but the last, where no sensor read), read a chunk at a
     time: {"cabin_mm", "cabin_deg", "platform_mm", "platform_deg"}; position of the body
     frame's origin, attitude the angle of the estimated rotation times the true one's
-    inverse."""
+    inverse. None each when the run ended before its first tick's estimate (a controller
+    that faulted at tick 0): there is no error to average."""
     from scipy.spatial.transform import Rotation
 
     model = physics.model.ptr
@@ -1171,6 +1172,8 @@ def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
     estimates = sensors.estimate_log(n)
     bodies = (("cabin", "cabin"), ("platform", "feed_platform"))
     adrs = [model.jnt_qposadr[model.body_jntadr[model.body(name).id]] for _, name in bodies]
+    if n <= 0:
+        return {f"{body}_{unit}": None for body, _ in bodies for unit in ("mm", "deg")}
     position, attitude = [[], []], [[], []]  # per body, per chunk: the ticks' errors, m and rad
     for start, rows in log.chunks(["qpos"]):
         qpos = rows["qpos"][: max(n - start, 0)]
