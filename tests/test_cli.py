@@ -9,6 +9,23 @@ import numpy as np
 import pytest
 
 
+def _video(path):
+    """(header, frames (n, 480, 640, 3) uint8) of a 640 x 480 video. mediapy's reader does not
+    parse this ffmpeg's header; imageio-ffmpeg reads it (its reader is closed while ffmpeg
+    still runs: closed after the last frame it leaves ffmpeg's pipes open), and the frames are
+    decoded by the same ffmpeg binary."""
+    reader = imageio_ffmpeg.read_frames(str(path))
+    meta = next(reader)
+    reader.close()
+    raw = subprocess.run(
+        [imageio_ffmpeg.get_ffmpeg_exe(), "-v", "error", "-i", str(path), "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+        capture_output=True,
+        check=True,
+        timeout=120,
+    ).stdout
+    return meta, np.frombuffer(raw, np.uint8).reshape(-1, 480, 640, 3)
+
+
 def planbench(*args, cwd=None):
     return subprocess.run(
         [sys.executable, "-m", "planbench.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=300
@@ -60,11 +77,8 @@ def test_run_writes_summary_timeseries_report_and_video(tmp_path):
     assert {c["name"] for c in summary["checks"]} >= {"keypoint_error", "obstacle_contacts"}
     ts = np.load(out / "timeseries.npz")
     assert ts["t"].shape[0] == ts["q_actual"].shape[0] == 601
-    # mediapy's reader does not parse this ffmpeg's header; imageio-ffmpeg reads it.
-    reader = imageio_ffmpeg.read_frames(str(out / "loader.mp4"))
-    meta = next(reader)
+    meta, frames = _video(out / "loader.mp4")
     assert tuple(meta["size"]) == (640, 480) and meta["fps"] == 30 and meta["codec"] == "h264"
-    frames = [np.frombuffer(f, np.uint8).reshape(480, 640, 3) for f in reader]
     assert len(frames) >= 85  # 3 s at 30 fps
     assert frames[len(frames) // 2].std() > 10  # frames show something, not a blank buffer
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp dirs left
@@ -349,9 +363,8 @@ def test_fast_run_outputs_and_stewart_option(tmp_path):
         assert ts[key].shape == (n, 3)
     assert ts["cable_tension"].shape == (n, 6) and ts["cable_tension"].min() > 100e3  # N
     assert np.abs(ts["stewart_leg"]).max() < 1e-3  # off: the legs hold nominal
-    reader = imageio_ffmpeg.read_frames(str(out / "closeup.mp4"))
-    assert tuple(next(reader)["size"]) == (640, 480)
-    frames = [np.frombuffer(f, np.uint8).reshape(480, 640, 3) for f in reader]
+    meta, frames = _video(out / "closeup.mp4")
+    assert tuple(meta["size"]) == (640, 480)
     assert len(frames) >= 85 and frames[-1].std() > 10
 
 

@@ -228,7 +228,7 @@ def test_workers_end_with_a_killed_driver(tmp_path):
     children = _workers_of(proc.pid)
     proc.kill()  # the driver alone
     proc.wait()
-    proc.stdout.read()  # returns at EOF: no process of the sweep holds the pipe any more
+    proc.communicate()  # returns at EOF: no process of the sweep holds the pipes any more
     deadline = time.monotonic() + 60
     while any(Path(f"/proc/{p}").exists() for p in children) and time.monotonic() < deadline:
         time.sleep(0.2)

@@ -35,7 +35,7 @@ def test_a_scenario_found_by_its_mechanism_imports_that_mechanism_alone():
     import sys
 
     code = (
-        "import sys; from sims import scenarios\n"
+        "import sys; from planbench import scenarios\n"
         "by_mechanism = {m: scenarios.get_of(m, n) for m, n in [('hexapod', 'hexapod-sync-move'), "
         "('loader', 'loader-supply')]}\n"
         "print(sorted(m for m in ('planbench.fast', 'planbench.antenna') if m in sys.modules))\n"
