@@ -91,7 +91,10 @@ class ChunkedSample:
 
     def head(self, n: int) -> "ChunkedSample":
         """The sample at the first ``n`` times."""
-        return ChunkedSample(self.sample, self.t[:n], self.chunk, self.stored)
+        head = ChunkedSample(self.sample, self.t[:n], self.chunk, self.stored)
+        if self._whole is not None:
+            head._whole = self._whole.rows(0, n)
+        return head
 
     def whole(self) -> TrajectorySample:
         """Every row, as one TrajectorySample (kept)."""
@@ -104,6 +107,9 @@ class ChunkedSample:
                 self._whole = TrajectorySample(self.t, *(np.concatenate([getattr(p, name) for p in parts])
                                                          for name in ("position", "velocity", "acceleration")))
             self._held = (0, None)
+            # Every row is now in memory: the stored log is let go (its file, a temporary
+            # one already removed from the file system, frees its disk space once closed).
+            self.stored = None
         return self._whole
 
     @property

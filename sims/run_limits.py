@@ -87,9 +87,10 @@ def format_bytes(n: float) -> str:
 def runlog_floats_per_tick(model, channels: int) -> int:
     """Doubles per tick of ``sims.runner.RunLog`` for a compiled model: t, qpos (nq), qvel
     (nv), act (na), ctrl and actuator_force (nu each), sensordata, mocap_pos and mocap_quat
-    (3 + 4 per mocap body), streamed to the log file, and what stays in memory per tick:
-    the reference's position, velocity and acceleration (``channels`` each) and two arrays of
-    the ticks' times (the reference's t, the episode's)."""
+    (3 + 4 per mocap body), streamed to the log file; the reference's t, position, velocity
+    and acceleration (``channels`` each), in a temporary log of its own
+    (``sims.runner.stored_reference``; a reference read whole holds its arrays in memory
+    instead, the ticks' times as its t); the ticks' times, in memory."""
     return (3 + model.nq + model.nv + model.na + 2 * model.nu + model.nsensordata
             + 7 * model.nmocap + 3 * channels)
 

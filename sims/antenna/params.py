@@ -128,16 +128,16 @@ def _exp_so3(rotvec) -> np.ndarray:
 
 
 def log_bytes_per_tick(imu: ImuModel = ImuModel(), drives: str = "ideal") -> float:
-    """Bytes an antenna run preallocates per control tick: the runner's log of the compiled
-    model (4 planned joints); the deck drive's ship-motion reference (t and 3 x 4) and its
-    servo's set-points and feed-forward (4 + 4); the task's record of the planner's updates
-    (t, the 3 x 3 attitude, 4 angles, iterations, two flags) once per IMU sample; the ideal
-    joint path every
-    REFERENCE_DT (t, 4 angles, error, iterations, two flags and its spline's 16
-    coefficients)."""
+    """Bytes an antenna run keeps per control tick, in memory or on disk: the runner's log of
+    the compiled model (4 planned joints); the deck drive's ship-motion reference (3 x 4, at
+    the run's ticks) and its servo's set-points and feed-forward (4 + 4); once per IMU sample
+    the task's record of the planner's updates (t, the 3 x 3 attitude, 4 angles, iterations,
+    two flags) and the sample's noise (3 + 3, drawn for the whole run: sims.antenna.sensors);
+    the ideal joint path every REFERENCE_DT (t, 4 angles, error, iterations, two flags, and its
+    spline's 16 coefficients and breakpoint)."""
     period, _ = imu.ticks(CONTROL_DT)
-    floats = (run_limits.runlog_floats_per_tick(_model(drives), 4) + 13 + 8 + (15 + 2 / 8) / period
-              + (7 + 2 / 8 + 16) * CONTROL_DT / REFERENCE_DT)
+    floats = (run_limits.runlog_floats_per_tick(_model(drives), 4) + 12 + 8 + (15 + 2 / 8 + 6) / period
+              + (7 + 2 / 8 + 16 + 1) * CONTROL_DT / REFERENCE_DT)
     return run_limits.floats(floats)
 
 

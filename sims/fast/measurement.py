@@ -844,8 +844,9 @@ def floats_per_tick(options: SensorOptions, control_dt: float = CONTROL_DT) -> f
     """Doubles per control tick that the sensors of ``options`` keep, in memory or in a file.
     Ideal: the true cabin pose (3 + 9) and the noise of their two measurements (2 x (3 + 9)).
     Fused: the fixes' errors (9 a fix, and one fix more per body: a run has n // every + 1) and
-    the estimates' log (2 x 12), streamed to a file of its own (``FusedSensors.estimates``);
-    the IMUs' errors are made a block of ticks at a time (``ImuErrors``)."""
+    the estimates' log (the tick's time and 2 x 12), streamed to a file of its own
+    (``FusedSensors.estimates``); the IMUs' errors are made a block of ticks at a time
+    (``ImuErrors``)."""
     if options.system == "ideal":
         return 36.0
     fixes = sum(1.0 / _ticks(1.0 / rate, control_dt, 1) for rate in (options.rtk_rate_hz, options.ts_rate_hz))

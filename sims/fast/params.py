@@ -213,10 +213,10 @@ WIND_AZIMUTH_DEG = 0.0
 DEFAULT_CABLE_SEGMENTS = 2
 
 #: Doubles per tick that a FAST run keeps besides the runner's log and its sensors' records: the
-#: plant's wind speed (1, in memory), wind force and catenary tensions (3 + 6, streamed to a
-#: file of their own: sims.fast.loads.CableLoads.log). (The controller holds its plan's per-tick
-#: arrays a block of ticks at a time: sims.fast.controller.PLAN_BLOCK_TICKS.)
-PER_TICK_FLOATS = 10
+#: plant's wind speed (1, in memory), the tick's time, wind force and catenary tensions (1 + 3 +
+#: 6, streamed to a file of their own: sims.fast.loads.CableLoads.log). (The controller holds its
+#: plan's per-tick arrays a block of ticks at a time: sims.fast.controller.PLAN_BLOCK_TICKS.)
+PER_TICK_FLOATS = 11
 
 
 def log_bytes_per_tick(cable_segments: int = DEFAULT_CABLE_SEGMENTS, sensors: SensorOptions = SensorOptions(),
