@@ -380,6 +380,11 @@ def cmd_run(argv: list[str]) -> int:
             reserved.enter_context(video.reserved())
         try:
             rows, passed, sim_time_s, wall_time_s = supervise.run_supervised(work, timeout)
+        except KeyboardInterrupt:
+            # Stopped by its user: the child, told to stop as at its time limit, kept the log
+            # streamed so far for an unfinished run's summary, which an interrupt does not write.
+            outputs.remove_leftovers(out.path)
+            raise
         except supervise.Fault as fault:
             ended = fault.ended
             partial = outputs.partial_log(out.path)  # the log the child streamed, if any

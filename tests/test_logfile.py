@@ -252,12 +252,11 @@ def _staged_log(parent: Path):
     return None
 
 
-def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
-    """``planbench run`` whose simulating process is killed (SIGKILL) mid-run: the output
-    holds summary.json (completed false) and log.arrow, its whole chunks, incomplete, equal
-    to the first rows of the same run completed."""
-    out = tmp_path / "out"
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+def _signal_mid_run(tmp_path: Path, out: Path, whom: str, signum: int):
+    """Start ``planbench run loader-supply`` (200 s) into ``out`` and, once its streamed log
+    holds a whole chunk, send ``signum`` to the simulating child (``whom`` "child") or to
+    planbench itself ("planbench"). Returns (the child's pid or None if the run ended first,
+    stdout, stderr, exit code)."""
     proc = subprocess.Popen(
         [
             sys.executable,
@@ -271,7 +270,6 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
             str(out),
             "--quiet",
         ],
-        env=env,
         cwd=tmp_path,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -285,7 +283,7 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
                 try:
                     if read_log(staged / "log.arrow").n >= logfile.CHUNK_TICKS:
                         child = json.loads((staged / outputs.STAGING_MARKER).read_text())["pid"]
-                        os.kill(child, signal.SIGKILL)
+                        os.kill(child if whom == "child" else proc.pid, signum)
                         break
                 except (ValueError, OSError):
                     pass
@@ -294,8 +292,18 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
+            proc.communicate()
+    return child, stdout, stderr, proc.returncode
+
+
+def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
+    """``planbench run`` whose simulating process is killed (SIGKILL) mid-run: the output
+    holds summary.json (completed false) and log.arrow, its whole chunks, incomplete, equal
+    to the first rows of the same run completed."""
+    out = tmp_path / "out"
+    child, stdout, stderr, returncode = _signal_mid_run(tmp_path, out, "child", signal.SIGKILL)
     assert child is not None, (stdout, stderr)  # the run was still going at its first chunk
-    assert proc.returncode == 1, stderr
+    assert returncode == 1, stderr
     assert "killed by SIGKILL" in stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is False and summary["log"]["complete"] is False
@@ -306,6 +314,16 @@ def test_a_killed_run_leaves_its_log_so_far_in_its_output(tmp_path):
     full = runner.simulate(_setup(duration=log.n * 0.005))
     np.testing.assert_array_equal(log.column("qpos"), full.qpos[: log.n])
     np.testing.assert_array_equal(log.column("ctrl"), full.ctrl[: log.n])
+
+
+def test_an_interrupted_run_leaves_nothing(tmp_path):
+    """SIGTERM to planbench itself mid-run (a user's interrupt, not the time limit): exit
+    128 + 15, and nothing in the output's folder, neither the output nor a staging directory
+    with the log so far."""
+    child, _, stderr, returncode = _signal_mid_run(tmp_path, tmp_path / "out", "planbench", signal.SIGTERM)
+    assert child is not None, stderr  # the run was still going at its first chunk
+    assert returncode == 128 + signal.SIGTERM and "interrupted by SIGTERM" in stderr, stderr
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path):
