@@ -613,3 +613,22 @@ def _running(pid: int) -> bool:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
     except (FileNotFoundError, ProcessLookupError):
         return False
+
+
+def test_a_pool_closed_before_its_runs_leaves_no_thread_behind():
+    """A campaign refused after its pool started (a plug-in that fails its check) ends the
+    pool at once: its workers and its manager thread are gone when ``close`` returns, so
+    concurrent.futures' exit hook has nothing to wake (a still-running manager thread can
+    close the wake-up pipe under it and print a traceback after the one-line error)."""
+    import concurrent.futures.process as cfp
+
+    from planbench.campaign.engines import LocalEngine
+
+    engine = LocalEngine(2)
+    engine.start()
+    started = dict(engine._pool._processes)
+    managers = [t for t in cfp._threads_wakeups if t.is_alive()]
+    assert managers, "a started pool runs its manager thread"
+    engine.close()
+    assert not [t for t in managers if t.is_alive()]
+    assert not [pid for pid in started if _running(pid)]

@@ -270,9 +270,14 @@ def _first_run(chunk) -> int:
 
 
 def _terminate(pool) -> None:
-    """End a pool now (an interrupt, an error): its workers get SIGTERM, then SIGKILL."""
+    """End a pool now (an interrupt, an error): its workers get SIGTERM, then SIGKILL, and
+    the pool's manager thread is waited for. That thread closes the pool's wake-up pipe when
+    it sees the workers gone; were it still running at interpreter exit, concurrent.futures'
+    exit hook could write to that pipe as it closes and print a traceback after planbench's
+    one-line error (CPython 3.11)."""
     with outputs.signals_deferred():
         processes = list((getattr(pool, "_processes", None) or {}).values())
+        manager = getattr(pool, "_executor_manager_thread", None)  # shutdown() forgets it
         pool.shutdown(wait=False, cancel_futures=True)
         for p in processes:
             if p.is_alive():
@@ -282,6 +287,8 @@ def _terminate(pool) -> None:
             if p.is_alive():
                 p.kill()
                 p.join(timeout=5)
+        if manager is not None:
+            manager.join(timeout=5)
 
 
 class RayEngine:
