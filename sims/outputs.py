@@ -832,6 +832,8 @@ class _StridedLog:
     """Every ``stride``-th row of a logged array, read from the run's log file a chunk at a time
     when written (``save_timeseries``)."""
 
+    dtype = np.dtype(float)
+
     def __init__(self, log, name: str, stride: int):
         self.log, self.name, self.stride = log, name, stride
         shape = () if name == "t" else tuple(log.file.shapes[name])
@@ -843,18 +845,19 @@ class _StridedLog:
 
 
 def save_timeseries(path, arrays: dict) -> None:
-    """``np.savez_compressed(path, **arrays)``, where an array may also be a ``_StridedLog``,
-    whose rows are written as they are read from the log (a long run's arrays are never whole
-    in memory)."""
+    """``np.savez_compressed(path, **arrays)``, where an array may also be one read from a log
+    a chunk at a time (a ``_StridedLog`` or a ``logfile.LoggedSeries``: ``shape``, ``dtype``
+    and ``parts()``), whose rows are written as they are read (a long run's arrays are never
+    whole in memory)."""
     from numpy.lib import format as npy
 
     with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as archive:
         for name, value in arrays.items():
             with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
-                if isinstance(value, _StridedLog):
+                if hasattr(value, "parts"):  # (a _StridedLog or a logfile.LoggedSeries)
                     npy.write_array_header_1_0(
                         member,
-                        {"descr": npy.dtype_to_descr(np.dtype(float)), "fortran_order": False, "shape": value.shape},
+                        {"descr": npy.dtype_to_descr(value.dtype), "fortran_order": False, "shape": value.shape},
                     )
                     for part in value.parts():
                         member.write(part.tobytes())

@@ -121,6 +121,66 @@ def test_a_timeseries_copied_from_the_log_is_savez_s(tmp_path_factory, n, chunk,
         np.testing.assert_array_equal(streamed[key], whole[key])
 
 
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(1, 40), chunk=st.integers(1, 9), seed=st.integers(0, 2**32 - 1))
+def test_a_spooled_series_reads_back_as_the_arrays_it_was_given(tmp_path_factory, n, chunk, seed):
+    """A series spooled to a temporary log a chunk at a time (``LoggedSeries``: FAST's 10 Hz
+    series) reads back whole, by parts and scaled as the arrays themselves, booleans and
+    integers of their own type, and timeseries.npz holds what np.savez_compressed writes."""
+    rng = np.random.default_rng(seed)
+    arrays = {
+        "error": rng.normal(size=n),
+        "tension": rng.normal(size=(n, 6)),
+        "observing": rng.random(n) < 0.5,
+        "segment": rng.integers(0, 9, n).astype(np.int32),
+    }
+    writer = logfile.temporary_writer({k: v.shape[1:] for k, v in arrays.items()}, np.arange(n) * 0.1, chunk=1)
+    for lo in range(0, n, chunk):
+        writer.append({k: np.asarray(v[lo : lo + chunk], float) for k, v in arrays.items()})
+    spooled = writer.read_back(n)
+    assert not writer.path.exists()  # (the open file keeps the data)
+    series = {k: logfile.LoggedSeries(spooled, k, v.dtype) for k, v in arrays.items()}
+    for key, value in arrays.items():
+        read = np.asarray(series[key])
+        assert read.dtype == value.dtype and series[key].shape == value.shape and len(series[key]) == n
+        np.testing.assert_array_equal(read, value)
+        np.testing.assert_array_equal(np.concatenate(list(series[key].parts())), value)
+        np.testing.assert_array_equal(series[key][-1], value[-1])
+    np.testing.assert_array_equal(np.asarray(1e3 * series["tension"]), 1e3 * arrays["tension"])
+    with pytest.raises(TypeError):
+        1e3 * series["observing"]  # scaling is for float series
+    folder = tmp_path_factory.mktemp("npz")
+    outputs.save_timeseries(folder / "spooled.npz", {**series, "mm": 1e3 * series["error"]})
+    np.savez_compressed(folder / "whole.npz", **arrays, mm=1e3 * arrays["error"])
+    spooled_npz, whole = np.load(folder / "spooled.npz"), np.load(folder / "whole.npz")
+    assert list(spooled_npz.keys()) == list(whole.keys())
+    for key in whole.keys():
+        assert spooled_npz[key].dtype == whole[key].dtype
+        np.testing.assert_array_equal(spooled_npz[key], whole[key])
+
+
+@settings(max_examples=50, deadline=None)
+@given(n=st.integers(1, 200), span=st.integers(1, 30), seed=st.integers(0, 2**32 - 1))
+def test_a_long_reports_envelope_keeps_every_span_s_extremes(n, span, seed):
+    """report.png draws a long run as envelopes: each span's smallest and largest value at the
+    span's first and middle time, so that no peak of the series is lost to the thinning."""
+    from planbench.fast.report import envelope, envelope_times
+
+    rng = np.random.default_rng(seed)
+    values, t = rng.normal(size=(n, 3)), np.cumsum(rng.random(n))
+    drawn, times = envelope(values, span), envelope_times(t, span)
+    m = -(-n // span)
+    assert drawn.shape == (2 * m, 3) and times.shape == (2 * m,)
+    for k in range(m):
+        part = values[k * span : (k + 1) * span]
+        np.testing.assert_array_equal(drawn[2 * k], part.min(axis=0))
+        np.testing.assert_array_equal(drawn[2 * k + 1], part.max(axis=0))
+        assert times[2 * k] == t[k * span] <= times[2 * k + 1] <= t[min(n, (k + 1) * span) - 1]
+    np.testing.assert_array_equal(drawn.max(axis=0), values.max(axis=0))
+    np.testing.assert_array_equal(drawn.min(axis=0), values.min(axis=0))
+    assert np.all(np.diff(times) >= 0)
+
+
 @pytest.mark.parametrize("n, chunk", [(1, 4), (4, 4), (8, 4), (9, 4)])
 def test_one_tick_one_chunk_and_chunk_multiples(tmp_path, n, chunk):
     _write(tmp_path / "log.arrow", n, chunk, 2)
@@ -340,7 +400,7 @@ def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path)
             "run",
             "loader-supply",
             "--duration",
-            "300",
+            "1200",  # a loop of about 17 s on this machine: the limit stops it mid-loop, however loaded
             "--timeout",
             "5",
             "--out",
@@ -398,7 +458,7 @@ def test_the_output_location_is_checked_before_the_first_step(tmp_path, monkeypa
 # ---------------------------------------------------------------- evaluation by chunks
 
 
-def test_fast_checks_do_not_depend_on_the_chunks(tmp_path):
+def test_fast_checks_do_not_depend_on_the_chunks(tmp_path, monkeypatch):
     """FAST's evaluation reads the log a chunk at a time: with 7-tick chunks and every 3rd row
     kept it gives the very check values, metrics and timeseries that the same log held
     whole (one chunk) gives, and the values the whole arrays give directly."""
@@ -411,6 +471,8 @@ def test_fast_checks_do_not_depend_on_the_chunks(tmp_path):
     chunked = evaluation.evaluate(log)
     series = evaluation.timeseries(log)
     assert not any(log.held(name) for name in logfile.ARRAYS)  # never read whole
+    # The 10 Hz series are spooled to disk as the chunks are read, not held.
+    assert all(isinstance(v, logfile.LoggedSeries) for v in evaluation.summary(log)["every"].values())
     whole = runner.RunLog(**{name: log.file.column(name) for name in ("t", *logfile.ARRAYS)}, reference=log.reference)
     held = evaluation.evaluate(whole)
     assert [c.to_json() for c in chunked[0]] == [c.to_json() for c in held[0]]
@@ -425,6 +487,13 @@ def test_fast_checks_do_not_depend_on_the_chunks(tmp_path):
     assert f"cable{cable + 1} at t = {whole.t[row]:.2f} s" in check.note
     np.testing.assert_array_equal(series["cable_tension"], tension[::3])
     np.testing.assert_array_equal(series["stewart_leg"], whole.qpos[::3, p.leg_qpos])
+    # Past REPORT_POINTS rows the report draws envelopes of the spooled series.
+    from planbench.fast import report
+
+    for points, name in ((10, "envelopes.png"), (10**6, "every-row.png")):
+        monkeypatch.setattr(report, "REPORT_POINTS", points)
+        evaluation.report(log, chunked[0], tmp_path / name)
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_a_run_written_after_the_fact_gets_a_copy_of_its_log(tmp_path):

@@ -51,37 +51,77 @@ def fast_plan_figure(plan, t: np.ndarray, path) -> None:
     plt.close(fig)
 
 
+#: Rows of a report's time axis beyond which each plotted series is drawn as its envelope
+#: (``envelope``): report.png's plots are about 500 pixels wide, so a long run's 10 Hz series
+#: would put dozens of points on each pixel column and hold them all in memory to draw them.
+REPORT_POINTS = 20_000
+
+
+def envelope(values: np.ndarray, span: int) -> np.ndarray:
+    """(2 m, ...) the smallest and the largest of ``values`` (n, ...) in each of its m spans of
+    ``span`` rows, interleaved (the last span padded with its last row): what a line through
+    every row shows at a pixel's width, peaks included."""
+    n = values.shape[0]
+    m = -(-n // span)
+    if m * span > n:
+        values = np.concatenate([values, np.repeat(values[-1:], m * span - n, axis=0)])
+    values = values.reshape(m, span, *values.shape[1:])
+    out = np.empty((2 * m, *values.shape[2:]), values.dtype)
+    out[0::2], out[1::2] = values.min(axis=1), values.max(axis=1)
+    return out
+
+
+def envelope_times(t: np.ndarray, span: int) -> np.ndarray:
+    """(2 m,) the times ``envelope``'s rows are drawn at: each span's first row and its middle."""
+    first = np.arange(0, t.size, span)
+    out = np.empty(2 * first.size)
+    out[0::2], out[1::2] = t[first], t[np.minimum(first + span // 2, t.size - 1)]
+    return out
+
+
 def fast_report(ts: dict, t: np.ndarray, checks, path, tension_min: float) -> None:
-    """report.png of a FAST run: feed and cabin errors, cable tensions, Stewart legs, wind."""
+    """report.png of a FAST run: feed and cabin errors, cable tensions, Stewart legs, wind.
+    ``ts``: timeseries (arrays, or series read whole one at a time); a run of more than
+    REPORT_POINTS rows is drawn as envelopes."""
+    span = -(-t.size // (REPORT_POINTS // 2)) if t.size > REPORT_POINTS else 1
+
+    def rows(values) -> np.ndarray:
+        values = np.asarray(values)
+        return values if span == 1 else envelope(values, span)
+
+    observing = np.asarray(ts["observing"]).astype(bool)
+    if span > 1:  # a span observing anywhere is drawn observing
+        observing = np.repeat(envelope(observing, span)[1::2], 2)
+        t = envelope_times(t, span)
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
-    observing = ts["observing"].astype(bool)
     for ax in axes.flat:
         ax.fill_between(t, 0, 1, where=observing, transform=ax.get_xaxis_transform(), color="0.93", lw=0)
     ax = axes[0, 0]
-    ax.plot(t, ts["feed_error_mm"], lw=0.7, label="feed |actual - planned|")
-    ax.plot(
-        t, 1e3 * np.linalg.norm(ts["cabin_pos_actual"] - ts["cabin_pos_planned"], axis=1), lw=0.7, label="cabin origin"
-    )
+    ax.plot(t, rows(ts["feed_error_mm"]), lw=0.7, label="feed |actual - planned|")
+    cabin = 1e3 * np.linalg.norm(np.asarray(ts["cabin_pos_actual"]) - np.asarray(ts["cabin_pos_planned"]), axis=1)
+    ax.plot(t, rows(cabin), lw=0.7, label="cabin origin")
     ax.set(title="position errors (grey: observing)", xlabel="t [s]", ylabel="mm")
     ax.legend(fontsize=8)
     ax = axes[0, 1]
+    tension, planned = rows(ts["cable_tension"]), rows(ts["cable_tension_planned"])
     for j, name in enumerate(ts["cable_names"]):
-        (line,) = ax.plot(t, ts["cable_tension"][:, j] / 1e3, lw=0.7, label=str(name))
-        ax.plot(t, ts["cable_tension_planned"][:, j] / 1e3, "--", color=line.get_color(), lw=0.6)
+        (line,) = ax.plot(t, tension[:, j] / 1e3, lw=0.7, label=str(name))
+        ax.plot(t, planned[:, j] / 1e3, "--", color=line.get_color(), lw=0.6)
     ax.axhline(tension_min / 1e3, color="r", lw=0.8)
     ax.set_ylim(bottom=0.0)
     ax.set(title="cable tensions (dashed: planned statics), T_min in red", xlabel="t [s]", ylabel="kN")
     ax.legend(fontsize=8, ncol=3)
     ax = axes[1, 0]
-    for j in range(ts["stewart_leg"].shape[1]):
-        ax.plot(t, 1e3 * ts["stewart_leg"][:, j], lw=0.7, label=f"leg{j + 1}")
+    legs = rows(ts["stewart_leg"])
+    for j in range(legs.shape[1]):
+        ax.plot(t, 1e3 * legs[:, j], lw=0.7, label=f"leg{j + 1}")
     ax.set(title="Stewart leg length changes", xlabel="t [s]", ylabel="mm")
     ax.legend(fontsize=8, ncol=3)
     ax = axes[1, 1]
     if "wind_speed" in ts:
-        ax.plot(t, ts["wind_speed"], color="0.4", lw=0.6, label="wind speed [m/s]")
+        ax.plot(t, rows(ts["wind_speed"]), color="0.4", lw=0.6, label="wind speed [m/s]")
         twin = ax.twinx()
-        twin.plot(t, np.linalg.norm(ts["wind_force"], axis=1) / 1e3, lw=0.6, label="drag on cabin and cables")
+        twin.plot(t, rows(np.linalg.norm(ts["wind_force"], axis=1)) / 1e3, lw=0.6, label="drag on cabin and cables")
         twin.set_ylabel("kN")
         twin.legend(fontsize=8, loc="upper right")
         ax.legend(fontsize=8, loc="upper left")

@@ -31,6 +31,7 @@ from planbench.fast.params import (
     _transit,
 )
 from planbench.fast.physics import CONTROL_DT, STRING_MODE_HZ, FastPhysics
+from planbench.logfile import LoggedSeries, temporary_writer
 from planbench.params import ParamError
 from planbench.planners import fast
 from planbench.planners.errors import LimitError
@@ -363,13 +364,21 @@ class FastEvaluation:
 
     def _reduce(self, log: RunLog) -> dict:
         """One pass over the log's chunks: the per-tick errors, segments and observing flags
-        whole (one number a tick), the extremes of the wide series (tensions, legs, forces,
-        angles; max and min, exact in any order), and every ``stride``-th row of each series
-        (the timeseries and the report)."""
+        whole (one number a tick, in arrays of the log's length), the extremes of the wide
+        series (tensions, legs, forces, angles; max and min, exact in any order), and every
+        ``stride``-th row of each series (the timeseries and the report), spooled to a
+        temporary log as the chunks are read (``logfile.LoggedSeries``): memory does not grow
+        with them however long the run."""
         n = log.n
         r = log.reference
-        scalars = {"feed_error": [], "cabin_error": [], "segment": [], "observing": []}
-        rows_kept = {}
+        scalars = {
+            "feed_error": np.empty(n),
+            "cabin_error": np.empty(n),
+            "segment": np.empty(n, np.int32),
+            "observing": np.empty(n, bool),
+        }
+        t_every = log.every("t", self.stride)
+        spool, dtypes = None, {}
         ext = {}
 
         def extreme(key, value, where, better):
@@ -379,11 +388,16 @@ class FastEvaluation:
         for start, rows in log.chunks(("t", "sensordata", "qpos", "qvel", "act", "ctrl", "actuator_force")):
             m = rows["t"].shape[0]
             s = self._rows_series(rows, r.rows(start, start + m), start, n)
-            for key in scalars:
-                scalars[key].append(s[key])
-            for key, value in s.items():
-                # (a copy: a view would keep the whole chunk it was read with)
-                rows_kept.setdefault(key, []).append(value[-start % self.stride :: self.stride].copy())
+            for key, whole in scalars.items():
+                whole[start : start + m] = s[key]
+            kept = {key: value[-start % self.stride :: self.stride] for key, value in s.items()}
+            if spool is None:
+                dtypes = {key: value.dtype for key, value in kept.items()}
+                spool = temporary_writer(
+                    {key: value.shape[1:] for key, value in kept.items()}, t_every, chunk=1, prefix="planbench-series-"
+                )
+            if next(iter(kept.values())).shape[0]:
+                spool.append({key: np.asarray(value, float) for key, value in kept.items()})
             tension, law = s["cable_tension"], s["cable_tension_law"]
             low = np.unravel_index(np.argmin(tension), tension.shape)
             high = np.unravel_index(np.argmax(law), law.shape)
@@ -403,10 +417,11 @@ class FastEvaluation:
             )
             ab = np.abs(s["ab_actual"] - s["ab_planned"]).max(axis=0)
             ext["ab_abs"] = (ab if "ab_abs" not in ext else np.maximum(ext["ab_abs"][0], ab), None)
-        out = {key: np.concatenate(parts) for key, parts in scalars.items()}
+        out = dict(scalars)
         out["extremes"] = {key: value for key, value in ext.items()}
-        out["every"] = {key: np.concatenate(parts) for key, parts in rows_kept.items()}
-        out["t_every"] = log.every("t", self.stride)
+        every = spool.read_back(t_every.size)
+        out["every"] = {key: LoggedSeries(every, key, dtype) for key, dtype in dtypes.items()}
+        out["t_every"] = t_every
         return out
 
     def evaluate(self, log: RunLog):
