@@ -1175,21 +1175,19 @@ def estimate_errors(sensors: FusedSensors, physics, log) -> dict:
     adrs = [model.jnt_qposadr[model.body_jntadr[model.body(name).id]] for _, name in bodies]
     if n <= 0:
         return {f"{body}_{unit}": None for body, _ in bodies for unit in ("mm", "deg")}
-    position, attitude = [[], []], [[], []]  # per body, per chunk: the ticks' errors, m and rad
+    position, attitude = np.empty((2, n)), np.empty((2, n))  # per body, per tick: the errors, m and rad
     for start, rows in log.chunks(["qpos"]):
         qpos = rows["qpos"][: max(n - start, 0)]
-        estimate = estimates.span("estimate", start, start + qpos.shape[0])
+        stop = start + qpos.shape[0]
+        estimate = estimates.span("estimate", start, stop)
         for k, adr in enumerate(adrs):
-            position[k].append(np.linalg.norm(estimate[:, k, :3] - qpos[:, adr : adr + 3], axis=1))
-            attitude[k].append(
-                (
-                    Rotation.from_matrix(estimate[:, k, 3:].reshape(-1, 3, 3))
-                    * Rotation.from_quat(qpos[:, adr + 3 : adr + 7], scalar_first=True).inv()
-                ).magnitude()
-            )
+            position[k, start:stop] = np.linalg.norm(estimate[:, k, :3] - qpos[:, adr : adr + 3], axis=1)
+            attitude[k, start:stop] = (
+                Rotation.from_matrix(estimate[:, k, 3:].reshape(-1, 3, 3))
+                * Rotation.from_quat(qpos[:, adr + 3 : adr + 7], scalar_first=True).inv()
+            ).magnitude()
     out = {}
     for k, (body, _) in enumerate(bodies):
-        p, a = np.concatenate(position[k]), np.concatenate(attitude[k])
-        out[f"{body}_mm"] = 1e3 * float(np.sqrt(np.mean(p**2)))
-        out[f"{body}_deg"] = float(np.degrees(np.sqrt(np.mean(a**2))))
+        out[f"{body}_mm"] = 1e3 * float(np.sqrt(np.mean(position[k] ** 2)))
+        out[f"{body}_deg"] = float(np.degrees(np.sqrt(np.mean(attitude[k] ** 2))))
     return out

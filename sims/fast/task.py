@@ -417,24 +417,54 @@ class FastEvaluation:
             )
             ab = np.abs(s["ab_actual"] - s["ab_planned"]).max(axis=0)
             ext["ab_abs"] = (ab if "ab_abs" not in ext else np.maximum(ext["ab_abs"][0], ab), None)
-        out = dict(scalars)
+        out = self._errors(scalars, log)  # (the per-tick arrays are dropped here)
         out["extremes"] = {key: value for key, value in ext.items()}
         every = spool.read_back(t_every.size)
         out["every"] = {key: LoggedSeries(every, key, dtype) for key, dtype in dtypes.items()}
         out["t_every"] = t_every
         return out
 
+    def _errors(self, scalars: dict, log: RunLog) -> dict:
+        """The feed's and the cabin's error statistics of the checks and metrics, from the
+        per-tick errors (m), segments and observing flags of ``_reduce``: over the observing
+        segments (the whole run when it has none), per segment, and over the whole run."""
+        observing = scalars["observing"]
+        window = observing if observing.any() else np.ones(log.n, bool)
+        feed_mm, cabin_mm = 1e3 * scalars["feed_error"], 1e3 * scalars["cabin_error"]
+        segments = {}
+        for k, seg in enumerate(self.goal.segments):
+            mask = scalars["segment"] == k
+            if mask.any():
+                segments[seg.name] = segments.get(seg.name, []) + [
+                    {
+                        "t0_s": seg.t0,
+                        "feed_error_rms_mm": _rms(feed_mm[mask]),
+                        "feed_error_max_mm": float(feed_mm[mask].max()),
+                        "cabin_error_rms_mm": _rms(cabin_mm[mask]),
+                    }
+                ]
+        return {
+            "observing_any": bool(observing.any()),
+            "observing_ticks": int(observing.sum()),
+            "feed_rms_mm": _rms(feed_mm[window]),
+            "feed_max_mm": float(feed_mm[window].max()),
+            "cabin_rms_mm": _rms(cabin_mm[window]),
+            "cabin_max_mm": float(cabin_mm[window].max()),
+            "feed_rms_all_mm": _rms(feed_mm),
+            "feed_max_all_mm": float(feed_mm.max()),
+            "segments": segments,
+        }
+
     def evaluate(self, log: RunLog):
         p = self.physics
+        n = log.n
         s = self.summary(log)
         ext = s["extremes"]
-        n = log.n
-        observing = s["observing"]
-        window = observing if observing.any() else np.ones(n, bool)
         where = (
-            "over the observing segments" if observing.any() else "no observing segment in this run: over the whole run"
+            "over the observing segments"
+            if s["observing_any"]
+            else "no observing segment in this run: over the whole run"
         )
-        feed_mm, cabin_mm = 1e3 * s["feed_error"], 1e3 * s["cabin_error"]
         t_min = fast.FAST_LIMITS.tension_min
         tension_min, low = ext["tension_min"]
         law_max, high = ext["law_max"]
@@ -448,13 +478,13 @@ class FastEvaluation:
         checks = [
             Check(
                 "feed_error_rms",
-                _rms(feed_mm[window]),
+                s["feed_rms_mm"],
                 FEED_RMS_LIMIT_MM,
                 "mm",
                 note=(f"Stewart {stewart}; " if stewart else "") + f"against the goal feed path; {where}",
             ),
-            Check("feed_error_max", float(feed_mm[window].max()), FEED_MAX_LIMIT_MM, "mm", note=where),
-            Check("cabin_error_rms", _rms(cabin_mm[window]), CABIN_RMS_LIMIT_MM, "mm", note=f"cabin origin; {where}"),
+            Check("feed_error_max", s["feed_max_mm"], FEED_MAX_LIMIT_MM, "mm", note=where),
+            Check("cabin_error_rms", s["cabin_rms_mm"], CABIN_RMS_LIMIT_MM, "mm", note=f"cabin origin; {where}"),
             Check(
                 "cable_tension_min",
                 float(tension_min) / 1e3,
@@ -479,18 +509,6 @@ class FastEvaluation:
             ),
             Check("stewart_force", float(ext["force_abs"][0]) / 1e3, force_limit / 1e3, "kN", note="demanded"),
         ]
-        segments = {}
-        for k, seg in enumerate(self.goal.segments):
-            mask = s["segment"] == k
-            if mask.any():
-                segments[seg.name] = segments.get(seg.name, []) + [
-                    {
-                        "t0_s": seg.t0,
-                        "feed_error_rms_mm": _rms(feed_mm[mask]),
-                        "feed_error_max_mm": float(feed_mm[mask].max()),
-                        "cabin_error_rms_mm": _rms(cabin_mm[mask]),
-                    }
-                ]
         ab_error = np.degrees(ext["ab_abs"][0]) * 3600.0
         metrics = dict(self.description)
         metrics.update(
@@ -500,11 +518,11 @@ class FastEvaluation:
                 ),
                 "wind_mean_m_s": self.loads.mean_speed,
                 "wind_toward_deg": float(np.degrees(np.arctan2(self.loads.direction[1], self.loads.direction[0]))),
-                "feed_error_rms_all_mm": _rms(feed_mm),
-                "feed_error_max_all_mm": float(feed_mm.max()),
-                "cabin_error_max_mm": float(cabin_mm[window].max()),
-                "observing_s": float(observing.sum() * (log.t[1] - log.t[0])) if n > 1 else 0.0,
-                "segments": segments,
+                "feed_error_rms_all_mm": s["feed_rms_all_mm"],
+                "feed_error_max_all_mm": s["feed_max_all_mm"],
+                "cabin_error_max_mm": s["cabin_max_mm"],
+                "observing_s": float(s["observing_ticks"] * (log.t[1] - log.t[0])) if n > 1 else 0.0,
+                "segments": s["segments"],
                 "cable_tension_range_kN": [float(tension_min) / 1e3, float(ext["tension_max"][0]) / 1e3],
                 "planned_tension_range_kN": [float(ext["planned_min"][0]) / 1e3, float(ext["planned_max"][0]) / 1e3],
                 # The winch commands less the unstretched lengths the plan implies: the feedback.
