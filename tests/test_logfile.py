@@ -164,11 +164,14 @@ def test_a_spooled_series_reads_back_as_the_arrays_it_was_given(tmp_path_factory
 def test_a_long_reports_envelope_keeps_every_span_s_extremes(n, span, seed):
     """report.png draws a long run as envelopes: each span's smallest and largest value at the
     span's first and middle time, so that no peak of the series is lost to the thinning."""
-    from planbench.fast.report import envelope, envelope_times
+    from planbench.fast.report import envelope, envelope_of_parts, envelope_times
 
     rng = np.random.default_rng(seed)
     values, t = rng.normal(size=(n, 3)), np.cumsum(rng.random(n))
     drawn, times = envelope(values, span), envelope_times(t, span)
+    # The same, made a part at a time (a spooled series' chunks), however the parts fall.
+    cuts = np.sort(rng.integers(0, n + 1, rng.integers(0, 6)))
+    np.testing.assert_array_equal(envelope_of_parts(np.split(values, cuts), span), drawn)
     m = -(-n // span)
     assert drawn.shape == (2 * m, 3) and times.shape == (2 * m,)
     for k in range(m):
@@ -386,11 +389,31 @@ def test_an_interrupted_run_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+#: A controller that hangs at tick HANG_TICK: the time limit then finds the run in its loop,
+#: with two whole chunks written, however long the machine takes to get there.
+HANG_TICK = 2 * logfile.CHUNK_TICKS + 7
+HANGING_CONTROLLER = textwrap.dedent(f"""
+    import time
+    from planbench.loader import reference_controller
+
+    class Controller:
+        def reset(self, context):
+            self.inner = reference_controller()
+            return self.inner.reset(context)
+
+        def __call__(self, tick, observation):
+            if tick == {HANG_TICK}:
+                time.sleep(3600)
+            return self.inner(tick, observation)
+""")
+
+
 def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path):
     """``planbench run --timeout``: the simulating process stopped at the limit (SIGTERM, then
     its clean-up) leaves summary.json (completed false) and log.arrow, its whole chunks,
     readable, incomplete, equal to the first rows of the same run completed."""
     out = tmp_path / "out"
+    (tmp_path / "hang.py").write_text(HANGING_CONTROLLER)
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     proc = subprocess.run(
         [
@@ -400,9 +423,11 @@ def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path)
             "run",
             "loader-supply",
             "--duration",
-            "1200",  # a loop of about 17 s on this machine: the limit stops it mid-loop, however loaded
+            "300",
+            "--controller",
+            "hang.py:Controller",
             "--timeout",
-            "5",
+            "10",
             "--out",
             str(out),
             "--quiet",
@@ -418,12 +443,11 @@ def test_a_run_past_its_time_limit_leaves_its_log_so_far_in_its_output(tmp_path)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is False and summary["log"]["complete"] is False
     log = read_log(out / "log.arrow")
-    assert not log.complete and log.n % logfile.CHUNK_TICKS == 0
+    assert not log.complete and log.n == 2 * logfile.CHUNK_TICKS  # the whole chunks before the hang
     assert summary["log"]["ticks"] == log.n
     assert _staged_log(tmp_path) is None  # nothing left beside the output
-    if log.n:
-        full = runner.simulate(_setup(duration=log.n * 0.005))
-        np.testing.assert_array_equal(log.column("qpos"), full.qpos[: log.n])
+    full = runner.simulate(_setup(duration=log.n * 0.005))
+    np.testing.assert_array_equal(log.column("qpos"), full.qpos[: log.n])
 
 
 # ---------------------------------------------------------------- the disk-space refusal

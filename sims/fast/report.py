@@ -79,27 +79,50 @@ def envelope_times(t: np.ndarray, span: int) -> np.ndarray:
     return out
 
 
+def envelope_of_parts(parts, span: int) -> np.ndarray:
+    """``envelope`` of the rows of ``parts`` (arrays (m_i, ...), in order) joined, made a part
+    at a time: only a part and less than a span of rows are held."""
+    out, carry = [], None
+    for part in parts:
+        if carry is not None and carry.shape[0]:
+            part = np.concatenate([carry, part])
+        whole = part.shape[0] // span * span
+        if whole:
+            out.append(envelope(part[:whole], span))
+        carry = part[whole:]
+    if carry is not None and carry.shape[0]:
+        out.append(envelope(carry, span))
+    return np.concatenate(out)
+
+
+def _parts(values):
+    """A series' rows a part at a time: a spooled series' chunks (``logfile.LoggedSeries``), or
+    an array whole."""
+    return values.parts() if hasattr(values, "parts") else iter([np.asarray(values)])
+
+
 def fast_report(ts: dict, t: np.ndarray, checks, path, tension_min: float) -> None:
     """report.png of a FAST run: feed and cabin errors, cable tensions, Stewart legs, wind.
-    ``ts``: timeseries (arrays, or series read whole one at a time); a run of more than
-    REPORT_POINTS rows is drawn as envelopes."""
+    ``ts``: timeseries (arrays, or series spooled to disk, read a chunk at a time); a run of
+    more than REPORT_POINTS rows is drawn as envelopes."""
     span = -(-t.size // (REPORT_POINTS // 2)) if t.size > REPORT_POINTS else 1
 
-    def rows(values) -> np.ndarray:
-        values = np.asarray(values)
-        return values if span == 1 else envelope(values, span)
+    def rows(*series, of=None) -> np.ndarray:
+        """The rows drawn of ``series`` (of ``of(*series)`` row by row, when given)."""
+        parts = (of(*p) if of else p[0] for p in zip(*(_parts(s) for s in series), strict=True))
+        return np.concatenate(list(parts)) if span == 1 else envelope_of_parts(parts, span)
 
-    observing = np.asarray(ts["observing"]).astype(bool)
+    observing = rows(ts["observing"]).astype(bool)
     if span > 1:  # a span observing anywhere is drawn observing
-        observing = np.repeat(envelope(observing, span)[1::2], 2)
+        observing = np.repeat(observing[1::2], 2)
         t = envelope_times(t, span)
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
     for ax in axes.flat:
         ax.fill_between(t, 0, 1, where=observing, transform=ax.get_xaxis_transform(), color="0.93", lw=0)
     ax = axes[0, 0]
     ax.plot(t, rows(ts["feed_error_mm"]), lw=0.7, label="feed |actual - planned|")
-    cabin = 1e3 * np.linalg.norm(np.asarray(ts["cabin_pos_actual"]) - np.asarray(ts["cabin_pos_planned"]), axis=1)
-    ax.plot(t, rows(cabin), lw=0.7, label="cabin origin")
+    cabin = rows(ts["cabin_pos_actual"], ts["cabin_pos_planned"], of=lambda a, b: 1e3 * np.linalg.norm(a - b, axis=1))
+    ax.plot(t, cabin, lw=0.7, label="cabin origin")
     ax.set(title="position errors (grey: observing)", xlabel="t [s]", ylabel="mm")
     ax.legend(fontsize=8)
     ax = axes[0, 1]
@@ -121,7 +144,8 @@ def fast_report(ts: dict, t: np.ndarray, checks, path, tension_min: float) -> No
     if "wind_speed" in ts:
         ax.plot(t, rows(ts["wind_speed"]), color="0.4", lw=0.6, label="wind speed [m/s]")
         twin = ax.twinx()
-        twin.plot(t, rows(np.linalg.norm(ts["wind_force"], axis=1)) / 1e3, lw=0.6, label="drag on cabin and cables")
+        drag = rows(ts["wind_force"], of=lambda f: np.linalg.norm(f, axis=1))
+        twin.plot(t, drag / 1e3, lw=0.6, label="drag on cabin and cables")
         twin.set_ylabel("kN")
         twin.legend(fontsize=8, loc="upper right")
         ax.legend(fontsize=8, loc="upper left")
