@@ -32,6 +32,18 @@ def planbench(*args, cwd=None):
     )
 
 
+def in_process(capsys, *args):
+    """``planbench ARGS`` run by ``planbench.cli.main`` in this process (the bad-input cases:
+    the same parsing and checks, without a Python start each; the process-level contract is
+    tested by test_bad_invocations and the cases here that start a process)."""
+    from planbench.cli import main
+
+    capsys.readouterr()
+    code = main([str(a) for a in args])
+    captured = capsys.readouterr()
+    return subprocess.CompletedProcess(args, code, captured.out, captured.err)
+
+
 def assert_one_line_error(proc, *words):
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
@@ -120,26 +132,30 @@ def test_unknown_scenario_exits_2(tmp_path):
 
 
 @pytest.mark.parametrize("duration", ["-1", "0", "nan", "abc"])
-def test_bad_duration_exits_2(tmp_path, duration):
+def test_bad_duration_exits_2(tmp_path, duration, capsys):
     assert_one_line_error(
-        planbench("run", "loader-supply", "--out", tmp_path / "x", f"--duration={duration}"), "duration"
+        in_process(capsys, "run", "loader-supply", "--out", tmp_path / "x", f"--duration={duration}"), "duration"
     )
     assert not (tmp_path / "x").exists()
 
 
-def test_unwritable_output_dir_exits_2(tmp_path):
+def test_unwritable_output_dir_exits_2(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("not a directory")
-    assert_one_line_error(planbench("run", "loader-supply", "--out", blocker / "out"), str(blocker), "not a directory")
-    assert_one_line_error(planbench("run", "loader-supply", "--out", blocker), "not a directory")
+    assert_one_line_error(
+        in_process(capsys, "run", "loader-supply", "--out", blocker / "out"), str(blocker), "not a directory"
+    )
+    assert_one_line_error(in_process(capsys, "run", "loader-supply", "--out", blocker), "not a directory")
     assert blocker.read_text() == "not a directory"
 
 
-def test_other_bad_options_exit_2(tmp_path):
-    assert_one_line_error(planbench("run", "loader-supply", "--wind", "4"), "unrecognized arguments: --wind 4")
-    assert_one_line_error(planbench("run", "loader-supply", "--seed", "-3"), "seed")
-    assert_one_line_error(planbench("run", "loader-supply", "--camera", "top", "--out", tmp_path / "c"), "camera")
-    assert_one_line_error(planbench("frobnicate"), "invalid choice")
+def test_other_bad_options_exit_2(tmp_path, capsys):
+    assert_one_line_error(in_process(capsys, "run", "loader-supply", "--wind", "4"), "unrecognized arguments: --wind 4")
+    assert_one_line_error(in_process(capsys, "run", "loader-supply", "--seed", "-3"), "seed")
+    assert_one_line_error(
+        in_process(capsys, "run", "loader-supply", "--camera", "top", "--out", tmp_path / "c"), "camera"
+    )
+    assert_one_line_error(in_process(capsys, "frobnicate"), "invalid choice")
 
 
 def test_plan_writes_npz_and_plot(tmp_path):
@@ -183,13 +199,15 @@ def test_hexapod_run_with_elevation_and_wind(tmp_path):
     assert frames == int(np.floor(summary["sim_time_s"] * 30)) + 1
 
 
-def test_hexapod_bad_elevation_exits_2(tmp_path):
+def test_hexapod_bad_elevation_exits_2(tmp_path, capsys):
     assert_one_line_error(
-        planbench("run", "hexapod-sync-move", "--elevation", "10", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "hexapod-sync-move", "--elevation", "10", "--out", tmp_path / "x"),
         "elevation = 10 deg",
         "[15, 90]",
     )
-    assert_one_line_error(planbench("run", "loader-supply", "--elevation", "45"), "unrecognized arguments: --elevation")
+    assert_one_line_error(
+        in_process(capsys, "run", "loader-supply", "--elevation", "45"), "unrecognized arguments: --elevation"
+    )
     assert not (tmp_path / "x").exists()
 
 
@@ -252,8 +270,8 @@ def test_antenna_sea_state_run_with_sea_options(tmp_path):
         (("loader-supply", "--prediction", "off"), ("unrecognized arguments", "--prediction")),
     ],
 )
-def test_antenna_bad_options_exit_2(tmp_path, args, words):
-    assert_one_line_error(planbench("run", *args, "--out", tmp_path / "x"), *words)
+def test_antenna_bad_options_exit_2(tmp_path, args, words, capsys):
+    assert_one_line_error(in_process(capsys, "run", *args, "--out", tmp_path / "x"), *words)
     assert not (tmp_path / "x").exists()
 
 
@@ -368,36 +386,36 @@ def test_fast_run_outputs_and_stewart_option(tmp_path):
     assert len(frames) >= 85 and frames[-1].std() > 10
 
 
-def test_fast_bad_stewart_option(tmp_path):
+def test_fast_bad_stewart_option(tmp_path, capsys):
     assert_one_line_error(
-        planbench("run", "fast-tracking", "--stewart", "maybe", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "fast-tracking", "--stewart", "maybe", "--out", tmp_path / "x"),
         "stewart = 'maybe' is not true or false",
     )
     assert_one_line_error(
-        planbench("run", "loader-supply", "--stewart", "on", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "loader-supply", "--stewart", "on", "--out", tmp_path / "x"),
         "unrecognized arguments: --stewart on",
     )
-    assert_one_line_error(planbench("run", "fast-ra-scan", "--wind", "-1", "--out", tmp_path / "x"), "wind")
+    assert_one_line_error(in_process(capsys, "run", "fast-ra-scan", "--wind", "-1", "--out", tmp_path / "x"), "wind")
     assert_one_line_error(
-        planbench("run", "fast-ra-scan", "--wind-direction", "inf", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "fast-ra-scan", "--wind-direction", "inf", "--out", tmp_path / "x"),
         "wind_direction = inf is not finite",
     )
     assert_one_line_error(
-        planbench("run", "hexapod-sync-move", "--wind-direction", "30", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "hexapod-sync-move", "--wind-direction", "30", "--out", tmp_path / "x"),
         "unrecognized arguments: --wind-direction 30",
     )
     assert_one_line_error(
-        planbench("run", "fast-tracking", "--cable-segments", "1", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "fast-tracking", "--cable-segments", "1", "--out", tmp_path / "x"),
         "cable_segments = 1 is not a chain",
         "2 ... 14",
     )
     assert_one_line_error(
-        planbench("run", "fast-tracking", "--cable-segments", "20", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "fast-tracking", "--cable-segments", "20", "--out", tmp_path / "x"),
         "cable_segments = 20 is outside [0, 14]",
         "omega dt <= 0.7",
     )
     assert_one_line_error(
-        planbench("run", "loader-supply", "--cable-segments", "4", "--out", tmp_path / "x"),
+        in_process(capsys, "run", "loader-supply", "--cable-segments", "4", "--out", tmp_path / "x"),
         "unrecognized arguments: --cable-segments 4",
     )
     assert not (tmp_path / "x").exists()
