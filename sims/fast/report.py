@@ -54,7 +54,7 @@ def fast_plan_figure(plan, t: np.ndarray, path) -> None:
 #: Rows of a report's time axis beyond which each plotted series is drawn as its envelope
 #: (``envelope``): report.png's plots are about 500 pixels wide, so a long run's 10 Hz series
 #: would put dozens of points on each pixel column and hold them all in memory to draw them.
-REPORT_POINTS = 20_000
+REPORT_POINTS = 4_000
 
 
 def envelope(values: np.ndarray, span: int) -> np.ndarray:
