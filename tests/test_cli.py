@@ -317,10 +317,9 @@ def test_antenna_without_prediction_fails_the_paper_motion(tmp_path):
 
 
 @pytest.mark.parametrize("name", ["fast-tracking", "fast-source-switch", "fast-ra-scan", "fast-dec-scan"])
-def test_fast_plans(tmp_path, name):
-    out = tmp_path / name
-    proc = planbench("plan", name, "--out", out)
-    assert proc.returncode == 0, proc.stderr
+def test_fast_plans(written_plan, name):
+    code, out = written_plan(name)
+    assert code == 0
     assert {p.name for p in out.iterdir()} == {
         "plan.npz",
         "plan.png",

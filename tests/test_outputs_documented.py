@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from planbench import api, scenarios
-from planbench.plans import write_plan
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 RUNS = {  # short runs (s): every array and metric is written whatever the duration
@@ -111,9 +110,9 @@ def test_every_run_output_is_documented(tmp_path, name, params):
 
 
 @pytest.mark.parametrize("name", PLANS)
-def test_every_plan_output_is_documented(tmp_path, name):
-    runs, plans = scenarios._registry()
-    out = write_plan({**runs, **plans}[name], tmp_path / "plan")
+def test_every_plan_output_is_documented(written_plan, name):
+    code, out = written_plan(name)
+    assert code == 0
     written = {("files", f.name) for f in out.iterdir()}
     for f in out.glob("*.npz"):
         with np.load(f) as npz:
