@@ -199,3 +199,20 @@ def test_the_public_api_is_what_all_names():
     section = readme.split("## Python API", 1)[1].split("\n## ", 1)[0]
     for name in planbench.__all__:
         assert f"`{name}" in section, f"README's Python API section does not list {name}"
+
+
+def test_finding_the_scenarios_imports_no_module_a_run_may_not_need(tmp_path):
+    """Every command line looks its scenario up in the registry, which imports the four
+    mechanisms: that leaves out what only some runs use (scipy.signal and scipy.stats, about
+    0.4 s; scipy.integrate, 0.3 s; the video writer), imported where they are used."""
+    code = (
+        "import sys\n"
+        "from planbench import scenarios\n"
+        "scenarios.get('loader-supply')\n"
+        "heavy = sorted(n for n in ('scipy.signal', 'scipy.stats', 'scipy.integrate', 'mediapy') if n in sys.modules)\n"
+        "assert not heavy, heavy\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True, text=True, timeout=300
+    )
+    assert proc.returncode == 0, proc.stderr

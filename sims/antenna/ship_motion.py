@@ -31,7 +31,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import integrate
 
 from planbench.planners.errors import PlanningError
 
@@ -376,6 +375,8 @@ def jonswap_normalization(gamma: float) -> float:
     gamma = float(gamma)
     if not math.isfinite(gamma) or gamma < 1.0:
         raise ShipMotionError(f"JONSWAP peak enhancement gamma = {gamma!r} must be >= 1")
+
+    from scipy import integrate  # (here: importing it costs every command line ~0.3 s)
 
     def f(u):
         return float(_jonswap_shape(u, gamma))

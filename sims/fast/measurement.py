@@ -38,7 +38,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
-import scipy.signal
 
 from planbench.fast.physics import CONTROL_DT, PHYSICS_DT, FastPhysics, index_view, moment_sum
 from planbench.logfile import temporary_writer
@@ -561,6 +560,8 @@ def gauss_markov(rng: np.random.Generator, shape: tuple, sigma: float, correlati
         return np.zeros(shape)
     phi = math.exp(-dt / correlation_s)
     n[1:] *= math.sqrt(1.0 - phi * phi)
+    import scipy.signal  # (here: importing it costs every command line ~0.4 s, scipy.stats included)
+
     return sigma * scipy.signal.lfilter([1.0], [1.0, -phi], n, axis=0)
 
 
