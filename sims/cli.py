@@ -193,9 +193,9 @@ def _resolve_source(command: str, argv: list[str]):
     from planbench.params import ParamError, set_overrides
 
     get, names = (
-        (scenarios.get, scenarios.SCENARIOS)
+        (scenarios.get, scenarios.KnownNames())
         if command == "run"
-        else (scenarios.get_plan, {**scenarios.SCENARIOS, **scenarios.PLANS})
+        else (scenarios.get_plan, scenarios.KnownNames(plans=True))
     )
     try:
         source = scenario_files.resolve(argv[0], get, names)

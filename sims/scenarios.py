@@ -208,8 +208,42 @@ def __getattr__(attribute: str):
     raise AttributeError(f"module {__name__!r} has no attribute {attribute!r}")
 
 
+def _by_prefix(name: str, plans: bool = False) -> Scenario | None:
+    """Before the registry is built: the scenario (or, with ``plans``, plan-only entry)
+    ``name`` if the mechanism its prefix names declares it (``loader-supply``: loader), that
+    mechanism's package imported alone; None otherwise. A command line that runs one
+    scenario then imports one mechanism, not all four (FAST's and the antenna's scipy
+    modules cost each start about 0.4 s)."""
+    if _registry.cache_info().currsize:
+        return None
+    prefix = name.split("-", 1)[0] if isinstance(name, str) else None
+    if prefix not in models.MECHANISMS:
+        return None
+    record = getattr(_import_mechanism(prefix), "MECHANISM", None)
+    entries = (*getattr(record, "scenarios", ()), *(getattr(record, "plans", ()) if plans else ()))
+    return next((entry for entry in entries if entry.name == name), None)
+
+
+class KnownNames:
+    """``name in KnownNames(plans)``: whether ``name`` is a scenario (or, with ``plans``, a
+    plan-only entry), asked of the mechanism its prefix names first (``_by_prefix``), then of
+    the whole registry."""
+
+    def __init__(self, plans: bool = False):
+        self.plans = plans
+
+    def __contains__(self, name) -> bool:
+        if _by_prefix(name, self.plans) is not None:
+            return True
+        scenarios, plans = _registry()
+        return name in scenarios or (self.plans and name in plans)
+
+
 def get(name: str) -> Scenario:
     """The scenario called ``name``; a ValueError lists the known names otherwise."""
+    found = _by_prefix(name)
+    if found is not None:
+        return found
     scenarios = _registry()[0]
     try:
         return scenarios[name]
@@ -233,6 +267,9 @@ def get_of(mechanism: str, name: str) -> Scenario:
 
 def get_plan(name: str) -> Scenario:
     """A scenario or a plan-only entry called ``name`` (``planbench plan``)."""
+    found = _by_prefix(name, plans=True)
+    if found is not None:
+        return found
     scenarios, plans = _registry()
     if name in plans:
         return plans[name]

@@ -202,13 +202,22 @@ def test_the_public_api_is_what_all_names():
 
 
 def test_finding_the_scenarios_imports_no_module_a_run_may_not_need(tmp_path):
-    """Every command line looks its scenario up in the registry, which imports the four
-    mechanisms: that leaves out what only some runs use (scipy.signal and scipy.stats, about
-    0.4 s; scipy.integrate, 0.3 s; the video writer), imported where they are used."""
+    """Every command line looks its scenario up: by its name's prefix, that mechanism alone
+    is imported; the whole registry (the four mechanisms) leaves out what only some runs use
+    (scipy.signal and scipy.stats, about 0.4 s; scipy.integrate, 0.3 s; the video writer),
+    imported where they are used."""
     code = (
         "import sys\n"
         "from planbench import scenarios\n"
-        "scenarios.get('loader-supply')\n"
+        "assert scenarios.get('loader-supply').name == 'loader-supply'\n"
+        "assert 'loader-supply' in scenarios.KnownNames()\n"
+        "others = sorted(n for n in sys.modules if n.split('.')[:2] in "
+        "(['planbench', 'fast'], ['planbench', 'antenna'], ['planbench', 'hexapod']))\n"
+        "assert not others, others\n"
+        "assert 'loader-nope' not in scenarios.KnownNames()  # (asks the whole registry)\n"
+        "assert 'fast-dec-scan' in scenarios.KnownNames(plans=True) and 'fast-dec-scan' not in scenarios.KnownNames()\n"
+        "assert scenarios.get_plan('fast-dec-scan').name == 'fast-dec-scan'\n"
+        "scenarios.mechanisms()\n"
         "heavy = sorted(n for n in ('scipy.signal', 'scipy.stats', 'scipy.integrate', 'mediapy') if n in sys.modules)\n"
         "assert not heavy, heavy\n"
     )
