@@ -301,26 +301,18 @@ class LogFile:
 
 
 class LoggedSeries:
-    """One array of a LogFile, as a whole array only when asked for (``np.asarray``): the
-    series an evaluation keeps at every stride-th tick of a long run, spooled to a temporary
-    log rather than held (``save_timeseries`` writes it a chunk at a time; a report reads one
-    series at a time). ``dtype``: the series' own type (a log stores float64; booleans and
-    small integers come back exactly); ``scale``: a factor its values are multiplied by as
-    they are read (a unit's change: mm of a series logged in m)."""
+    """Every ``stride``-th row of one array of a LogFile, as a whole array only when asked for
+    (``np.asarray``): a log's arrays in timeseries.npz, and the series an evaluation keeps at
+    every stride-th tick of a long run, spooled to a temporary log rather than held
+    (``save_timeseries`` writes it a chunk at a time; a report reads one series at a time).
+    ``dtype``: the series' own type (a log stores float64; booleans and small integers come
+    back exactly); ``scale``: a factor its values are multiplied by as they are read (a unit's
+    change: mm of a series logged in m)."""
 
-    def __init__(self, log: LogFile, name: str, dtype=float, scale: float | None = None):
+    def __init__(self, log: LogFile, name: str, dtype=float, scale: float | None = None, stride: int = 1):
         log._known(name)
-        self.log, self.name, self.dtype, self.scale = log, name, np.dtype(dtype), scale
-        self.shape = (log.n, *(() if name == "t" else tuple(log.shapes[name])))
-
-    def __rmul__(self, factor: float) -> LoggedSeries:
-        """``factor * series``: the series scaled as it is read (float series only)."""
-        if self.dtype != np.dtype(float) or self.scale is not None:
-            return NotImplemented
-        return LoggedSeries(self.log, self.name, self.dtype, float(factor))
-
-    def _values(self, values: np.ndarray) -> np.ndarray:
-        return values.astype(self.dtype) if self.scale is None else self.scale * values
+        self.log, self.name, self.dtype, self.scale, self.stride = log, name, np.dtype(dtype), scale, stride
+        self.shape = (len(range(0, log.n, stride)), *(() if name == "t" else tuple(log.shapes[name])))
 
     @property
     def ndim(self) -> int:
@@ -329,16 +321,29 @@ class LoggedSeries:
     def __len__(self) -> int:
         return self.shape[0]
 
+    def __rmul__(self, factor: float) -> LoggedSeries:
+        """``factor * series``: the series scaled as it is read (float series only)."""
+        if self.dtype != np.dtype(float) or self.scale is not None:
+            return NotImplemented
+        return LoggedSeries(self.log, self.name, self.dtype, float(factor), self.stride)
+
+    def _values(self, values: np.ndarray) -> np.ndarray:
+        return values.astype(self.dtype) if self.scale is None else self.scale * values
+
     def parts(self):
-        """Each chunk's rows in turn, of ``dtype``."""
+        """Each chunk's rows (every stride-th of the log's) in turn, of ``dtype``."""
+        start = 0
         for part in self.log.chunks([self.name]):
-            yield np.ascontiguousarray(self._values(part[self.name]))
+            rows = part[self.name]
+            yield np.ascontiguousarray(self._values(rows[-start % self.stride :: self.stride]))
+            start += rows.shape[0]
 
     def __getitem__(self, key) -> np.ndarray:
         return np.asarray(self)[key]
 
     def __array__(self, dtype=None, copy=None) -> np.ndarray:
-        values = self._values(self.log.column(self.name))
+        whole = self.log.column(self.name) if self.stride == 1 else self.log.every(self.name, self.stride)
+        values = self._values(whole)
         return values if dtype is None else values.astype(dtype)
 
 

@@ -828,33 +828,16 @@ def _as_output_dir(out_dir, kind: str) -> OutputDir:
     return out_dir if isinstance(out_dir, OutputDir) else OutputDir(out_dir, kind=kind)
 
 
-class _StridedLog:
-    """Every ``stride``-th row of a logged array, read from the run's log file a chunk at a time
-    when written (``save_timeseries``)."""
-
-    dtype = np.dtype(float)
-
-    def __init__(self, log, name: str, stride: int):
-        self.log, self.name, self.stride = log, name, stride
-        shape = () if name == "t" else tuple(log.file.shapes[name])
-        self.shape = (len(range(0, log.n, stride)), *shape)
-
-    def parts(self):
-        for start, part in self.log.chunks([self.name]):
-            yield np.ascontiguousarray(part[self.name][-start % self.stride :: self.stride])
-
-
 def save_timeseries(path, arrays: dict) -> None:
     """``np.savez_compressed(path, **arrays)``, where an array may also be one read from a log
-    a chunk at a time (a ``_StridedLog`` or a ``logfile.LoggedSeries``: ``shape``, ``dtype``
-    and ``parts()``), whose rows are written as they are read (a long run's arrays are never
-    whole in memory)."""
+    a chunk at a time (a ``logfile.LoggedSeries``: ``shape``, ``dtype`` and ``parts()``), whose
+    rows are written as they are read (a long run's arrays are never whole in memory)."""
     from numpy.lib import format as npy
 
     with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as archive:
         for name, value in arrays.items():
             with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
-                if hasattr(value, "parts"):  # (a _StridedLog or a logfile.LoggedSeries)
+                if hasattr(value, "parts"):  # (a logfile.LoggedSeries, read a chunk at a time)
                     npy.write_array_header_1_0(
                         member,
                         {"descr": npy.dtype_to_descr(value.dtype), "fortran_order": False, "shape": value.shape},
@@ -889,6 +872,7 @@ def write_run(
     ``more_videos``: (file name, camera) pairs of further videos inside ``out_dir`` (the
     demo's close-ups). Returns the summary.
     """
+    from planbench.logfile import LoggedSeries
     from planbench.render import render_video
 
     target = _as_output_dir(out_dir, "run")
@@ -924,7 +908,7 @@ def write_run(
                     arrays = {
                         name: log.every(name, stride)
                         if log.file is None or log.held(name)
-                        else _StridedLog(log, name, stride)
+                        else LoggedSeries(log.file, name, stride=stride)
                         for name in names
                     }
                     t_every = log.every("t", stride)

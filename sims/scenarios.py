@@ -214,12 +214,16 @@ def _by_prefix(name: str, plans: bool = False) -> Scenario | None:
     mechanism's package imported alone; None otherwise. A command line that runs one
     scenario then imports one mechanism, not all four (FAST's and the antenna's scipy
     modules cost each start about 0.4 s)."""
+    prefix = name.split("-", 1)[0]
+    return _declared_by(prefix, name, plans) if prefix in models.MECHANISMS else None
+
+
+def _declared_by(mechanism: str, name: str, plans: bool = False) -> Scenario | None:
+    """Before the registry is built: the entry ``name`` that ``mechanism`` declares, that
+    mechanism's package imported alone; None otherwise (or once the registry is built)."""
     if _registry.cache_info().currsize:
         return None
-    prefix = name.split("-", 1)[0] if isinstance(name, str) else None
-    if prefix not in models.MECHANISMS:
-        return None
-    record = getattr(_import_mechanism(prefix), "MECHANISM", None)
+    record = getattr(_import_mechanism(mechanism), "MECHANISM", None)
     entries = (*getattr(record, "scenarios", ()), *(getattr(record, "plans", ()) if plans else ()))
     return next((entry for entry in entries if entry.name == name), None)
 
@@ -257,12 +261,8 @@ def get_of(mechanism: str, name: str) -> Scenario:
     and the antenna's scipy modules) would cost each worker about a second of its start.
     Once the registry is built, its answer; a name the mechanism does not declare is looked
     up in the registry (``get``: a ValueError lists the known names)."""
-    if _registry.cache_info().currsize == 0:
-        record = getattr(_import_mechanism(mechanism), "MECHANISM", None)
-        for scenario in getattr(record, "scenarios", ()):
-            if scenario.name == name:
-                return scenario
-    return get(name)
+    found = _declared_by(mechanism, name)
+    return found if found is not None else get(name)
 
 
 def get_plan(name: str) -> Scenario:

@@ -111,7 +111,7 @@ def test_a_timeseries_copied_from_the_log_is_savez_s(tmp_path_factory, n, chunk,
     names = ("t", "qpos", "act", "mocap_pos")
     series = {"names": np.array(["a", "bc"]), "series": np.arange(7.0) / 3}
     outputs.save_timeseries(
-        folder / "streamed.npz", {**{k: outputs._StridedLog(log, k, stride) for k in names}, **series}
+        folder / "streamed.npz", {**{k: logfile.LoggedSeries(log.file, k, stride=stride) for k in names}, **series}
     )
     np.savez_compressed(folder / "whole.npz", **{k: log.file.column(k)[::stride] for k in names}, **series)
     streamed, whole = np.load(folder / "streamed.npz"), np.load(folder / "whole.npz")
