@@ -271,27 +271,43 @@ class _Anchors:
         return 3 * rows + choice
 
 
-def _poses_along(anchors: _Anchors, position: np.ndarray):
+def _poses_along(anchors: _Anchors, position: np.ndarray, fresh: np.ndarray):
     """Forward kinematics of the planned strut positions (N, P, 6) of N moves, each move's P
     points in time order (the first its start, the last its end): point k starts from point
     k - 1's pose, moved by the nearest anchor's linearization, the end from the target pose
-    itself (an exact plan ends exactly there). Returns (poses (N, P, 6), residual (N, P) m)."""
+    itself (an exact plan ends exactly there). A point that is not ``fresh`` (N, P) repeats
+    the one before it (the same time) and takes its pose: the pose its own iteration would
+    reach, since it would start there already converged. Returns (poses (N, P, 6), residual
+    (N, P) m)."""
     count, points = position.shape[:2]
-    rows = np.arange(count)
     poses = np.empty(position.shape)
     residual = np.empty((count, points))
     previous_pose, previous_position = anchors.poses[:, 0], anchors.struts[:, 0]
     for k in range(points):
-        which = anchors.nearest(rows, position[:, k])
         if k == points - 1:
+            rows = np.arange(count)
             guess = anchors.poses[:, 2]
+            which = anchors.nearest(rows, position[:, k])
         else:
-            guess = previous_pose + np.einsum("nij,nj->ni", anchors.inverse[which], position[:, k] - previous_position)
-        poses[:, k], residual[:, k] = poses_of_lengths(
-            position[:, k] + RUBIN_CAMERA.nominal_lengths, guess, anchors.inverse, which
+            if k:
+                poses[:, k], residual[:, k] = poses[:, k - 1], residual[:, k - 1]
+            rows = np.flatnonzero(fresh[:, k])
+            which = anchors.nearest(rows, position[rows, k])
+            guess = previous_pose[rows] + np.einsum(
+                "nij,nj->ni", anchors.inverse[which], position[rows, k] - previous_position[rows]
+            )
+        poses[rows, k], residual[rows, k] = poses_of_lengths(
+            position[rows, k] + RUBIN_CAMERA.nominal_lengths, guess, anchors.inverse, which
         )
         previous_pose, previous_position = poses[:, k], position[:, k]
     return poses, residual
+
+
+def _max_by_move(values: np.ndarray, first: np.ndarray, points: int) -> np.ndarray:
+    """(N, C) the largest of ``values`` (F, C) of each move's points, row r of ``values``
+    being flat point ``first[r]`` (sorted; every move has at least one)."""
+    starts = np.flatnonzero(np.diff(first // points, prepend=-1))
+    return np.maximum.reduceat(values, starts, axis=0)
 
 
 #: Interior extremes of the pose inside the pieces evaluated exactly per move (the largest
@@ -313,15 +329,21 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     times[:, 0::2] = ticks * dt
     times[:, 1::2] = 0.5 * (ticks[:, :-1] + ticks[:, 1:]) * dt
     points = times.shape[1]
-    rows = np.repeat(index, points)
-    sample = _sample_rows(moves, rows, times.ravel())
-    position = sample.position.reshape(count, points, 6)
-    speed = np.abs(sample.velocity).reshape(count, points, 6).max(axis=1)  # (N, 6)
-    accel = np.abs(sample.acceleration).reshape(count, points, 6).max(axis=1)
+    # Switching ticks shared by several struts repeat a time: such a point is sampled and
+    # solved once, and its copies take its values (the same numbers).
+    fresh = np.ones((count, points), dtype=bool)
+    fresh[:, 1:] = times[:, 1:] != times[:, :-1]
+    first = np.flatnonzero(fresh.ravel())
+    source = np.maximum.accumulate(np.where(fresh.ravel(), np.arange(fresh.size), 0))
+    rank = np.cumsum(fresh.ravel()) - 1  # flat point -> its row among ``first``
+    sample = _sample_rows(moves, first // points, times.ravel()[first])
+    position = sample.position[rank[source]].reshape(count, points, 6)
+    speed = _max_by_move(np.abs(sample.velocity), first, points)  # (N, 6)
+    accel = _max_by_move(np.abs(sample.acceleration), first, points)
     stroke = np.abs(position).max(axis=1)
 
     anchors = _Anchors(moves)
-    poses, residual = _poses_along(anchors, position)
+    poses, residual = _poses_along(anchors, position, fresh)
     converged = (residual <= FK_TOLERANCE_M).all(axis=1)
 
     # Exact samples: the largest |ratio| of any axis at a switching tick or a midpoint.
@@ -372,13 +394,18 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     # Hexapod-space speeds: the strut speeds are linear in t inside a piece and the Jacobian
     # nearly constant over a move, so each speed (a norm of a linear function) peaks at a
     # switching tick.
-    velocity = sample.velocity.reshape(count, points, 6)
-    block = max(1, KINEMATICS_BLOCK // points)
-    hex_speed = np.concatenate(
-        [
-            hexapod_planner.hexapod_speed_ratios(poses[lo : lo + block], velocity[lo : lo + block]).max(axis=1)
-            for lo in range(0, count, block)
-        ]
+    fresh_poses = poses.reshape(-1, 6)[first]
+    hex_speed = _max_by_move(
+        np.concatenate(
+            [
+                hexapod_planner.hexapod_speed_ratios(
+                    fresh_poses[lo : lo + KINEMATICS_BLOCK], sample.velocity[lo : lo + KINEMATICS_BLOCK]
+                )
+                for lo in range(0, first.size, KINEMATICS_BLOCK)
+            ]
+        ),
+        first,
+        points,
     )
     _, moving = strut_tolerances(moves.start, moves.target)
     arrival = moves.n_ticks * dt
