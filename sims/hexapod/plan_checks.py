@@ -118,7 +118,7 @@ from planbench.planners import hexapod as hexapod_planner
 from planbench.planners.errors import PlanningError
 from planbench.planners.hexapod import POSE_LABELS, RUBIN_CAMERA, RUBIN_LIMITS, STRUT_LABELS, StrutMove
 from planbench.planners.legs import component_norm, leg_vector_components
-from planbench.planners.trajectory import PiecewiseTrajectory, control_ticks
+from planbench.planners.trajectory import PiecewiseTrajectory, TrajectorySample, control_ticks
 
 #: Forward kinematics stops for a pose once its largest strut-length residual is below this,
 #: m (0.1 nm: 1e-8 of the smallest pose limit, 1e-4 of the 1 um end-pose limit).
@@ -127,9 +127,10 @@ FK_TOLERANCE_M = 1e-10
 FK_MAX_ITERATIONS = 40
 #: Moves planned and judged at once: bounds the memory (about 25 kB per move, 50 MB a chunk).
 CHUNK_MOVES = 2048
-#: Poses whose Jacobians are computed at once (its arrays stay in cache: twice as fast as
-#: a chunk's ~50 000 at once; the numbers do not depend on it).
-KINEMATICS_BLOCK = 8192
+#: Points whose strut samples and Jacobians are computed at once: their arrays stay in the
+#: cache (sampling 40 000 points 2048 at a time is 3.6 times as fast as all at once; the
+#: numbers do not depend on it).
+KINEMATICS_BLOCK = 2048
 
 _LOWER, _UPPER = RUBIN_LIMITS.pose_lower, RUBIN_LIMITS.pose_upper
 _CENTRE, _HALF = (_UPPER + _LOWER) / 2.0, (_UPPER - _LOWER) / 2.0
@@ -184,14 +185,20 @@ def poses_of_lengths(
       FK_MAX_ITERATIONS did not converge.
     """
     pose = np.array(guess, dtype=float)
-    which = np.arange(pose.shape[0]) if which is None else np.asarray(which)
+    inverse = inverse_jacobian if which is None else inverse_jacobian[np.asarray(which)]  # (M, 6, 6)
     residual = _strut_lengths(pose) - lengths
     worst = _max_last(np.abs(residual))
     active = np.flatnonzero(worst > FK_TOLERANCE_M)
     for _ in range(FK_MAX_ITERATIONS):
         if active.size == 0:
             break
-        step = np.einsum("nij,nj->ni", inverse_jacobian[which[active]], residual[active])
+        if active.size == pose.shape[0]:  # every row (often the first step): no gathers
+            pose -= np.einsum("nij,nj->ni", inverse, residual)
+            residual = _strut_lengths(pose) - lengths
+            worst = _max_last(np.abs(residual))
+            active = np.flatnonzero(worst > FK_TOLERANCE_M)
+            continue
+        step = np.einsum("nij,nj->ni", inverse[active], residual[active])
         pose[active] -= step
         res = _strut_lengths(pose[active]) - lengths[active]
         residual[active] = res
@@ -230,19 +237,28 @@ def _switching_ticks(moves: hexapod_planner.StrutMoves) -> np.ndarray:
     return np.sort(np.concatenate([zero, k, n - k, ends], axis=1), axis=1)
 
 
-def _sample_rows(moves: hexapod_planner.StrutMoves, rows: np.ndarray, t: np.ndarray):
-    """The planner's own ``StrutMove.sample`` of move ``rows[r]`` at time ``t[r]`` for every r."""
-    batch = StrutMove(
-        moves.start[rows],
-        moves.target[rows],
-        moves.n_ticks[rows],
-        moves.n_accel[rows],
-        moves.accel[rows],
-        moves.dt,
-        None,
-        moves.synchronous,
+def _sample_rows(moves: hexapod_planner.StrutMoves, rows: np.ndarray, t: np.ndarray) -> TrajectorySample:
+    """The planner's own ``StrutMove.sample`` of move ``rows[r]`` at time ``t[r]`` for every r,
+    KINEMATICS_BLOCK rows at a time (the sample is elementwise: the same numbers)."""
+    parts = []
+    for lo in range(0, rows.size, KINEMATICS_BLOCK):
+        block = rows[lo : lo + KINEMATICS_BLOCK]
+        batch = StrutMove(
+            moves.start[block],
+            moves.target[block],
+            moves.n_ticks[block],
+            moves.n_accel[block],
+            moves.accel[block],
+            moves.dt,
+            None,
+            moves.synchronous,
+        )
+        parts.append(batch.sample(t[lo : lo + KINEMATICS_BLOCK]))
+    if len(parts) == 1:
+        return parts[0]
+    return TrajectorySample(
+        *(np.concatenate([getattr(p, f) for p in parts]) for f in ("t", "position", "velocity", "acceleration"))
     )
-    return batch.sample(t)
 
 
 class _Anchors:
@@ -280,27 +296,29 @@ def _poses_along(anchors: _Anchors, position: np.ndarray, fresh: np.ndarray):
     reach, since it would start there already converged. Returns (poses (N, P, 6), residual
     (N, P) m)."""
     count, points = position.shape[:2]
-    poses = np.empty(position.shape)
-    residual = np.empty((count, points))
+    # Point by point, each point's rows contiguous.
+    along = np.ascontiguousarray(position.transpose(1, 0, 2))  # (P, N, 6)
+    poses = np.empty(along.shape)
+    residual = np.empty((points, count))
     previous_pose, previous_position = anchors.poses[:, 0], anchors.struts[:, 0]
     for k in range(points):
-        if k == points - 1:
-            rows = np.arange(count)
-            guess = anchors.poses[:, 2]
-            which = anchors.nearest(rows, position[:, k])
+        if k == points - 1 or fresh[:, k].all():
+            rows = slice(None)
+            inverse = anchors.inverse[anchors.nearest(np.arange(count), along[k])]
+            if k == points - 1:
+                guess = anchors.poses[:, 2]
+            else:
+                guess = previous_pose + np.einsum("nij,nj->ni", inverse, along[k] - previous_position)
         else:
-            if k:
-                poses[:, k], residual[:, k] = poses[:, k - 1], residual[:, k - 1]
+            poses[k], residual[k] = poses[k - 1], residual[k - 1]
             rows = np.flatnonzero(fresh[:, k])
-            which = anchors.nearest(rows, position[rows, k])
-            guess = previous_pose[rows] + np.einsum(
-                "nij,nj->ni", anchors.inverse[which], position[rows, k] - previous_position[rows]
-            )
-        poses[rows, k], residual[rows, k] = poses_of_lengths(
-            position[rows, k] + RUBIN_CAMERA.nominal_lengths, guess, anchors.inverse, which
+            inverse = anchors.inverse[anchors.nearest(rows, along[k, rows])]
+            guess = previous_pose[rows] + np.einsum("nij,nj->ni", inverse, along[k, rows] - previous_position[rows])
+        poses[k, rows], residual[k, rows] = poses_of_lengths(
+            along[k, rows] + RUBIN_CAMERA.nominal_lengths, guess, inverse
         )
-        previous_pose, previous_position = poses[:, k], position[:, k]
-    return poses, residual
+        previous_pose, previous_position = poses[k], along[k]
+    return np.ascontiguousarray(poses.transpose(1, 0, 2)), np.ascontiguousarray(residual.T)
 
 
 def _max_by_move(values: np.ndarray, first: np.ndarray, points: int) -> np.ndarray:
