@@ -225,3 +225,26 @@ def test_finding_the_scenarios_imports_no_module_a_run_may_not_need(tmp_path):
         [sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True, text=True, timeout=300
     )
     assert proc.returncode == 0, proc.stderr
+
+
+def test_a_planner_only_campaign_worker_starts_without_the_simulation_or_the_report(tmp_path):
+    """A local worker of a planner-only campaign imports the campaign's worker side and the
+    scenario's mechanism only: not the simulation pipeline, not the report's matplotlib and
+    scipy.stats, not the spec's distributions (the driver draws); a simulating worker imports
+    the pipeline as it starts."""
+    code = (
+        "import os, sys\n"
+        "from planbench.campaign import engines, worker\n"
+        "context = worker.Context('hexapod-sync-move', {}, None, {}, 'plan', (), (), mechanism='hexapod')\n"
+        "engines._init_worker(os.getppid(), context)\n"
+        "assert 'planbench.hexapod.plan_columns' in sys.modules\n"
+        "heavy = sorted(n for n in ('planbench.pipeline', 'planbench.campaign.report', 'matplotlib', 'scipy.stats')"
+        " if n in sys.modules)\n"
+        "assert not heavy, heavy\n"
+        "engines._init_worker(os.getppid(), context.__class__(**{**context.__dict__, 'mode': 'simulate'}))\n"
+        "assert 'planbench.pipeline' in sys.modules\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True, text=True, timeout=300
+    )
+    assert proc.returncode == 0, proc.stderr

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from tqdm import tqdm
 
-from planbench.campaign import engines, report, worker
+from planbench.campaign import engines, worker
 from planbench.campaign import spec as spec_module
 from planbench.campaign import store as store_module
 
@@ -253,6 +253,8 @@ def _sweep(spec, context, target, runner_engine, rerun_worst, quiet, echo, campa
         campaign_wall = time.perf_counter() - campaign_start
         table = target.table()
         target.write_results(table)
+        from planbench.campaign import report  # (matplotlib and scipy.stats: the driver's alone)
+
         summary = report.write(target, spec, table)
         worst = []
         if rerun_worst:
@@ -266,6 +268,7 @@ def rerun_worst_runs(spec, target, table, k: int, quiet: bool, echo) -> list:
     import numpy as np
 
     from planbench import outputs, pipeline
+    from planbench.campaign import report
 
     picked = report.worst_runs(table, k, target.checks())
     rows = {r["run"]: r for r in table.to_pylist() if r["run"] in set(picked)}

@@ -40,11 +40,13 @@ def _init_worker(parent: int | None = None, context: worker.Context | None = Non
     if parent == os.getpid():  # an in-process stand-in for a pool (tests)
         return
     # What every run needs, made as the worker starts (while the driver checks the runs and
-    # opens the campaign's directory): the pipeline, MuJoCo, the scenario's mechanism and the
-    # base parameters (``worker.prepare``). What fails here fails again in the first chunk,
-    # which reports it in its rows (an initializer's error would break the pool instead).
+    # opens the campaign's directory): the scenario's mechanism and the base parameters
+    # (``worker.prepare``), and for simulated runs the pipeline and MuJoCo. What fails here
+    # fails again in the first chunk, which reports it in its rows (an initializer's error
+    # would break the pool instead).
     try:
-        import planbench.pipeline  # noqa: F401
+        if context is None or context.mode == "simulate":
+            import planbench.pipeline  # noqa: F401
         import planbench.scenarios  # noqa: F401
 
         if context is not None:

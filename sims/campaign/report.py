@@ -17,7 +17,6 @@ import math
 
 import numpy as np
 import pyarrow as pa
-from scipy import stats
 
 #: Scatter plots show at most this many runs (every k-th run, so the picture is reproducible).
 MAX_SCATTER = 20_000
@@ -27,6 +26,8 @@ def wilson(passed: int, n: int, confidence: float = 0.95) -> tuple[float, float]
     """The Wilson score interval of a pass rate ``passed / n`` (None for n = 0)."""
     if n == 0:
         return None, None
+    from scipy import stats  # (scipy.stats takes ~0.4 s to import: only where a report is written)
+
     ci = stats.binomtest(passed, n).proportion_ci(confidence_level=confidence, method="wilson")
     return float(ci.low), float(ci.high)
 

@@ -47,7 +47,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
 from planbench.params import ParamError, Params, _bound, field_types
 
@@ -187,6 +186,8 @@ class Distribution:
         return a.get("low", -math.inf), a.get("high", math.inf)
 
     def frozen(self):
+        from scipy import stats  # (~0.4 s to import: a campaign's workers never draw)
+
         a = self.args
         if self.name == "uniform":
             return stats.uniform(loc=a["low"], scale=a["high"] - a["low"])
