@@ -632,3 +632,26 @@ def test_a_pool_closed_before_its_runs_leaves_no_thread_behind():
     engine.close()
     assert not [t for t in managers if t.is_alive()]
     assert not [pid for pid in started if _running(pid)]
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.lists(st.integers(0, 10**7), min_size=1, max_size=30, unique=True).flatmap(
+        lambda runs: st.tuples(st.permutations(runs), st.lists(st.integers(1, len(runs)), min_size=1, max_size=6))
+    )
+)
+def test_the_results_table_is_in_run_order_whatever_its_parts_hold(tmp_path_factory, drawn):
+    """Part files written in run order (a campaign without a break) are joined as they are;
+    parts whose runs overlap or interleave (a resumed campaign's) are sorted."""
+    import pyarrow as pa
+
+    runs, cuts = drawn
+    out = CampaignDir(tmp_path_factory.mktemp("parts") / "campaign")
+    out.table_dir.mkdir(parents=True)
+    bounds = sorted({0, len(runs), *(c % len(runs) for c in cuts)})
+    for lo, hi in itertools.pairwise(bounds):  # each part's rows in run order, as a chunk writes them
+        part = sorted(runs[lo:hi])
+        out.append(pa.table({"run": pa.array(part, pa.int64()), "value": pa.array([2.0 * r for r in part])}), {})
+    table = out.table()
+    assert table.column("run").to_pylist() == sorted(runs)
+    assert table.column("value").to_pylist() == [2.0 * r for r in sorted(runs)]
