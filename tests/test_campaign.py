@@ -655,3 +655,21 @@ def test_the_results_table_is_in_run_order_whatever_its_parts_hold(tmp_path_fact
     table = out.table()
     assert table.column("run").to_pylist() == sorted(runs)
     assert table.column("value").to_pylist() == [2.0 * r for r in sorted(runs)]
+
+
+def test_a_write_that_fails_midway_leaves_neither_the_file_nor_a_half_written_one(tmp_path):
+    from planbench.campaign.store import write_atomic
+
+    (tmp_path / "results.parquet").write_bytes(b"the old table")
+
+    def half(f):
+        f.write(b"half of a table")
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        write_atomic(tmp_path / "results.parquet", half)
+    assert [p.name for p in tmp_path.iterdir()] == ["results.parquet"]
+    assert (tmp_path / "results.parquet").read_bytes() == b"the old table"
+    write_atomic(tmp_path / "results.parquet", lambda f: f.write(b"the new table"))
+    assert [p.name for p in tmp_path.iterdir()] == ["results.parquet"]
+    assert (tmp_path / "results.parquet").read_bytes() == b"the new table"

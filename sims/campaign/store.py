@@ -46,16 +46,25 @@ def _fsync_dir(path: Path) -> None:
         os.close(fd)
 
 
-def write_atomic(path: Path, data: bytes) -> None:
-    """``data`` into ``path``: a temporary file beside it, fsync, rename (never half-written)."""
+def write_atomic(path: Path, data) -> None:
+    """``data`` (bytes, or a function that writes to the binary file it is given) into
+    ``path``: a temporary file beside it, fsync, rename (never half-written)."""
     tmp = path.with_name(f"{_TMP}{path.name}.{os.getpid()}")
-    with outputs.signals_deferred():
+    try:
         with open(tmp, "wb") as f:
-            f.write(data)
+            if isinstance(data, bytes):
+                f.write(data)
+            else:
+                data(f)
             f.flush()
             os.fsync(f.fileno())
-        os.replace(tmp, path)
-        _fsync_dir(path.parent)
+        with outputs.signals_deferred():
+            os.replace(tmp, path)
+            _fsync_dir(path.parent)
+    except BaseException:  # an interrupt or a full disk: the half-written file goes
+        with outputs.signals_deferred():
+            tmp.unlink(missing_ok=True)
+        raise
 
 
 class CampaignDir(outputs._Target):
@@ -179,9 +188,7 @@ class CampaignDir(outputs._Target):
 
             first, last = rows[0]["run"], rows[-1]["run"]
             table = rows_table(rows)
-        sink = pa.BufferOutputStream()
-        pq.write_table(table, sink)
-        write_atomic(self.table_dir / f"part-{first:08d}-{last:08d}.parquet", sink.getvalue().to_pybytes())
+        write_atomic(self.table_dir / f"part-{first:08d}-{last:08d}.parquet", lambda f: pq.write_table(table, f))
 
     def checks(self) -> dict:
         try:
@@ -203,9 +210,8 @@ class CampaignDir(outputs._Target):
         return table.sort_by("run")
 
     def write_results(self, table: pa.Table) -> Path:
-        sink = pa.BufferOutputStream()
-        pq.write_table(table, sink)
-        write_atomic(self.path / RESULTS, sink.getvalue().to_pybytes())
+        # Written straight to the file: the table's bytes are not held twice in memory.
+        write_atomic(self.path / RESULTS, lambda f: pq.write_table(table, f))
         return self.path / RESULTS
 
     # ---------------------------------------------------------------- per-run outputs
