@@ -35,6 +35,14 @@ def _environment(path: Path | None = None) -> dict:
     return env
 
 
+def _python_passes(code: str, cwd: Path) -> None:
+    """Run ``code`` in a fresh Python (planbench as installed) and require it to exit 0."""
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=cwd, env=_environment(), capture_output=True, text=True, timeout=300
+    )
+    assert proc.returncode == 0, proc.stderr
+
+
 def _planbench(*args, cwd: Path, path: Path | None = None) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-m", "planbench.cli", *map(str, args)],
@@ -161,10 +169,7 @@ def test_planbench_imports_no_old_top_level_name(tmp_path):
         "print(len(sys.modules), old)\n"
         "assert not old, old\n"
     )
-    proc = subprocess.run(
-        [sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True, text=True, timeout=300
-    )
-    assert proc.returncode == 0, proc.stderr
+    _python_passes(code, tmp_path)
 
 
 @pytest.mark.parametrize(
@@ -221,10 +226,7 @@ def test_finding_the_scenarios_imports_no_module_a_run_may_not_need(tmp_path):
         "heavy = sorted(n for n in ('scipy.signal', 'scipy.stats', 'scipy.integrate', 'mediapy') if n in sys.modules)\n"
         "assert not heavy, heavy\n"
     )
-    proc = subprocess.run(
-        [sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True, text=True, timeout=300
-    )
-    assert proc.returncode == 0, proc.stderr
+    _python_passes(code, tmp_path)
 
 
 def test_a_planner_only_campaign_worker_starts_without_the_simulation_or_the_report(tmp_path):
@@ -244,7 +246,4 @@ def test_a_planner_only_campaign_worker_starts_without_the_simulation_or_the_rep
         "engines._init_worker(os.getppid(), context.__class__(**{**context.__dict__, 'mode': 'simulate'}))\n"
         "assert 'planbench.pipeline' in sys.modules\n"
     )
-    proc = subprocess.run(
-        [sys.executable, "-c", code], cwd=tmp_path, env=_environment(), capture_output=True, text=True, timeout=300
-    )
-    assert proc.returncode == 0, proc.stderr
+    _python_passes(code, tmp_path)
