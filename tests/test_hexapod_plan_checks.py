@@ -274,3 +274,29 @@ def test_the_nearest_anchor_is_the_argmin_of_the_distances(seed, count):
     np.testing.assert_array_equal(
         tied.nearest(np.array([0, 1, 1]), np.array([[1.0] * 6, [3.0] * 6, [2.0] * 6])), [0, 3 + 1, 3 + 1]
     )
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_a_repeated_sample_time_takes_the_pose_its_own_solve_would_reach(seed, synchronous):
+    """Switching ticks that struts share repeat a sample time; the judge solves such a time
+    once. Solving every repeat on its own gives the same poses and residuals, bit for bit."""
+    from planbench.hexapod.plan_checks import _Anchors, _poses_along, _sample_rows, _switching_ticks
+
+    rng = np.random.default_rng(seed)
+    start, target = hp.random_poses(30, rng), hp.random_poses(30, rng)
+    moves = hp.plan_moves(start, target, synchronous=synchronous, method="closed")
+    ticks = _switching_ticks(moves)
+    times = np.empty((len(moves), 2 * ticks.shape[1] - 1))
+    times[:, 0::2] = ticks * moves.dt
+    times[:, 1::2] = 0.5 * (ticks[:, :-1] + ticks[:, 1:]) * moves.dt
+    position = _sample_rows(moves, np.repeat(np.arange(len(moves)), times.shape[1]), times.ravel()).position
+    position = position.reshape(len(moves), -1, 6)
+    fresh = np.ones(times.shape, dtype=bool)
+    fresh[:, 1:] = times[:, 1:] != times[:, :-1]
+    assert not fresh.all()  # struts share switching ticks in such moves
+    anchors = _Anchors(moves)
+    once, once_residual = _poses_along(anchors, position, fresh)
+    every, every_residual = _poses_along(anchors, position, np.ones_like(fresh))
+    np.testing.assert_array_equal(once, every)
+    np.testing.assert_array_equal(once_residual, every_residual)
