@@ -673,3 +673,33 @@ def test_a_write_that_fails_midway_leaves_neither_the_file_nor_a_half_written_on
     write_atomic(tmp_path / "results.parquet", lambda f: f.write(b"the new table"))
     assert [p.name for p in tmp_path.iterdir()] == ["results.parquet"]
     assert (tmp_path / "results.parquet").read_bytes() == b"the new table"
+
+
+def test_a_failed_results_write_fails_the_campaign_after_its_report(tmp_path, monkeypatch):
+    """results.parquet is written beside the report (another thread): an error there is the
+    campaign's error, raised once both are done, never lost in the thread."""
+    from planbench import campaign
+
+    spec = _write(
+        tmp_path / "spec.toml",
+        """
+scenario = "hexapod-sync-move"
+mode = "plan"
+samples = 20
+invalid = "skip"
+[random]
+"moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
+""",
+    )
+
+    def disk_full(self, table):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(CampaignDir, "write_results", disk_full)
+    with pytest.raises(OSError, match="No space left"):
+        campaign.sweep(spec, tmp_path / "out", workers=1, quiet=True)
+    assert (tmp_path / "out" / "campaign.json").is_file()  # the report, whole
+    assert not (tmp_path / "out" / "results.parquet").exists()
+    monkeypatch.undo()
+    outcome = campaign.sweep(spec, tmp_path / "out", workers=1, quiet=True)  # resumed: every row done
+    assert outcome.ran == 0 and pq.read_table(tmp_path / "out" / "results.parquet").num_rows == 20
