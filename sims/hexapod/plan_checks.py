@@ -76,10 +76,10 @@ Every strut sample comes from ``StrutMove.sample`` itself, the planner's own eva
 ``StrutMove`` whose fields are (rows, 6) arrays, one row per (move, time), samples each row
 at its own time (its formulas are elementwise). Struts often share a switching tick (about a
 third of a move's samples repeat the time before them): such a time is sampled, solved and
-given its speeds once, and its copies take those numbers. The forward kinematics iterates each pose on
-its own until its strut-length residual is below ``FK_TOLERANCE_M``, so no result depends on
-the others in its batch: judging runs together gives, bit for bit, what judging each alone
-does (tested).
+given its speeds once, and its copies take those numbers. The forward kinematics iterates
+each pose on its own until its strut-length residual is below ``FK_TOLERANCE_M``, so no
+result depends on the others in its batch: judging runs together gives, bit for bit, what
+judging each alone does (tested).
 
 A planner of your own (``judge_plans(..., planner=...)``) is judged by sampling the
 trajectories it returns at the control ticks (``judge_trajectories``): slower, the same
