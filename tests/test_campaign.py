@@ -574,21 +574,26 @@ invalid = "skip"
         assert np.array_equal(c.value, row[f"check.{c.name}"], equal_nan=True), c.name
 
 
+def _random_target_spec(tmp_path, samples: int) -> Path:
+    """A planner-only hexapod campaign of ``samples`` moves, each to a random x target."""
+    return _write(
+        tmp_path / "spec.toml",
+        f"""
+scenario = "hexapod-sync-move"
+mode = "plan"
+samples = {samples}
+invalid = "skip"
+[random]
+"moves[0].target[0]" = {{ distribution = "uniform", low = -5.0, high = 5.0 }}
+""",
+    )
+
+
 def test_a_pool_held_across_campaigns_serves_each_and_ends_with_its_block(tmp_path):
     from planbench import campaign
     from planbench.campaign.engines import LocalEngine
 
-    spec = _write(
-        tmp_path / "spec.toml",
-        """
-scenario = "hexapod-sync-move"
-mode = "plan"
-samples = 40
-invalid = "skip"
-[random]
-"moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
-""",
-    )
+    spec = _random_target_spec(tmp_path, samples=40)
     from planbench.campaign import context_of, worker
 
     loaded = spec_module.load(spec)  # the rows computed here, in one chunk, for reference
@@ -680,17 +685,7 @@ def test_a_failed_results_write_fails_the_campaign_after_its_report(tmp_path, mo
     campaign's error, raised once both are done, never lost in the thread."""
     from planbench import campaign
 
-    spec = _write(
-        tmp_path / "spec.toml",
-        """
-scenario = "hexapod-sync-move"
-mode = "plan"
-samples = 20
-invalid = "skip"
-[random]
-"moves[0].target[0]" = { distribution = "uniform", low = -5.0, high = 5.0 }
-""",
-    )
+    spec = _random_target_spec(tmp_path, samples=20)
 
     def disk_full(self, table):
         raise OSError(28, "No space left on device")

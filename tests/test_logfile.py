@@ -107,18 +107,25 @@ def test_a_timeseries_copied_from_the_log_is_savez_s(tmp_path_factory, n, chunk,
         writer.row("qpos", i)[:] = [i, -i, 0.5 * i]
         writer.row("mocap_pos", i)[:] = np.arange(6).reshape(2, 3) * i
     log = runner.RunLog(file=writer.read_back(n))
-    folder = tmp_path_factory.mktemp("npz")
     names = ("t", "qpos", "act", "mocap_pos")
     series = {"names": np.array(["a", "bc"]), "series": np.arange(7.0) / 3}
-    outputs.save_timeseries(
-        folder / "streamed.npz", {**{k: logfile.LoggedSeries(log.file, k, stride=stride) for k in names}, **series}
+    _assert_npz_as_savez(
+        tmp_path_factory.mktemp("npz"),
+        {**{k: logfile.LoggedSeries(log.file, k, stride=stride) for k in names}, **series},
+        {**{k: log.file.column(k)[::stride] for k in names}, **series},
     )
-    np.savez_compressed(folder / "whole.npz", **{k: log.file.column(k)[::stride] for k in names}, **series)
-    streamed, whole = np.load(folder / "streamed.npz"), np.load(folder / "whole.npz")
-    assert list(streamed.keys()) == list(whole.keys())
-    for key in whole.keys():
-        assert streamed[key].dtype == whole[key].dtype
-        np.testing.assert_array_equal(streamed[key], whole[key])
+
+
+def _assert_npz_as_savez(folder, streamed: dict, whole: dict) -> None:
+    """``save_timeseries(streamed)`` holds what ``np.savez_compressed(whole)`` does: the same
+    arrays, in the same order, of the same types."""
+    outputs.save_timeseries(folder / "streamed.npz", streamed)
+    np.savez_compressed(folder / "whole.npz", **whole)
+    written, expected = np.load(folder / "streamed.npz"), np.load(folder / "whole.npz")
+    assert list(written.keys()) == list(expected.keys())
+    for key in expected.keys():
+        assert written[key].dtype == expected[key].dtype
+        np.testing.assert_array_equal(written[key], expected[key])
 
 
 @settings(max_examples=25, deadline=None)
@@ -149,14 +156,11 @@ def test_a_spooled_series_reads_back_as_the_arrays_it_was_given(tmp_path_factory
     np.testing.assert_array_equal(np.asarray(1e3 * series["tension"]), 1e3 * arrays["tension"])
     with pytest.raises(TypeError):
         1e3 * series["observing"]  # scaling is for float series
-    folder = tmp_path_factory.mktemp("npz")
-    outputs.save_timeseries(folder / "spooled.npz", {**series, "mm": 1e3 * series["error"]})
-    np.savez_compressed(folder / "whole.npz", **arrays, mm=1e3 * arrays["error"])
-    spooled_npz, whole = np.load(folder / "spooled.npz"), np.load(folder / "whole.npz")
-    assert list(spooled_npz.keys()) == list(whole.keys())
-    for key in whole.keys():
-        assert spooled_npz[key].dtype == whole[key].dtype
-        np.testing.assert_array_equal(spooled_npz[key], whole[key])
+    _assert_npz_as_savez(
+        tmp_path_factory.mktemp("npz"),
+        {**series, "mm": 1e3 * series["error"]},
+        {**arrays, "mm": 1e3 * arrays["error"]},
+    )
 
 
 @settings(max_examples=50, deadline=None)
