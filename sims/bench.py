@@ -10,8 +10,13 @@ For each scenario (no video) it reports:
                    the share of MuJoCo's steps, of the code under test (the controller's calls
                    and the online planner inside them) and of the testbed's own cost (sensors,
                    disturbance, logging, divergence scans).
-The best of several runs is taken for both (REPEATS, or the mechanism's ``benchmark_runs``), so
-a busy machine affects both sides alike; scenarios not tagged "benchmark" get one run each.
+  replay ratio     the loop's physics steps per second divided by those of MuJoCo alone
+                   stepping the run's own motion (``replay_steps_per_second``: the logged
+                   states and commands set tick by tick), and the replay's over bare: loop/bare
+                   = loop/replay x replay/bare, the Python between the steps times MuJoCo's own
+                   extra work on the run's motion.
+The best of several runs is taken for all three (REPEATS, or the mechanism's ``benchmark_runs``),
+so a busy machine affects every side alike; scenarios not tagged "benchmark" get one run each.
 For the scenarios with drive trains as built it also reports their cost: the loop's wall time
 per physics step against the ideal drives'.
 
@@ -31,7 +36,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from planbench import pipeline, scenarios
+from planbench import pipeline, runner, scenarios
 
 REPEATS = 5
 
@@ -71,6 +76,65 @@ def bare_steps_per_second(setup, n_steps: int) -> float:
     return n_steps / best
 
 
+#: The arrays a replay sets before each tick's steps, in the order of MuJoCo's state
+#: (``REPLAY_SPEC``): the logged state and the tick's command.
+REPLAY_ARRAYS = ("qpos", "qvel", "act", "ctrl", "mocap_pos", "mocap_quat")
+REPLAY_SPEC = int(runner.STATE_SPEC | mujoco.mjtState.mjSTATE_CTRL)
+
+
+def replay_steps_per_second(setup, log, repeats: int = 1) -> tuple[float, float]:
+    """MuJoCo alone on a run's own motion: for each tick of ``log`` (a finished run of the
+    same scenario and parameters as ``setup``), its logged state (qpos, qvel, act, mocap) and
+    command set with one ``mj_setState``, then the loop's ``mj_step(model, data, nstep=k)``;
+    best of ``repeats`` passes.
+
+    Bare stepping starts from rest; a run's motion can cost MuJoCo more per step (the drives'
+    friction and the joint limits as active constraints, the solver's iterations while the
+    machine accelerates), which loop/bare counts as if it were the loop's own. loop/replay
+    leaves that out: what remains is the Python between the steps (the code under test and the
+    testbed) and its effect on MuJoCo's caches. Not replayed: what the plant's Python writes
+    besides the command (external forces such as the wind's, FAST's cable parameters); the
+    solver's warm start is the replay's own previous step's.
+
+    Returns (steps per second, the largest |difference| between the state a replayed tick
+    ends in and the next logged state over the last pass: 0.0 where the run's plant writes
+    nothing but the command, and the loop's MuJoCo calls are exactly these)."""
+    physics = setup.physics
+    model, data = physics.model.ptr, physics.data.ptr
+    names = [name for name in REPLAY_ARRAYS if model.nmocap or not name.startswith("mocap")]
+    ticks = log.n - 1
+    k = log.physics_steps // ticks if ticks > 0 else 0
+    if ticks <= 0 or k * ticks != log.physics_steps:
+        raise ValueError(f"a replay needs a run of whole ticks; this log has {log.n} rows, {log.physics_steps} steps")
+    size = mujoco.mj_stateSize(model, REPLAY_SPEC)
+    commands = model.nq + model.nv + model.na  # where the command's columns begin
+    state = np.r_[0:commands, commands + model.nu : size]  # a row's columns but the command
+    end = np.empty(size)
+    best, deviation = float("inf"), 0.0
+    for _ in range(repeats):
+        elapsed, deviation, pending = 0.0, 0.0, None
+        for start, part in log.chunks(names):
+            rows = np.concatenate([part[name].reshape(part[name].shape[0], -1) for name in names], axis=1)
+            if rows.shape[1] != size:
+                raise RuntimeError("MuJoCo's state layout is not qpos, qvel, act, ctrl, mocap_pos, mocap_quat")
+            if pending is not None:  # the last chunk's final tick ended at this chunk's first row
+                deviation = max(deviation, float(np.max(np.abs(pending - rows[0, state]))))
+            steps = rows[: max(0, ticks - start)]
+            clock = time.perf_counter()
+            for row in steps:
+                mujoco.mj_setState(model, data, row, REPLAY_SPEC)
+                mujoco.mj_step(model, data, nstep=k)
+            elapsed += time.perf_counter() - clock
+            mujoco.mj_getState(model, data, end, REPLAY_SPEC)
+            if steps.shape[0] < rows.shape[0]:  # the run's last row is in this chunk
+                deviation = max(deviation, float(np.max(np.abs(end[state] - rows[steps.shape[0], state]))))
+                pending = None
+            else:
+                pending = end[state].copy()
+        best = min(best, elapsed)
+    return ticks * k / best, deviation
+
+
 def bench_scenario(name: str, repeats: int = REPEATS, drives_cost: bool = True) -> dict:
     """One scenario's row (module docstring): the best of ``repeats`` runs, one profiled run,
     bare stepping, and (``drives_cost``, where the scenario has drive trains as built) the
@@ -85,7 +149,9 @@ def bench_scenario(name: str, repeats: int = REPEATS, drives_cost: bool = True) 
         best_loop = loop_rate if best_loop is None else max(best_loop, loop_rate)
     # One more run with the loop's clocks on: physics, code under test, the testbed's own cost.
     profiled = pipeline.execute(scenario, scenario.params, profile=True)[1].log
-    bare = bare_steps_per_second(pipeline.build(scenario, scenario.params), best_run.log.physics_steps)
+    fresh = pipeline.build(scenario, scenario.params)
+    bare = bare_steps_per_second(fresh, best_run.log.physics_steps)
+    replay, replay_deviation = replay_steps_per_second(fresh, best_run.log, repeats)
     cost = None
     if drives_cost and "drives" in type(scenario.params).names() and scenario.params.drives != "ideal":
         # The drive trains' cost: the loop's wall time per tick against the ideal drives'.
@@ -104,6 +170,8 @@ def bench_scenario(name: str, repeats: int = REPEATS, drives_cost: bool = True) 
         "loop_steps_per_s": best_loop,
         "bare_steps_per_s": bare,
         "loop_ratio": best_loop / bare,
+        "replay_steps_per_s": replay,
+        "replay_deviation": replay_deviation,
         "planner_wall_s": best_run.metrics.get("planner_wall_s"),
         "physics_share": profiled.physics_wall_s / profiled.loop_wall_s,
         "code_under_test_share": profiled.controller_wall_s / profiled.loop_wall_s,
@@ -142,6 +210,21 @@ def format_table(rows: list[dict]) -> str:
             f"{r['scenario']:<28} {100 * r['physics_share']:>7.0f}% {100 * r['code_under_test_share']:>20.0f}% "
             f"{100 * testbed:>7.0f}%"
         )
+    lines.append("")
+    lines.append(
+        f"{'MuJoCo alone on the run (replay)':<33} {'replay steps/s':>14} {'replay/bare':>11} {'loop/replay':>11}"
+    )
+    for r in rows:
+        if r.get("replay_steps_per_s"):
+            replay = r["replay_steps_per_s"]
+            lines.append(
+                f"{r['scenario']:<33} {replay:>14.0f} {replay / r['bare_steps_per_s']:>11.2f} "
+                f"{r['loop_steps_per_s'] / replay:>11.2f}"
+            )
+    lines.append(
+        "replay: the run's logged states and commands set tick by tick, then the loop's mj_step; loop/bare = "
+        "loop/replay x replay/bare, the Python between the steps times MuJoCo's own extra work on the run's motion"
+    )
     for r in rows:
         if r.get("planner_wall_s"):
             loop_wall = r["physics_steps"] / r["loop_steps_per_s"]

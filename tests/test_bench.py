@@ -3,9 +3,12 @@ own, and a planner-only campaign's counts (never a timed assertion)."""
 
 from __future__ import annotations
 
-import numpy as np
+from types import SimpleNamespace
 
-from planbench import bench
+import numpy as np
+import pytest
+
+from planbench import bench, runner, scenarios
 
 
 def test_peak_memory_is_the_childs_own_not_its_parents(tmp_path, monkeypatch):
@@ -71,3 +74,52 @@ def test_the_campaign_table_compares_engines_in_the_same_state():
     assert ratios["ray x2, first on its cluster (best of 2)"] == ["0.80", "0.50"]
     assert ratios["ray x2, cluster up (best of 2)"] == ["1.67", "0.83"]
     assert lines[-1].endswith("tables equal run for run: yes")
+
+
+def _short(name: str, **params):
+    scenario = scenarios.get(name)
+    return scenario.build(scenario.resolve(duration=0.405, **params))  # 81 ticks of 5 ms
+
+
+@pytest.mark.parametrize("chunk", [7, 4096])
+@pytest.mark.parametrize(
+    ("name", "params", "exact"),
+    [
+        ("loader-supply", {}, True),
+        ("hexapod-sync-move", {"wind": 0.0}, True),
+        ("hexapod-sync-move", {"wind": 6.0}, False),  # the wind is an external force, not replayed
+    ],
+)
+def test_a_replay_steps_the_runs_own_motion(name, params, exact, chunk):
+    """Replaying a run's logged states and commands ends each tick in the next logged state,
+    bit for bit, where the plant writes nothing but the command (compared at each chunk's end
+    and at the run's); the hexapod's wind, a force the replay does not apply, moves it off."""
+    log = runner.simulate(_short(name, **params), chunk_ticks=chunk)
+    rate, deviation = bench.replay_steps_per_second(_short(name, **params), log)
+    assert rate > 0.0
+    assert (deviation == 0.0) if exact else (1e-7 < deviation < 1e-2)
+
+
+def test_a_replay_refuses_a_log_without_a_tick():
+    log = SimpleNamespace(n=1, physics_steps=0)
+    with pytest.raises(ValueError, match="this log has 1 rows, 0 steps"):
+        bench.replay_steps_per_second(_short("loader-supply"), log)
+
+
+def test_the_table_splits_loop_over_bare_into_replay_ratios():
+    row = {
+        "scenario": "loader-direct",
+        "sim_time_s": 3.0,
+        "wall_time_s": 0.2,
+        "realtime_factor": 15.0,
+        "physics_steps": 6000,
+        "loop_steps_per_s": 90_000.0,
+        "bare_steps_per_s": 150_000.0,
+        "loop_ratio": 0.6,
+        "replay_steps_per_s": 100_000.0,
+        "physics_share": 0.9,
+        "code_under_test_share": 0.02,
+    }
+    text = bench.format_table([row])
+    line = next(line for line in text.splitlines() if line.startswith("loader-direct") and "100000" in line)
+    assert line.split()[-2:] == ["0.67", "0.90"]  # replay/bare, loop/replay
