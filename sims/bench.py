@@ -212,18 +212,21 @@ def format_table(rows: list[dict]) -> str:
         )
     lines.append("")
     lines.append(
-        f"{'MuJoCo alone on the run (replay)':<33} {'replay steps/s':>14} {'replay/bare':>11} {'loop/replay':>11}"
+        f"{'MuJoCo alone on the run (replay)':<33} {'replay steps/s':>14} {'replay/bare':>11} {'loop/replay':>11} "
+        f"{'off the log':>11}"
     )
     for r in rows:
         if r.get("replay_steps_per_s"):
             replay = r["replay_steps_per_s"]
             lines.append(
                 f"{r['scenario']:<33} {replay:>14.0f} {replay / r['bare_steps_per_s']:>11.2f} "
-                f"{r['loop_steps_per_s'] / replay:>11.2f}"
+                f"{r['loop_steps_per_s'] / replay:>11.2f} {r.get('replay_deviation', float('nan')):>11.1e}"
             )
     lines.append(
         "replay: the run's logged states and commands set tick by tick, then the loop's mj_step; loop/bare = "
-        "loop/replay x replay/bare, the Python between the steps times MuJoCo's own extra work on the run's motion"
+        "loop/replay x replay/bare, the Python between the steps times MuJoCo's own extra work on the run's motion; "
+        "off the log: the largest |state - logged state| where a replayed tick ends (0: the run's own steps, bit for "
+        "bit; above 0: the plant also writes what the replay leaves out, such as external forces)"
     )
     for r in rows:
         if r.get("planner_wall_s"):

@@ -117,9 +117,10 @@ def test_the_table_splits_loop_over_bare_into_replay_ratios():
         "bare_steps_per_s": 150_000.0,
         "loop_ratio": 0.6,
         "replay_steps_per_s": 100_000.0,
+        "replay_deviation": 0.0,
         "physics_share": 0.9,
         "code_under_test_share": 0.02,
     }
     text = bench.format_table([row])
     line = next(line for line in text.splitlines() if line.startswith("loader-direct") and "100000" in line)
-    assert line.split()[-2:] == ["0.67", "0.90"]  # replay/bare, loop/replay
+    assert line.split()[-3:] == ["0.67", "0.90", "0.0e+00"]  # replay/bare, loop/replay, off the log
