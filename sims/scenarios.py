@@ -220,8 +220,10 @@ def _by_prefix(name: str, plans: bool = False) -> Scenario | None:
 
 def _declared_by(mechanism: str, name: str, plans: bool = False) -> Scenario | None:
     """Before the registry is built: the entry ``name`` that ``mechanism`` declares, that
-    mechanism's package imported alone; None otherwise (or once the registry is built)."""
-    if _registry.cache_info().currsize:
+    mechanism's package imported alone; None otherwise (or once the registry is built, or
+    where PLANBENCH_MECHANISMS adds mechanisms: one of those may declare the same name, which
+    the registry refuses)."""
+    if _registry.cache_info().currsize or models.extra_roots():
         return None
     record = getattr(_import_mechanism(mechanism), "MECHANISM", None)
     entries = (*getattr(record, "scenarios", ()), *(getattr(record, "plans", ()) if plans else ()))

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -136,3 +137,18 @@ def test_nothing_outside_its_folders_names_it():
         and "pendulum" in (ROOT / f).read_text(errors="replace").lower()
     ]
     assert outside == []
+
+
+def test_a_name_it_shares_with_a_built_in_scenario_is_refused(tmp_path):
+    """A mechanism of one's own that declares loader-supply: the command line does not take the
+    loader's by its name's prefix alone; the registry refuses the name as taken."""
+    root = tmp_path / "mine"
+    shutil.copytree(PENDULUM, root, ignore=shutil.ignore_patterns("__pycache__"))
+    package = root / "sims" / "pendulum" / "__init__.py"
+    package.write_text(package.read_text().replace('"pendulum-swing",', '"loader-supply",'))
+    done = planbench(
+        "run", "loader-supply", "--out", "out", cwd=tmp_path, check=False, **{models.ROOTS_VARIABLE: str(root)}
+    )
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert "scenario name 'loader-supply' of sims.pendulum is taken" in done.stderr
+    assert not (tmp_path / "out").exists()

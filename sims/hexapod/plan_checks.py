@@ -360,10 +360,11 @@ def _judge_strut_moves(moves: hexapod_planner.StrutMoves) -> dict:
     fresh = np.ones((count, points), dtype=bool)
     fresh[:, 1:] = times[:, 1:] != times[:, :-1]
     first = np.flatnonzero(fresh.ravel())
-    source = np.maximum.accumulate(np.where(fresh.ravel(), np.arange(fresh.size), 0))
-    rank = np.cumsum(fresh.ravel()) - 1  # flat point -> its row among ``first``
+    # Flat point -> the row among ``first`` of the fresh point at or before it (its own, or
+    # the one it repeats).
+    rank = np.cumsum(fresh.ravel()) - 1
     sample = _sample_rows(moves, first // points, times.ravel()[first])
-    position = sample.position[rank[source]].reshape(count, points, 6)
+    position = sample.position[rank].reshape(count, points, 6)
     speed = _max_by_move(np.abs(sample.velocity), first, points)  # (N, 6)
     accel = _max_by_move(np.abs(sample.acceleration), first, points)
     stroke = np.abs(position).max(axis=1)
